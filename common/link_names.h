@@ -1,0 +1,11 @@
+#pragma once
+// System names of the two segments for a `--shm NAME` (DESIGN.md §2: one segment per link).
+
+#include <string>
+
+namespace impetus {
+
+inline std::string world_link_name(const std::string& shm) { return shm + ".world"; }
+inline std::string device_port_name(const std::string& shm) { return shm + ".device"; }
+
+}  // namespace impetus

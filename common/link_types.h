@@ -1,0 +1,142 @@
+#pragma once
+// The frames that cross the world link and the device port (DESIGN.md §2). These are the contract between processes:
+// fixed capacity, no pointers, trivially copyable, SI units, world frame (right-handed, z up).
+//
+// Changing any struct here changes the shared-memory layout: bump kLayoutVersion in segment.h.
+
+#include "common/vec3.h"
+
+#include <cstdint>
+#include <type_traits>
+
+namespace impetus {
+
+inline constexpr std::uint32_t kMaxPlanes = 64;          // planes in one world → haptic frame
+inline constexpr std::uint32_t kMaxImpulseEntries = 64;  // objects with a running impulse total in one report
+
+enum class Coupling : std::uint32_t {
+  impulse = 0,   // paper §2.2: the haptic side integrates the force, the world applies the impulse
+  position = 1,  // the paper's "previous method": the world samples the finger and applies a penalty force
+  local = 2,     // paper §6.3: the haptic side also moves the touched object between world steps (issue 9)
+};
+
+// Plane flags.
+inline constexpr std::uint32_t kPlaneDynamic = 1u << 0;  // the object moves; impulses on it are applied by the world
+
+// One plane of paper §3.1: the nearest surface point of an object to the finger and the outward normal there, plus
+// what the haptic side needs for friction (§6.2) and for splitting the reaction among objects.
+struct Plane {
+  std::int32_t object_id = -1;  // index of the object in the scene; stable for the whole run
+  std::uint32_t flags = 0;
+  Vec3 point_m{};                 // nearest surface point to the finger
+  Vec3 normal{};                  // unit, pointing out of the object toward the finger side
+  Vec3 com_m{};                   // object's centre of mass
+  Vec3 velocity_mps{};            // linear velocity of the centre of mass
+  Vec3 angular_velocity_radps{};  // angular velocity, world frame
+  double static_friction = 0.0;   // coefficient, dimensionless
+  double dynamic_friction = 0.0;  // coefficient, dimensionless, <= static_friction
+  // Local response model for the coming world period (issue 9, paper §6.3). Zero means "not provided": the haptic
+  // side must then treat the object as immovable between world steps.
+  double inverse_mass_per_kg = 0.0;
+  std::array<double, 9> inverse_inertia_world{};  // row-major, 1/(kg·m²), about the centre of mass
+};
+
+// World → haptic, published once per world step i (DESIGN.md §1 step 5).
+struct PlaneFrame {
+  std::uint64_t frame_index = 0;       // i; 0 is the first frame of a world session
+  std::uint64_t world_session = 0;     // changes when the world manager restarts
+  std::uint64_t report_tick_applied = 0;  // tick of the last haptic report whose impulses the world applied
+  std::uint64_t report_session_applied = 0;  // haptic session of that report (0 if none yet)
+  double world_time_s = 0.0;           // simulated time at the end of this step
+  double world_period_s = 0.0;         // T_w
+  Coupling coupling = Coupling::impulse;
+  std::uint32_t plane_count = 0;
+  // Haptic parameters from the scene; the haptic controller's flags override them.
+  double stiffness_Npm = 0.0;
+  double damping_Nspm = 0.0;
+  std::array<Plane, kMaxPlanes> planes{};
+  std::uint64_t checksum = 0;  // frame_checksum() of everything above; set by the writer
+};
+
+// Running impulse on one object since the haptic session started (never reset while the session lives), so the world
+// applies `total - applied_so_far` whatever the timing and nothing is lost or counted twice (DESIGN.md §2).
+struct ObjectImpulse {
+  std::int32_t object_id = -1;
+  // Incremented by the haptic side each time it (re)allocates an entry for this object: a new epoch restarts the
+  // total from zero, so the world resets its baseline instead of seeing a negative or huge difference.
+  std::uint32_t epoch = 0;
+  Vec3 impulse_Ns{};              // ∑ −f_k·Δt over ticks, shared to this object (paper §3.4)
+  Vec3 angular_impulse_Nms{};     // ∑ (contact − CoM) × (−f_k·Δt), about the centre of mass
+  std::uint64_t last_tick = 0;    // last haptic tick that added to this entry
+};
+
+// Haptic → world, published every haptic tick (DESIGN.md §1 "One haptic tick").
+struct HapticReport {
+  std::uint64_t tick = 0;           // haptic tick j of this session
+  std::uint64_t haptic_session = 0; // nonzero; changes when the haptic controller restarts
+  double haptic_time_s = 0.0;       // session time at this tick
+  Vec3 finger_m{};                  // C_j
+  Vec3 finger_velocity_mps{};
+  std::uint32_t finger_valid = 0;   // 0 while no device is attached: position coupling must not use finger_m
+  std::uint32_t entry_count = 0;
+  Vec3 static_impulse_Ns{};         // share of the reaction that went into static geometry (floor, fixed objects)
+  std::array<ObjectImpulse, kMaxImpulseEntries> entries{};
+  std::uint64_t checksum = 0;
+};
+
+inline constexpr int kStringCount = 4;
+
+// Haptic → device: the tensions to command (DESIGN.md §1 step 6).
+struct DeviceCommand {
+  std::uint64_t tick = 0;
+  std::uint64_t haptic_session = 0;
+  std::array<double, kStringCount> tension_N{};
+  std::uint64_t checksum = 0;
+};
+
+// Device → haptic: the encoder readings.
+struct DeviceState {
+  std::uint64_t tick = 0;            // device tick; in lockstep equal to the haptic tick it answers
+  std::uint64_t device_session = 0;  // changes on each attach
+  std::array<std::int64_t, kStringCount> encoder_counts{};
+  std::uint64_t checksum = 0;
+};
+
+static_assert(std::is_trivially_copyable_v<Plane>);
+static_assert(std::is_trivially_copyable_v<PlaneFrame>);
+static_assert(std::is_trivially_copyable_v<ObjectImpulse>);
+static_assert(std::is_trivially_copyable_v<HapticReport>);
+static_assert(std::is_trivially_copyable_v<DeviceCommand>);
+static_assert(std::is_trivially_copyable_v<DeviceState>);
+
+// Why a reader rejected a frame; kOk means accepted.
+enum class FrameError : std::uint32_t {
+  ok = 0,
+  checksum,
+  count_out_of_range,
+  not_finite,
+  normal_not_unit,
+  bad_period,
+  bad_coupling,
+  bad_friction,
+};
+const char* to_string(FrameError error);
+
+// Checksums cover every byte of the frame before the checksum field. Writers set them; readers verify them.
+std::uint64_t frame_checksum(const PlaneFrame& frame);
+std::uint64_t frame_checksum(const HapticReport& report);
+std::uint64_t frame_checksum(const DeviceCommand& command);
+std::uint64_t frame_checksum(const DeviceState& state);
+
+template <class Frame>
+void seal(Frame& frame) {
+  frame.checksum = frame_checksum(frame);
+}
+
+// Validation of everything a reader accepts: checksum, counts within capacity, finite numbers, unit normals.
+FrameError validate(const PlaneFrame& frame);
+FrameError validate(const HapticReport& report);
+FrameError validate(const DeviceCommand& command);
+FrameError validate(const DeviceState& state);
+
+}  // namespace impetus

@@ -1,0 +1,86 @@
+#pragma once
+// Turn-taking for `--clock lockstep` (DESIGN.md §3): the haptic controller's tick count is the master clock; the device
+// advances once per haptic tick and the world steps at tick i·n + phase. A follower sleeps on an interprocess semaphore
+// until the master gives it a turn, does its step, and hands the turn back — no spinning (the machine has 2 cores) and
+// the order of every read and write is fixed, so runs are bitwise reproducible.
+//
+// Every wait is sliced (kWaitSlice) so a waiter notices a dead peer or a shutdown request instead of hanging forever.
+
+#include <semaphore.h>
+
+#include <atomic>
+#include <cstdint>
+
+namespace impetus {
+
+enum class ClockMode : std::uint32_t { realtime = 0, lockstep = 1 };
+const char* to_string(ClockMode mode);
+
+enum class TurnResult { ok, shutdown, peer_gone, timed_out };
+
+// Lives in a segment. Both semaphores are process-shared.
+class LockstepTurn {
+ public:
+  LockstepTurn();
+  // Re-initialises both semaphores. Only when no process can be waiting on them (the peer died and its slot is not
+  // yet released), so stale posts from a dead peer cannot hand a new peer a turn that was never given.
+  void reset();
+
+  // Master: hands tick `tick` to the follower.
+  void give(std::uint64_t tick);
+  // Master: waits for the follower to finish its turn. `peer_alive()` is polled every slice; the wait gives up after
+  // `timeout_s` (a follower that is alive but stuck for that long is a bug worth stopping for).
+  template <class PeerAlive>
+  TurnResult wait_done(PeerAlive&& peer_alive, double timeout_s);
+
+  // Follower: waits for a turn; on ok, `tick()` is the tick to do. `keep_waiting()` is polled every slice.
+  template <class KeepWaiting>
+  TurnResult wait_turn(KeepWaiting&& keep_waiting);
+  // Follower: hands the turn back.
+  void finish();
+
+  std::uint64_t tick() const { return tick_.load(std::memory_order_acquire); }
+  // Master: ends the session; a follower's wait returns `shutdown` from then on.
+  void request_shutdown();
+  bool shutdown_requested() const { return shutdown_.load(std::memory_order_acquire) != 0; }
+
+ private:
+  enum class Wait { posted, slice_over, error };
+  static Wait wait_slice(sem_t& semaphore);
+
+  sem_t go_;
+  sem_t done_;
+  std::atomic<std::uint64_t> tick_{0};
+  std::atomic<std::uint32_t> shutdown_{0};
+};
+
+template <class PeerAlive>
+TurnResult LockstepTurn::wait_done(PeerAlive&& peer_alive, double timeout_s) {
+  const int slices = static_cast<int>(timeout_s / 0.1) + 1;
+  for (int slice = 0; slice < slices; ++slice) {
+    switch (wait_slice(done_)) {
+      case Wait::posted: return TurnResult::ok;
+      case Wait::error: return TurnResult::peer_gone;
+      case Wait::slice_over:
+        if (!peer_alive()) return TurnResult::peer_gone;
+        break;
+    }
+  }
+  return TurnResult::timed_out;
+}
+
+template <class KeepWaiting>
+TurnResult LockstepTurn::wait_turn(KeepWaiting&& keep_waiting) {
+  for (;;) {
+    if (shutdown_requested()) return TurnResult::shutdown;
+    switch (wait_slice(go_)) {
+      case Wait::posted: return shutdown_requested() ? TurnResult::shutdown : TurnResult::ok;
+      case Wait::error: return TurnResult::peer_gone;
+      case Wait::slice_over:
+        if (!keep_waiting()) return TurnResult::peer_gone;
+        break;
+    }
+  }
+}
+
+}  // namespace impetus

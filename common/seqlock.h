@@ -1,0 +1,80 @@
+#pragma once
+// Single-writer, many-reader channel for one trivially-copyable frame, placed in shared memory (DESIGN.md §2).
+//
+// The writer never waits: it bumps the sequence word to odd, stores the payload, then bumps it to even. A reader polls
+// the sequence word first (cheap, so it copies only when something new was published), copies the payload, and keeps
+// the copy only if the sequence was even and unchanged across the copy — it never returns a torn frame. The payload
+// lives in relaxed atomic 64-bit words so the concurrent copy is not a data race in the C++ memory model.
+//
+// Exactly one writer per channel (one process, one thread). Readers may be in any process.
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
+
+namespace impetus {
+
+template <class T>
+class SeqlockChannel {
+  static_assert(std::is_trivially_copyable_v<T>, "a channel frame must be trivially copyable");
+  static_assert(std::atomic<std::uint64_t>::is_always_lock_free, "the sequence and payload words must be lock-free");
+
+ public:
+  static constexpr std::size_t kWords = (sizeof(T) + 7) / 8;
+
+  // Publishes a frame. Wait-free.
+  void write(const T& frame) {
+    const std::uint64_t seq = sequence_.load(std::memory_order_relaxed);
+    sequence_.store(seq + 1, std::memory_order_relaxed);
+    // Orders the odd sequence before the payload stores (a reader that sees new payload sees the odd sequence).
+    std::atomic_thread_fence(std::memory_order_release);
+    const auto* bytes = reinterpret_cast<const unsigned char*>(&frame);
+    for (std::size_t w = 0; w < kWords; ++w) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, bytes + w * 8, w + 1 < kWords ? 8 : sizeof(T) - w * 8);
+      payload_[w].store(word, std::memory_order_relaxed);
+    }
+    sequence_.store(seq + 2, std::memory_order_release);
+  }
+
+  // The current sequence number: even and > 0 once something was written; compare with a previous value to see
+  // whether there is news without copying the payload.
+  std::uint64_t sequence() const { return sequence_.load(std::memory_order_acquire); }
+
+  // Copies the latest frame into `out` if it was published after `last_sequence` (pass 0 to accept any frame).
+  // Returns false if nothing new was published or the writer was mid-write `max_attempts` times in a row (the caller
+  // retries on its next tick instead of spinning). On success `last_sequence` is updated.
+  bool try_read(T& out, std::uint64_t& last_sequence, int max_attempts = 4) const {
+    for (int attempt = 0; attempt < max_attempts; ++attempt) {
+      const std::uint64_t before = sequence_.load(std::memory_order_acquire);
+      if (before == last_sequence || before == 0) return false;
+      if (before & 1u) continue;
+      auto* bytes = reinterpret_cast<unsigned char*>(&out);
+      for (std::size_t w = 0; w < kWords; ++w) {
+        const std::uint64_t word = payload_[w].load(std::memory_order_relaxed);
+        std::memcpy(bytes + w * 8, &word, w + 1 < kWords ? 8 : sizeof(T) - w * 8);
+      }
+      // Orders the payload loads before the second sequence load.
+      std::atomic_thread_fence(std::memory_order_acquire);
+      if (sequence_.load(std::memory_order_relaxed) == before) {
+        last_sequence = before;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // Used only when a segment is created (no concurrent access).
+  void reset() {
+    sequence_.store(0, std::memory_order_relaxed);
+    for (auto& word : payload_) word.store(0, std::memory_order_relaxed);
+  }
+
+ private:
+  std::atomic<std::uint64_t> sequence_{0};
+  std::atomic<std::uint64_t> payload_[kWords];
+};
+
+}  // namespace impetus

@@ -1,0 +1,126 @@
+#include "common/impulse_ledger.h"
+#include "common/segment.h"
+#include "common/seqlock.h"
+#include "test_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <time.h>
+
+#include <atomic>
+#include <random>
+
+namespace impetus {
+namespace {
+
+struct ReportLayout {
+  static constexpr SegmentKind kKind = SegmentKind::world_link;
+  SegmentHeader header;
+  SeqlockChannel<HapticReport> report;
+  std::atomic<std::uint32_t> writer_done{0};
+  Vec3 rendered_total_Ns[4]{};  // what the writer rendered per object, published when it is done
+};
+
+void sleep_ns(long ns) {
+  timespec duration{ns / 1'000'000'000, ns % 1'000'000'000};
+  nanosleep(&duration, nullptr);
+}
+
+// Impulses are whole multiples of 2^-20 N·s and totals stay far below 2^32 of them, so every sum below is exact in
+// double precision: the test can demand equality, and a single lost or doubled tick shows as a mismatch.
+constexpr double kQuantum_Ns = 1.0 / (1 << 20);
+
+}  // namespace
+
+TEST_CASE("impulse applied by a reader at random 5-100 Hz equals impulse rendered by a 1 kHz writer with jitter") {
+  const std::string name = test::unique_segment_name("ledger");
+  auto segment = Segment<ReportLayout>::create(name);
+
+  const pid_t writer = test::fork_child([&] {
+    std::mt19937_64 random(12345);
+    std::uniform_int_distribution<int> quanta(-50, 200);
+    std::uniform_int_distribution<long> jitter_ns(200'000, 1'800'000);  // 1 kHz on average, ±0.8 ms
+    std::uniform_int_distribution<int> object_pick(0, 3);
+    HapticReport report{};
+    report.haptic_session = 77;
+    report.entry_count = 4;
+    for (int k = 0; k < 4; ++k) report.entries[k].object_id = k;
+    for (std::uint64_t tick = 1; tick <= 1500; ++tick) {
+      report.tick = tick;
+      ObjectImpulse& entry = report.entries[object_pick(random)];
+      for (int a = 0; a < 3; ++a) entry.impulse_Ns[a] += quanta(random) * kQuantum_Ns;
+      entry.last_tick = tick;
+      seal(report);
+      segment->report.write(report);
+      sleep_ns(jitter_ns(random));
+    }
+    for (int k = 0; k < 4; ++k) segment->rendered_total_Ns[k] = report.entries[k].impulse_Ns;
+    segment->writer_done.store(1, std::memory_order_release);
+    return 0;
+  });
+
+  ImpulseLedger ledger(4);
+  Vec3 applied_Ns[4]{};
+  auto apply = [&](int object, const ImpulseDelta& delta) {
+    for (int a = 0; a < 3; ++a) applied_Ns[object][a] += delta.impulse_Ns[a];
+  };
+  std::mt19937_64 random(999);
+  std::uniform_int_distribution<long> period_ns(10'000'000, 200'000'000);  // 5–100 Hz
+  std::uint64_t last_sequence = 0;
+  HapticReport report{};
+  int reads = 0;
+  for (;;) {
+    const bool done = segment->writer_done.load(std::memory_order_acquire) != 0;
+    // Reading the same report twice must not apply anything twice: read, then read again with a reset sequence.
+    if (segment->report.try_read(report, last_sequence) && validate(report) == FrameError::ok) {
+      ledger.consume(report, apply);
+      ledger.consume(report, apply);
+      ++reads;
+    }
+    if (done) break;
+    sleep_ns(period_ns(random));
+  }
+  REQUIRE(test::wait_child(writer) == 0);
+  // One last read after the writer finished: the final totals.
+  std::uint64_t any = 0;
+  REQUIRE(segment->report.try_read(report, any));
+  ledger.consume(report, apply);
+
+  CHECK(reads > 5);
+  for (int k = 0; k < 4; ++k) {
+    for (int a = 0; a < 3; ++a) CHECK(applied_Ns[k][a] == segment->rendered_total_Ns[k][a]);
+  }
+}
+
+TEST_CASE("a new haptic session or entry epoch restarts the baseline from zero instead of a burst") {
+  ImpulseLedger ledger(2);
+  double applied_x_Ns = 0.0;
+  auto apply = [&](int, const ImpulseDelta& delta) { applied_x_Ns += delta.impulse_Ns[0]; };
+
+  HapticReport report{};
+  report.haptic_session = 1;
+  report.entry_count = 1;
+  report.entries[0].object_id = 0;
+  report.entries[0].impulse_Ns = {5.0, 0, 0};
+  ledger.consume(report, apply);
+  CHECK(applied_x_Ns == 5.0);
+
+  // The haptic controller restarts: its new total (0.25) is all new impulse, not 0.25 − 5.
+  report.haptic_session = 2;
+  report.entries[0].impulse_Ns = {0.25, 0, 0};
+  ledger.consume(report, apply);
+  CHECK(applied_x_Ns == 5.25);
+
+  // The entry is re-allocated with a new epoch: same rule.
+  report.entries[0].epoch = 1;
+  report.entries[0].impulse_Ns = {0.5, 0, 0};
+  ledger.consume(report, apply);
+  CHECK(applied_x_Ns == 5.75);
+
+  report.entries[0].object_id = 9;  // not in the world
+  ledger.consume(report, apply);
+  CHECK(ledger.unknown_objects() == 1);
+  CHECK(applied_x_Ns == 5.75);
+}
+
+}  // namespace impetus

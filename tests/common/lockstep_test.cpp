@@ -1,0 +1,98 @@
+#include "common/lockstep.h"
+#include "common/segment.h"
+#include "test_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <signal.h>
+
+#include <array>
+#include <atomic>
+#include <vector>
+
+namespace impetus {
+namespace {
+
+constexpr int kMaxEvents = 4096;
+
+// Events are encoded as who·10^6 + tick: 1 = device turn, 2 = haptic tick, 3 = world step.
+struct LockstepLayout {
+  static constexpr SegmentKind kKind = SegmentKind::world_link;
+  SegmentHeader header;
+  LockstepTurn device_turn;
+  LockstepTurn world_turn;
+  std::atomic<std::uint32_t> event_count{0};
+  std::array<std::int64_t, kMaxEvents> events{};
+};
+
+void record(LockstepLayout& layout, int who, std::uint64_t tick) {
+  const std::uint32_t index = layout.event_count.fetch_add(1);
+  if (index < kMaxEvents) layout.events[index] = who * 1'000'000 + static_cast<std::int64_t>(tick);
+}
+
+int follow(LockstepLayout& layout, LockstepTurn& turn, int who) {
+  for (;;) {
+    const TurnResult result = turn.wait_turn([] { return getppid() != 1; });
+    if (result == TurnResult::shutdown) return 0;
+    if (result != TurnResult::ok) return 1;
+    record(layout, who, turn.tick());
+    turn.finish();
+  }
+}
+
+// One run of three processes: the test process is the haptic master, two children follow. Returns the event order.
+std::vector<std::int64_t> run_three_processes(std::uint64_t ticks, std::uint64_t ticks_per_step,
+                                              std::uint64_t phase) {
+  const std::string name = test::unique_segment_name("lockstep");
+  auto segment = Segment<LockstepLayout>::create(name);
+  const pid_t device = test::fork_child([&] { return follow(*segment, segment->device_turn, 1); });
+  const pid_t world = test::fork_child([&] { return follow(*segment, segment->world_turn, 3); });
+  auto alive = [](pid_t pid) { return [pid] { return kill(pid, 0) == 0; }; };
+
+  for (std::uint64_t tick = 0; tick < ticks; ++tick) {
+    segment->device_turn.give(tick);
+    REQUIRE(segment->device_turn.wait_done(alive(device), 10.0) == TurnResult::ok);
+    record(*segment, 2, tick);
+    if (tick >= phase && (tick - phase) % ticks_per_step == 0) {
+      segment->world_turn.give(tick);
+      REQUIRE(segment->world_turn.wait_done(alive(world), 10.0) == TurnResult::ok);
+    }
+  }
+  segment->device_turn.request_shutdown();
+  segment->world_turn.request_shutdown();
+  CHECK(test::wait_child(device) == 0);
+  CHECK(test::wait_child(world) == 0);
+  const std::uint32_t count = segment->event_count.load();
+  REQUIRE(count <= kMaxEvents);
+  return {segment->events.begin(), segment->events.begin() + count};
+}
+
+}  // namespace
+
+TEST_CASE("lockstep with three processes runs device, haptic and world in a fixed order, identical across runs") {
+  constexpr std::uint64_t kTicks = 500, kTicksPerStep = 50, kPhase = 17;
+  const auto first = run_three_processes(kTicks, kTicksPerStep, kPhase);
+  const auto second = run_three_processes(kTicks, kTicksPerStep, kPhase);
+
+  std::vector<std::int64_t> expected;
+  for (std::uint64_t tick = 0; tick < kTicks; ++tick) {
+    expected.push_back(1'000'000 + static_cast<std::int64_t>(tick));
+    expected.push_back(2'000'000 + static_cast<std::int64_t>(tick));
+    if (tick >= kPhase && (tick - kPhase) % kTicksPerStep == 0) {
+      expected.push_back(3'000'000 + static_cast<std::int64_t>(tick));
+    }
+  }
+  CHECK(first == expected);
+  CHECK(second == first);
+}
+
+TEST_CASE("a lockstep master notices a dead follower instead of hanging") {
+  const std::string name = test::unique_segment_name("deadfollower");
+  auto segment = Segment<LockstepLayout>::create(name);
+  const pid_t follower = test::fork_child([] { return 0; });  // exits at once, never takes a turn
+  REQUIRE(test::wait_child(follower) == 0);
+  segment->device_turn.give(0);
+  CHECK(segment->device_turn.wait_done([&] { return kill(follower, 0) == 0; }, 5.0) == TurnResult::peer_gone);
+}
+
+}  // namespace impetus
