@@ -23,11 +23,9 @@ case "$sanitize" in
   *) echo "test.sh: --sanitize must be address or thread, not '$sanitize'" >&2; exit 2 ;;
 esac
 
-bash scripts/deps.sh
 build_dir=build${sanitize:+-$sanitize}
 build_type=Release
 [ -n "$sanitize" ] && build_type=RelWithDebInfo
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE="$build_type" -DIMPETUS_SANITIZE="$sanitize" >/dev/null
-cmake --build "$build_dir" -j"$(nproc)"
+bash scripts/build.sh "$build_dir" -DCMAKE_BUILD_TYPE="$build_type" -DIMPETUS_SANITIZE="$sanitize"
 cd "$build_dir"
 ctest --output-on-failure --timeout 600 -j"$(nproc)" "${ctest_args[@]}"

@@ -61,8 +61,11 @@ TEST_CASE("impulse applied by a reader at random 5-100 Hz equals impulse rendere
 
   ImpulseLedger ledger(4);
   Vec3 applied_Ns[4]{};
-  auto apply = [&](int object, const ImpulseDelta& delta) {
-    for (int a = 0; a < 3; ++a) applied_Ns[object][a] += delta.impulse_Ns[a];
+  auto consume = [&](const HapticReport& report) {
+    for (std::uint32_t k = 0; k < report.entry_count; ++k) {
+      const ImpulseDelta delta = ledger.take(report.haptic_session, report.entries[k]);
+      for (int a = 0; a < 3; ++a) applied_Ns[report.entries[k].object_id][a] += delta.impulse_Ns[a];
+    }
   };
   std::mt19937_64 random(999);
   std::uniform_int_distribution<long> period_ns(10'000'000, 200'000'000);  // 5–100 Hz
@@ -73,8 +76,8 @@ TEST_CASE("impulse applied by a reader at random 5-100 Hz equals impulse rendere
     const bool done = segment->writer_done.load(std::memory_order_acquire) != 0;
     // Reading the same report twice must not apply anything twice: read, then read again with a reset sequence.
     if (segment->report.try_read(report, last_sequence) && validate(report) == FrameError::ok) {
-      ledger.consume(report, apply);
-      ledger.consume(report, apply);
+      consume(report);
+      consume(report);
       ++reads;
     }
     if (done) break;
@@ -84,7 +87,7 @@ TEST_CASE("impulse applied by a reader at random 5-100 Hz equals impulse rendere
   // One last read after the writer finished: the final totals.
   std::uint64_t any = 0;
   REQUIRE(segment->report.try_read(report, any));
-  ledger.consume(report, apply);
+  consume(report);
 
   CHECK(reads > 5);
   for (int k = 0; k < 4; ++k) {
@@ -94,33 +97,25 @@ TEST_CASE("impulse applied by a reader at random 5-100 Hz equals impulse rendere
 
 TEST_CASE("a new haptic session or entry epoch restarts the baseline from zero instead of a burst") {
   ImpulseLedger ledger(2);
-  double applied_x_Ns = 0.0;
-  auto apply = [&](int, const ImpulseDelta& delta) { applied_x_Ns += delta.impulse_Ns[0]; };
-
-  HapticReport report{};
-  report.haptic_session = 1;
-  report.entry_count = 1;
-  report.entries[0].object_id = 0;
-  report.entries[0].impulse_Ns = {5.0, 0, 0};
-  ledger.consume(report, apply);
-  CHECK(applied_x_Ns == 5.0);
+  ObjectImpulse entry{};
+  entry.object_id = 0;
+  entry.impulse_Ns = {5.0, 0, 0};
+  CHECK(ledger.take(1, entry).impulse_Ns.x() == 5.0);
+  CHECK(ledger.take(1, entry).impulse_Ns.x() == 0.0);  // the same total again: nothing new
 
   // The haptic controller restarts: its new total (0.25) is all new impulse, not 0.25 − 5.
-  report.haptic_session = 2;
-  report.entries[0].impulse_Ns = {0.25, 0, 0};
-  ledger.consume(report, apply);
-  CHECK(applied_x_Ns == 5.25);
+  entry.impulse_Ns = {0.25, 0, 0};
+  CHECK(ledger.take(2, entry).impulse_Ns.x() == 0.25);
 
   // The entry is re-allocated with a new epoch: same rule.
-  report.entries[0].epoch = 1;
-  report.entries[0].impulse_Ns = {0.5, 0, 0};
-  ledger.consume(report, apply);
-  CHECK(applied_x_Ns == 5.75);
+  entry.epoch = 1;
+  entry.impulse_Ns = {0.5, 0, 0};
+  CHECK(ledger.take(2, entry).impulse_Ns.x() == 0.5);
 
-  report.entries[0].object_id = 9;  // not in the world
-  ledger.consume(report, apply);
-  CHECK(ledger.unknown_objects() == 1);
-  CHECK(applied_x_Ns == 5.75);
+  // The static share follows the session rule too.
+  CHECK(ledger.take_static(2, {0, 0, -1.0}).z() == -1.0);
+  CHECK(ledger.take_static(2, {0, 0, -1.5}).z() == -0.5);
+  CHECK(ledger.take_static(3, {0, 0, -0.25}).z() == -0.25);
 }
 
 }  // namespace impetus

@@ -1,0 +1,44 @@
+#include "common/daemon.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+namespace impetus {
+
+std::atomic<bool> g_stop_requested{false};
+
+namespace {
+extern "C" void on_stop_signal(int) { g_stop_requested.store(true); }
+}  // namespace
+
+void install_stop_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  // No SA_RESTART: a blocking sleep or wait returns EINTR and its loop re-checks the flag.
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+const char* to_string(Coupling coupling) {
+  switch (coupling) {
+    case Coupling::impulse: return "impulse";
+    case Coupling::position: return "position";
+    case Coupling::local: return "local";
+  }
+  return "unknown";
+}
+
+std::string check_writable_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path parent = fs::absolute(fs::path(path)).parent_path();
+  std::error_code error;
+  if (!fs::is_directory(parent, error)) return "directory '" + parent.string() + "' does not exist";
+  if (access(parent.c_str(), W_OK) != 0) return "directory '" + parent.string() + "' is not writable";
+  if (fs::is_directory(fs::path(path), error)) return "'" + path + "' is a directory";
+  return "";
+}
+
+}  // namespace impetus

@@ -1,0 +1,52 @@
+#pragma once
+// What the three daemons share outside their loops: a stop flag raised by SIGINT/SIGTERM, opening a segment that
+// its creator may not have created yet, and the command-line vocabulary of DESIGN.md §4.
+
+#include "common/link_types.h"
+#include "common/lockstep.h"
+#include "common/segment.h"
+
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <string>
+#include <thread>
+
+namespace impetus {
+
+// Raised by SIGINT or SIGTERM once install_stop_handlers() ran; loops poll it and finish their current step.
+extern std::atomic<bool> g_stop_requested;
+void install_stop_handlers();
+
+// Opens `name`, retrying while it does not exist (or is still being created) for up to `timeout_s`, or until a stop
+// is requested. Errors other than "not there yet" (another layout version, another kind) are thrown at once.
+template <class Layout>
+Segment<Layout> open_when_ready(const std::string& name, double timeout_s) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    try {
+      return Segment<Layout>::open(name);
+    } catch (const SegmentError& error) {
+      const std::string message = error.what();
+      const bool not_there_yet = message.find("is its creator running") != std::string::npos ||
+                                 message.find("still being created") != std::string::npos ||
+                                 message.find("too small for a header") != std::string::npos;
+      if (!not_there_yet || std::chrono::steady_clock::now() > give_up || g_stop_requested.load()) throw;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+// CLI11 maps for the enum flags, so a bad value is rejected with the flag, the value and the choices.
+inline const std::map<std::string, ClockMode> kClockNames{{"realtime", ClockMode::realtime},
+                                                          {"lockstep", ClockMode::lockstep}};
+inline const std::map<std::string, Coupling> kCouplingNames{
+    {"impulse", Coupling::impulse}, {"position", Coupling::position}, {"local", Coupling::local}};
+const char* to_string(Coupling coupling);
+
+// A CLI11 validator for file paths we will write: the directory must exist and be writable.
+std::string check_writable_path(const std::string& path);
+
+}  // namespace impetus

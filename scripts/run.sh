@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# Runs one trial: world_manager + haptic_controller + spidar_sim (DESIGN.md §4), collects their logs under DIR,
+# prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
+#
+#   scripts/run.sh --scene FILE --trajectory SPEC [--coupling impulse|position|local] [--rate HZ] [--phase TICKS]
+#                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet]
+#                  [-- extra haptic_controller flags, e.g. --stiffness 5000]
+#
+# Binaries come from $IMPETUS_BUILD_DIR (default build/); build them with scripts/build.sh.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="${IMPETUS_BUILD_DIR:-$root/build}"
+
+usage() { sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; }
+die() { echo "run.sh: $*" >&2; exit 2; }
+
+scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
+haptic_extra=()
+while (($#)); do
+  case "$1" in
+    --scene) scene="${2:?}"; shift 2 ;;
+    --trajectory) trajectory="${2:?}"; shift 2 ;;
+    --coupling) coupling="${2:?}"; shift 2 ;;
+    --rate) rate="${2:?}"; shift 2 ;;
+    --phase) phase="${2:?}"; shift 2 ;;
+    --clock) clock="${2:?}"; shift 2 ;;
+    --duration) duration="${2:?}"; shift 2 ;;
+    --out) out="${2:?}"; shift 2 ;;
+    --quiet) quiet=1; shift ;;
+    -h|--help) usage; exit 0 ;;
+    --) shift; haptic_extra=("$@"); break ;;
+    *) die "unknown argument '$1' (see --help)" ;;
+  esac
+done
+[ -n "$scene" ] || die "--scene is required"
+[ -f "$scene" ] || die "--scene: no such file '$scene'"
+[ -n "$trajectory" ] || die "--trajectory is required"
+case "$clock" in realtime|lockstep) ;; *) die "--clock must be realtime or lockstep, not '$clock'" ;; esac
+for bin in world_manager haptic_controller spidar_sim; do
+  [ -x "$build/$bin/$bin" ] || die "$build/$bin/$bin is missing: run scripts/build.sh first"
+done
+[ -n "$out" ] || out="$root/out/run-$(date +%Y%m%d-%H%M%S)-$$"
+mkdir -p "$out"
+# One shared-memory name per trial, so trials can run in parallel.
+shm="impetus_run_$$_$RANDOM"
+
+world_args=(--scene "$scene" --coupling "$coupling" --clock "$clock" --phase "$phase" --shm "$shm"
+            --log "$out/world.csv" --summary "$out/world.json")
+[ -n "$rate" ] && world_args+=(--rate "$rate")
+haptic_args=(--clock "$clock" --duration "$duration" --shm "$shm" --log "$out/haptic.csv"
+             --summary "$out/haptic.json" "${haptic_extra[@]}")
+device_args=(--clock "$clock" --trajectory "$trajectory" --shm "$shm" --log "$out/device.csv")
+
+pids=()
+stop_all() {
+  for pid in "${pids[@]}"; do kill -TERM "$pid" 2>/dev/null || true; done
+}
+on_interrupt() {
+  echo "run.sh: interrupted, stopping the trial" >&2
+  stop_all
+  wait || true
+  rm -f "/dev/shm/$shm.world" "/dev/shm/$shm.device"
+  exit 130
+}
+trap on_interrupt INT TERM
+
+start=$(date +%s.%N)
+"$build/world_manager/world_manager" "${world_args[@]}" 2>"$out/world.err" & world=$!; pids+=("$world")
+"$build/haptic_controller/haptic_controller" "${haptic_args[@]}" 2>"$out/haptic.err" & haptic=$!; pids+=("$haptic")
+"$build/spidar_sim/spidar_sim" "${device_args[@]}" 2>"$out/device.err" & device=$!; pids+=("$device")
+
+status=0
+# The trial lasts as long as the trajectory (its final hold lets the objects come to rest), capped by --duration.
+# Then the haptic controller and the world are stopped like a user would, and must exit cleanly.
+wait "$device" || { echo "run.sh: spidar_sim failed:" >&2; cat "$out/device.err" >&2; status=1; }
+kill -TERM "$haptic" 2>/dev/null || true
+wait "$haptic" || { echo "run.sh: haptic_controller failed:" >&2; cat "$out/haptic.err" >&2; status=1; }
+kill -TERM "$world" 2>/dev/null || true
+wait "$world" || { echo "run.sh: world_manager failed:" >&2; cat "$out/world.err" >&2; status=1; }
+end=$(date +%s.%N)
+trap - INT TERM
+for segment in "/dev/shm/$shm.world" "/dev/shm/$shm.device"; do
+  [ -e "$segment" ] && { echo "run.sh: $segment was left behind; removing it" >&2; rm -f "$segment"; status=1; }
+done
+((status == 0)) || exit "$status"
+
+args=("$out" --set "scene=$scene" --set "trajectory=$trajectory" --set "coupling=$coupling" --set "rate=$rate"
+      --set "phase_ticks=$phase" --set "clock=$clock" --set "duration_s=$duration"
+      --set "wall_start=$start" --set "wall_end=$end")
+((quiet)) && args+=(--quiet)
+/usr/bin/python3 "$root/scripts/summarize_trial.py" "${args[@]}"

@@ -1,0 +1,58 @@
+#!/usr/bin/python3
+"""Merges one trial's per-process summaries into DIR/summary.json (DESIGN.md §4) and prints the outcome.
+
+usage: summarize_trial.py DIR [--set key=value ...] [--quiet]
+"""
+import argparse
+import json
+import pathlib
+import sys
+
+
+def load(path):
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError) as error:
+        sys.exit(f"summarize_trial: cannot read {path}: {error}")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("dir", type=pathlib.Path)
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="a config entry of the trial")
+    parser.add_argument("--quiet", action="store_true")
+    args = parser.parse_args()
+
+    world = load(args.dir / "world.json")
+    haptic = load(args.dir / "haptic.json")
+    config = dict(world.get("config", {}))
+    for item in args.set:
+        key, _, value = item.partition("=")
+        config[key] = value
+    if "wall_start" in config and "wall_end" in config:
+        config["wall_time_s"] = float(config.pop("wall_end")) - float(config.pop("wall_start"))
+    summary = {"objects": world["objects"], "haptic": haptic["haptic"], "world": world["world"], "config": config}
+    (args.dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+
+    if args.quiet:
+        return
+    print(f"trial: {config.get('scene')} / {config.get('trajectory')} / {config.get('coupling')} coupling, "
+          f"{config.get('clock')} clock, world {config.get('world_rate_hz')} Hz, phase {config.get('phase_ticks')}")
+    for name, obj in summary["objects"].items():
+        x, y, z = obj["position"]
+        jx, jy, jz = obj["impulse_Ns"]
+        print(f"  {name:12s} final position [{x:+.4f} {y:+.4f} {z:+.4f}] m   "
+              f"impulse delivered [{jx:+.4f} {jy:+.4f} {jz:+.4f}] N·s")
+    h, w = summary["haptic"], summary["world"]
+    print(f"  haptic: {h['ticks']} ticks, max force {h['max_force_N']:.2f} N, faults {h['faults']}, "
+          f"force clamps {h['force_clamps']}, saturations {h['saturations']}, skipped periods {h['skipped_periods']}, "
+          f"lateness p50/p99/max {h['lateness_p50_ns'] / 1e3:.0f}/{h['lateness_p99_ns'] / 1e3:.0f}/"
+          f"{h['lateness_max_ns'] / 1e3:.0f} µs")
+    print(f"  world:  {w['steps']} steps, {w['time_s']:.3f} s simulated, skipped periods {w['skipped_periods']}, "
+          f"rejected reports {w['rejected_reports']}")
+    print(f"  wall time {config.get('wall_time_s', 0):.2f} s; logs and summary.json in {args.dir}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,65 @@
+#include "spidar_sim/device_sim.h"
+
+#include <cmath>
+#include <iomanip>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace impetus {
+
+namespace {
+
+// Log precision: 1e-9 m resolves a fraction of an encoder count (1.7e-5 m) and a nanonewton of force.
+constexpr int kLogSignificantDigits = 10;
+
+}  // namespace
+
+DeviceSim::DeviceSim(const SpidarGeometry& geometry, HardwareParams hardware, FingerParams finger,
+                     Trajectory trajectory)
+    : hardware_(geometry, hardware),
+      trajectory_(std::move(trajectory)),
+      finger_(finger, to_eigen(trajectory_.position_at(0.0))) {
+  state_.encoder_counts = hardware_.encoder_counts(finger_.position_m());
+}
+
+const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& commanded_tension_N, double dt_s) {
+  if (!(std::isfinite(dt_s) && dt_s > 0.0 && dt_s <= kMaxTick_s)) {
+    throw std::invalid_argument("DeviceSim::tick: dt_s must be in (0, " + std::to_string(kMaxTick_s) + "] s, got " +
+                                std::to_string(dt_s));
+  }
+  const int substeps = finger_.substeps_for(dt_s);
+  const double h_s = dt_s / substeps;
+  for (int k = 0; k < substeps; ++k) {
+    const double t_s = time_s_ + k * h_s;
+    hardware_.apply(commanded_tension_N, h_s);
+    const Eigen::Vector3d force_N = hardware_.force_on_finger(finger_.position_m());
+    finger_.step(to_eigen(trajectory_.position_at(t_s)), to_eigen(trajectory_.velocity_at(t_s)), force_N, h_s);
+  }
+  time_s_ += dt_s;
+  ++state_.tick;
+  state_.encoder_counts = hardware_.encoder_counts(finger_.position_m());
+  return state_;
+}
+
+void DeviceSim::write_log_header(std::ostream& out) {
+  out << "time_s,target_x_m,target_y_m,target_z_m,finger_x_m,finger_y_m,finger_z_m,"
+         "finger_vx_mps,finger_vy_mps,finger_vz_mps,force_x_N,force_y_N,force_z_N,"
+         "tension_0_N,tension_1_N,tension_2_N,tension_3_N,count_0,count_1,count_2,count_3\n";
+}
+
+void DeviceSim::write_log_row(std::ostream& out) const {
+  const auto old_precision = out.precision(kLogSignificantDigits);
+  const auto write3 = [&out](const Vec3& v) { out << ',' << v[0] << ',' << v[1] << ',' << v[2]; };
+  out << time_s_;
+  write3(target_m());
+  write3(finger_m());
+  write3(finger_velocity_mps());
+  write3(device_force_N());
+  for (const double t : tensions_N()) out << ',' << t;
+  for (const std::int64_t c : encoder_counts()) out << ',' << c;
+  out << '\n';
+  out.precision(old_precision);
+}
+
+}  // namespace impetus

@@ -1,0 +1,64 @@
+#pragma once
+// One simulated device session: the SPIDAR hardware, the finger and the scripted target, advanced one device tick at a
+// time (DESIGN.md §1 "One device tick"). main.cpp wires it to the device port and the clock; tests drive it directly.
+//
+// Contract of tick(): the commanded tensions are held for dt_s (zero-order hold, like a motor amplifier's setpoint);
+// within the tick the finger is integrated in sub-steps, re-evaluating the target and the string directions at each;
+// the returned state carries the encoder counts at the end of the tick. Time starts at 0 with the finger at rest on
+// the trajectory's start and the motors at the minimum tension. No allocation after construction.
+
+#include "common/device_geometry.h"
+#include "common/link_types.h"
+#include "common/trajectory.h"
+#include "common/vec3.h"
+#include "spidar_sim/finger.h"
+#include "spidar_sim/spidar_hardware.h"
+
+#include <array>
+#include <ostream>
+
+namespace impetus {
+
+class DeviceSim {
+ public:
+  // Throws std::invalid_argument (from the parts) if the geometry or parameters are unusable.
+  DeviceSim(const SpidarGeometry& geometry, HardwareParams hardware, FingerParams finger, Trajectory trajectory);
+
+  // Advances one device tick of dt_s (finite, > 0 and at most kMaxTick_s; else std::invalid_argument) and returns the
+  // encoder counts at its end with `tick` incremented (the first call returns tick 1). The caller sets
+  // device_session and seals the frame before publishing it.
+  const DeviceState& tick(const std::array<double, kStringCount>& commanded_tension_N, double dt_s);
+
+  // A realtime hiccup longer than this is a bug upstream, not a tick: the sub-step count would explode.
+  static constexpr double kMaxTick_s = 1.0;
+
+  const DeviceState& state() const { return state_; }
+  double time_s() const { return time_s_; }
+  Vec3 target_m() const { return trajectory_.position_at(time_s_); }
+  Vec3 finger_m() const { return to_vec3(finger_.position_m()); }
+  Vec3 finger_velocity_mps() const { return to_vec3(finger_.velocity_mps()); }
+  // Net string force on the finger at the end of the last tick (N): Σ t_i·u_i.
+  Vec3 device_force_N() const { return to_vec3(hardware_.force_on_finger(finger_.position_m())); }
+  const std::array<double, kStringCount>& tensions_N() const { return hardware_.tensions_N(); }
+  const std::array<std::int64_t, kStringCount>& encoder_counts() const { return state_.encoder_counts; }
+  // True once the session time reaches the end of the trajectory (the target then holds still).
+  bool finished() const { return time_s_ >= trajectory_.duration_s(); }
+
+  const Trajectory& trajectory() const { return trajectory_; }
+  const SpidarHardware& hardware() const { return hardware_; }
+  const Finger& finger() const { return finger_; }
+
+  // Log (DESIGN.md §4 "Logs"): one header, then one row per tick with time, target, finger position and velocity,
+  // device force, applied tensions and encoder counts.
+  static void write_log_header(std::ostream& out);
+  void write_log_row(std::ostream& out) const;
+
+ private:
+  SpidarHardware hardware_;
+  Trajectory trajectory_;
+  Finger finger_;
+  double time_s_ = 0.0;
+  DeviceState state_{};
+};
+
+}  // namespace impetus

@@ -1,0 +1,75 @@
+// Channel latency between two processes: a writer publishes a HapticReport-sized frame every millisecond with its
+// CLOCK_MONOTONIC send time inside; a reader in another process polls the sequence word and records publish→observe
+// latency. Prints p50/p99/max; asserts nothing (timing on a shared VM is a measurement, not a test).
+//
+//   bench_channel [SECONDS=5]
+
+#include "common/link_types.h"
+#include "common/loop_stats.h"
+#include "common/segment.h"
+#include "common/seqlock.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+namespace {
+
+struct BenchLayout {
+  static constexpr impetus::SegmentKind kKind = impetus::SegmentKind::world_link;
+  impetus::SegmentHeader header;
+  impetus::SeqlockChannel<impetus::HapticReport> channel;
+  std::atomic<std::uint32_t> stop{0};
+  std::atomic<std::uint32_t> reader_ready{0};
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace impetus;
+  const double seconds = argc > 1 ? std::atof(argv[1]) : 5.0;
+  if (!(seconds > 0.0)) {
+    std::fprintf(stderr, "usage: bench_channel [SECONDS>0]\n");
+    return 2;
+  }
+  const std::string name = "impetus_bench_channel_" + std::to_string(getpid());
+  auto segment = Segment<BenchLayout>::create(name);
+
+  const pid_t reader = fork();
+  if (reader == 0) {
+    LatencyHistogram latency;
+    HapticReport report{};
+    std::uint64_t last = 0;
+    segment->reader_ready.store(1);
+    while (segment->stop.load(std::memory_order_relaxed) == 0) {
+      if (segment->channel.try_read(report, last)) {
+        latency.record(monotonic_now_ns() - static_cast<std::int64_t>(report.tick));
+      }
+    }
+    std::printf("channel publish->observe latency (HapticReport, %zu bytes, %llu samples): p50 %.2f us, "
+                "p99 %.2f us, p99.9 %.2f us, max %.1f us\n",
+                sizeof(HapticReport), static_cast<unsigned long long>(latency.count()),
+                latency.percentile_ns(0.5) / 1e3, latency.percentile_ns(0.99) / 1e3,
+                latency.percentile_ns(0.999) / 1e3, latency.max_ns() / 1e3);
+    std::fflush(stdout);
+    _exit(0);
+  }
+  while (segment->reader_ready.load() == 0) usleep(1000);
+  HapticReport report{};
+  report.entry_count = 8;
+  const std::int64_t end = monotonic_now_ns() + static_cast<std::int64_t>(seconds * 1e9);
+  while (monotonic_now_ns() < end) {
+    report.tick = static_cast<std::uint64_t>(monotonic_now_ns());  // the send time travels in the frame
+    seal(report);
+    segment->channel.write(report);
+    usleep(1000);
+  }
+  segment->stop.store(1);
+  int status = 0;
+  waitpid(reader, &status, 0);
+  return 0;
+}

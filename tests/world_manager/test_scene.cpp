@@ -1,0 +1,202 @@
+#include "common/scene.h"
+#include "world_test_support.h"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <numbers>
+#include <fstream>
+#include <limits>
+#include <string>
+
+using impetus::Scene;
+using impetus::SceneError;
+using nlohmann::json;
+
+namespace {
+
+json cube() {
+  return json{{"name", "cube"},         {"shape", "box"},  {"size_m", {0.05, 0.05, 0.05}},
+              {"dynamic", true},        {"mass_kg", 1.0},  {"position_m", {0.03, 0.0, 0.025}}};
+}
+
+json scene_with(const json& object) { return json{{"objects", {object}}}; }
+
+// The error must name the file and the JSON path of the offending field, and say why.
+void require_error(const json& document, const std::string& pointer, const std::string& reason) {
+  try {
+    impetus::parse_scene(document, "bad.json");
+    FAIL("expected SceneError for " << pointer);
+  } catch (const SceneError& error) {
+    const std::string message = error.what();
+    INFO(message);
+    CHECK(message.rfind("bad.json: " + pointer + ":", 0) == 0);
+    CHECK(message.find(reason) != std::string::npos);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("a minimal scene gets the documented defaults") {
+  const Scene scene = impetus::parse_scene(scene_with(cube()), "ok.json");
+  REQUIRE(scene.objects.size() == 1);
+  CHECK(scene.gravity_mps2[2] == -9.81);
+  CHECK(scene.floor.present);
+  CHECK(scene.floor.height_m == 0.0);
+  CHECK(scene.physics.world_rate_hz == 20.0);
+  CHECK(scene.haptic.stiffness_Npm == 2000.0);
+  CHECK(scene.objects[0].mass_kg == 1.0);
+  CHECK(scene.objects[0].orientation_wxyz[0] == 1.0);
+  CHECK(scene.floor_object_id() == 1);
+}
+
+TEST_CASE("density gives mass from the shape's volume") {
+  json sphere{{"name", "s"}, {"shape", "sphere"}, {"radius_m", 0.1}, {"dynamic", true},
+              {"density_kgpm3", 1000.0}, {"position_m", {0, 0, 1}}};
+  const Scene scene = impetus::parse_scene(scene_with(sphere), "ok.json");
+  CHECK(scene.objects[0].mass_kg == Approx(1000.0 * 4.0 / 3.0 * std::numbers::pi * 1e-3).epsilon(1e-12));
+}
+
+TEST_CASE("shipped scenes load") {
+  for (const char* file : {"tap.json", "spheres.json", "stack.json"}) {
+    INFO(file);
+    const Scene scene = impetus::load_scene(impetus::test::scene_path(file));
+    CHECK_FALSE(scene.objects.empty());
+  }
+  const Scene spheres = impetus::load_scene(impetus::test::scene_path("spheres.json"));
+  CHECK(spheres.objects.size() >= 20);  // paper §5: more than 20 movable spheres
+  const Scene tap = impetus::load_scene(impetus::test::scene_path("tap.json"));
+  CHECK(tap.objects[0].mass_kg == 1.0);  // paper §4.2.2: a cube of 1 kg
+}
+
+TEST_CASE("scene error: unknown key names the key") {
+  json object = cube();
+  object["colour"] = "red";
+  require_error(scene_with(object), "/objects/0/colour", "unknown key");
+  require_error(json{{"objects", json::array()}, {"physcs", json::object()}}, "/physcs", "unknown key");
+}
+
+TEST_CASE("scene error: a key of another shape is unknown") {
+  json object = cube();
+  object["radius_m"] = 0.1;
+  require_error(scene_with(object), "/objects/0/radius_m", "unknown key");
+}
+
+TEST_CASE("scene error: missing field") {
+  json object = cube();
+  object.erase("position_m");
+  require_error(scene_with(object), "/objects/0/position_m", "missing");
+  require_error(json::object(), "/objects", "missing");
+  json no_size = cube();
+  no_size.erase("size_m");
+  require_error(scene_with(no_size), "/objects/0/size_m", "missing");
+  json no_mass = cube();
+  no_mass.erase("mass_kg");
+  require_error(scene_with(no_mass), "/objects/0/mass_kg", "missing");
+}
+
+TEST_CASE("scene error: wrong type") {
+  json object = cube();
+  object["mass_kg"] = "heavy";
+  require_error(scene_with(object), "/objects/0/mass_kg", "expected a number");
+  json flag = cube();
+  flag["dynamic"] = 1;
+  require_error(scene_with(flag), "/objects/0/dynamic", "expected true or false");
+  json short_position = cube();
+  short_position["position_m"] = {0.0, 0.0};
+  require_error(scene_with(short_position), "/objects/0/position_m", "array of 3");
+}
+
+TEST_CASE("scene error: negative or zero mass") {
+  json object = cube();
+  object["mass_kg"] = -1.0;
+  require_error(scene_with(object), "/objects/0/mass_kg", "positive");
+  object["mass_kg"] = 0.0;
+  require_error(scene_with(object), "/objects/0/mass_kg", "positive");
+}
+
+TEST_CASE("scene error: mass and density together") {
+  json object = cube();
+  object["density_kgpm3"] = 1000.0;
+  require_error(scene_with(object), "/objects/0/density_kgpm3", "not both");
+}
+
+TEST_CASE("scene error: zero or negative size") {
+  json object = cube();
+  object["size_m"] = {0.05, 0.0, 0.05};
+  require_error(scene_with(object), "/objects/0/size_m/1", "positive");
+  json sphere{{"name", "s"}, {"shape", "sphere"}, {"radius_m", -0.1}, {"dynamic", false}, {"position_m", {0, 0, 0}}};
+  require_error(scene_with(sphere), "/objects/0/radius_m", "positive");
+}
+
+TEST_CASE("scene error: non-unit quaternion") {
+  json object = cube();
+  object["orientation_wxyz"] = {1.0, 0.1, 0.0, 0.0};
+  require_error(scene_with(object), "/objects/0/orientation_wxyz", "unit");
+}
+
+TEST_CASE("scene error: non-finite number") {
+  // JSON text cannot carry NaN, but a document built in code can.
+  json object = cube();
+  object["position_m"] = {0.0, std::numeric_limits<double>::quiet_NaN(), 0.0};
+  require_error(scene_with(object), "/objects/0/position_m/1", "finite");
+  json rate{{"objects", json::array()}, {"physics", {{"world_rate_hz", std::numeric_limits<double>::infinity()}}}};
+  require_error(rate, "/physics/world_rate_hz", "finite");
+}
+
+TEST_CASE("scene error: duplicate name") {
+  json second = cube();
+  second["position_m"] = {0.2, 0.0, 0.025};
+  require_error(json{{"objects", {cube(), second}}}, "/objects/1/name", "duplicate");
+}
+
+TEST_CASE("scene error: dynamic friction above static friction") {
+  json object = cube();
+  object["static_friction"] = 0.2;
+  object["dynamic_friction"] = 0.3;
+  require_error(scene_with(object), "/objects/0/dynamic_friction", "must not exceed");
+}
+
+TEST_CASE("scene error: restitution outside [0, 1]") {
+  json object = cube();
+  object["restitution"] = 1.5;
+  require_error(scene_with(object), "/objects/0/restitution", "[0, 1]");
+}
+
+TEST_CASE("scene error: unknown shape") {
+  json object = cube();
+  object["shape"] = "torus";
+  require_error(scene_with(object), "/objects/0/shape", "unknown shape");
+}
+
+TEST_CASE("scene error: static object with a mass or a velocity") {
+  json object = cube();
+  object["dynamic"] = false;
+  require_error(scene_with(object), "/objects/0/mass_kg", "static");
+}
+
+TEST_CASE("scene error: bad physics settings") {
+  require_error(json{{"objects", json::array()}, {"physics", {{"substeps", 0}}}}, "/physics/substeps", "positive");
+  require_error(json{{"objects", json::array()}, {"physics", {{"substeps", 2.5}}}}, "/physics/substeps", "integer");
+  require_error(json{{"objects", json::array()}, {"haptic", {{"stiffness_Npm", -1}}}}, "/haptic/stiffness_Npm",
+                "positive");
+}
+
+TEST_CASE("scene error: the message echoes the offending value") {
+  json object = cube();
+  object["mass_kg"] = -3.5;
+  try {
+    impetus::parse_scene(scene_with(object), "bad.json");
+    FAIL("expected SceneError");
+  } catch (const SceneError& error) {
+    CHECK(std::string(error.what()).find("(got -3.5)") != std::string::npos);
+  }
+}
+
+TEST_CASE("scene error: unreadable file and invalid JSON name the file") {
+  CHECK_THROWS_WITH(impetus::load_scene("/nonexistent/scene.json"), Catch::Contains("/nonexistent/scene.json"));
+  const std::string path = std::string(IMPETUS_BINARY_DIR) + "/broken_scene_for_test.json";
+  std::ofstream(path) << "{\"objects\": [";
+  CHECK_THROWS_WITH(impetus::load_scene(path), Catch::Contains(path) && Catch::Contains("not valid JSON"));
+}

@@ -1,0 +1,49 @@
+#pragma once
+// Shared set-up for the world_manager tests: ODE is initialised once per process (as the daemon's main does), and
+// scenes are built from small JSON documents.
+
+#include "common/scene.h"
+#include "world_manager/ode_runtime.h"
+#include "world_manager/world.h"
+
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <string>
+
+namespace impetus::test {
+
+inline std::unique_ptr<World> make_world(const Scene& scene, const WorldOptions& options = {}) {
+  init_ode_once();
+  return std::make_unique<World>(scene, options);
+}
+
+inline std::string scene_path(const std::string& file) { return std::string(IMPETUS_SOURCE_DIR) + "/scenes/" + file; }
+
+// One free 1 kg-class body and nothing else: no gravity, no floor, so the only velocity change is the impulse.
+inline nlohmann::json free_body_document(const nlohmann::json& object) {
+  return nlohmann::json{{"gravity_mps2", {0, 0, 0}}, {"floor", nullptr}, {"objects", {object}}};
+}
+
+// A report from `session` at `tick` with the finger at `finger_m` (valid) and no impulse entries.
+inline HapticReport make_report(std::uint64_t session, std::uint64_t tick, const Vec3& finger_m = {0, 0, 0},
+                                bool finger_valid = false) {
+  HapticReport report{};
+  report.haptic_session = session;
+  report.tick = tick;
+  report.finger_m = finger_m;
+  report.finger_valid = finger_valid ? 1u : 0u;
+  return report;
+}
+
+inline void add_entry(HapticReport& report, std::int32_t object_id, std::uint32_t epoch, const Vec3& impulse_Ns,
+                      const Vec3& angular_impulse_Nms = {0, 0, 0}) {
+  ObjectImpulse& entry = report.entries[report.entry_count++];
+  entry.object_id = object_id;
+  entry.epoch = epoch;
+  entry.impulse_Ns = impulse_Ns;
+  entry.angular_impulse_Nms = angular_impulse_Nms;
+  entry.last_tick = report.tick;
+}
+
+}  // namespace impetus::test

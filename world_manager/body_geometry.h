@@ -1,0 +1,39 @@
+#pragma once
+// Analytic geometry of the scene's shapes: the nearest surface point to a query point and the outward normal there
+// (paper §3.1 steps 2–3), and world-frame bounding boxes for the feature query. Pure functions, no ODE.
+//
+// Shapes are centred on the body origin (the centre of mass) with their axis along body z (DESIGN.md §4).
+
+#include "common/scene.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace impetus {
+
+// Pose of a body: world = orientation · body + position.
+struct BodyPose {
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // unit
+};
+
+struct SurfacePoint {
+  Eigen::Vector3d point_m;  // on the surface
+  Eigen::Vector3d normal;   // unit, outward
+  // Distance from the query point to the surface: positive outside, negative inside (−penetration depth).
+  double signed_distance_m = 0.0;
+};
+
+// Nearest surface point to `query_m` (body frame). Inside the shape this is the nearest face, not the far side, and the
+// normal still points outward there, so a penetrating finger is pushed out the short way. Where the nearest point is
+// not unique (the exact centre of a sphere, the axis of a capsule or cylinder) a fixed direction is chosen (+z for a
+// sphere, +x for the radial direction of a capsule or cylinder) so the answer is deterministic.
+SurfacePoint nearest_surface_point_body(const Shape& shape, const Eigen::Vector3d& query_m);
+
+// The same for a body in the world: query, result point and normal in the world frame.
+SurfacePoint nearest_surface_point(const Shape& shape, const BodyPose& pose, const Eigen::Vector3d& query_m);
+
+// Tight world-frame axis-aligned bounding box of the shape at `pose`.
+Eigen::AlignedBox3d world_bounds(const Shape& shape, const BodyPose& pose);
+
+}  // namespace impetus

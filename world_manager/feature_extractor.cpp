@@ -1,0 +1,130 @@
+#include "world_manager/feature_extractor.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace impetus {
+
+namespace {
+
+// The grid cell should hold a few objects and cover the base reach: the larger of the reach radius and the median
+// object size keeps both the number of cells per query and the objects per cell small.
+double choose_cell_size_m(const Scene& scene) {
+  std::vector<double> extents_m;
+  extents_m.reserve(scene.objects.size());
+  for (const SceneObject& object : scene.objects) {
+    const Eigen::AlignedBox3d box = world_bounds(object.shape, BodyPose{});
+    extents_m.push_back(box.sizes().maxCoeff());
+  }
+  double median_m = 0.0;
+  if (!extents_m.empty()) {
+    auto middle = extents_m.begin() + static_cast<std::ptrdiff_t>(extents_m.size() / 2);
+    std::nth_element(extents_m.begin(), middle, extents_m.end());
+    median_m = *middle;
+  }
+  return std::max(scene.haptic.reach_radius_m, median_m);
+}
+
+bool nearer(const ReachCandidate& a, const ReachCandidate& b) {
+  if (a.surface.signed_distance_m != b.surface.signed_distance_m) {
+    return a.surface.signed_distance_m < b.surface.signed_distance_m;
+  }
+  return a.object_id < b.object_id;
+}
+
+}  // namespace
+
+FeatureExtractor::FeatureExtractor(const Scene& scene) : scene_(scene), grid_(choose_cell_size_m(scene)) {}
+
+void FeatureExtractor::index(std::span<const ObjectState> states, double world_period_s) {
+  swept_bounds_.resize(states.size());
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const ObjectState& state = states[i];
+    Eigen::AlignedBox3d box = world_bounds(scene_.objects[i].shape, state.pose);
+    // Sweeping each box by its own motion in one period lets the query use only the finger's part of the reach.
+    const double sweep_m = state.velocity_mps.norm() * world_period_s;
+    box.min().array() -= sweep_m;
+    box.max().array() += sweep_m;
+    swept_bounds_[i] = box;
+  }
+  grid_.rebuild(swept_bounds_);
+}
+
+void FeatureExtractor::within_reach(const FingerSample& finger, std::span<const ObjectState> states,
+                                    double world_period_s, std::vector<ReachCandidate>& out) const {
+  out.clear();
+  const double finger_speed_mps = finger.velocity_mps.norm();
+  const double finger_reach_m = scene_.haptic.reach_radius_m + finger_speed_mps * world_period_s;
+  const Eigen::AlignedBox3d query(finger.position_m.array() - finger_reach_m,
+                                  finger.position_m.array() + finger_reach_m);
+  grid_.query(query, candidate_ids_);
+
+  for (std::int32_t id : candidate_ids_) {
+    const ObjectState& state = states[static_cast<std::size_t>(id)];
+    const SurfacePoint surface =
+        nearest_surface_point(scene_.objects[static_cast<std::size_t>(id)].shape, state.pose, finger.position_m);
+    // DESIGN.md §1 step 4: reach = base radius + (finger speed + object speed)·T_w.
+    const double reach_m =
+        scene_.haptic.reach_radius_m + (finger_speed_mps + state.velocity_mps.norm()) * world_period_s;
+    // A NaN distance fails this test: a broken object gives no plane rather than a frame the haptic side rejects.
+    if (surface.signed_distance_m <= reach_m && surface.point_m.allFinite() && surface.normal.allFinite()) {
+      out.push_back({id, surface});
+    }
+  }
+
+  if (scene_.floor.present) {
+    // The floor is the half-space z <= height: nearest point straight below (or above) the finger, normal +z.
+    const double height_m = scene_.floor.height_m;
+    const double distance_m = finger.position_m.z() - height_m;
+    if (distance_m <= finger_reach_m) {
+      const Eigen::Vector3d point_m(finger.position_m.x(), finger.position_m.y(), height_m);
+      out.push_back({scene_.floor_object_id(), {point_m, Eigen::Vector3d::UnitZ(), distance_m}});
+    }
+  }
+  std::sort(out.begin(), out.end(), nearer);
+}
+
+Plane FeatureExtractor::make_plane(const ReachCandidate& candidate, std::span<const ObjectState> states) const {
+  Plane plane;
+  plane.object_id = candidate.object_id;
+  plane.point_m = to_vec3(candidate.surface.point_m);
+  plane.normal = to_vec3(candidate.surface.normal);
+  const bool is_floor = candidate.object_id == scene_.floor_object_id();
+  const Material& material =
+      is_floor ? scene_.floor.material : scene_.objects[static_cast<std::size_t>(candidate.object_id)].material;
+  plane.static_friction = material.static_friction;
+  plane.dynamic_friction = material.dynamic_friction;
+  if (scene_.haptic.finger_material_given) {
+    // The finger pad is one more material: combined like any two bodies (common/scene.h).
+    plane.static_friction = combine_friction(plane.static_friction, scene_.haptic.finger_material.static_friction);
+    plane.dynamic_friction = combine_friction(plane.dynamic_friction, scene_.haptic.finger_material.dynamic_friction);
+  }
+  if (is_floor) {
+    plane.com_m = plane.point_m;  // the floor has no centre of mass; it never moves, so any point on it serves
+    return plane;
+  }
+  const ObjectState& state = states[static_cast<std::size_t>(candidate.object_id)];
+  const SceneObject& object = scene_.objects[static_cast<std::size_t>(candidate.object_id)];
+  plane.flags = object.dynamic ? kPlaneDynamic : 0u;
+  plane.com_m = to_vec3(state.pose.position_m);
+  plane.velocity_mps = to_vec3(state.velocity_mps);
+  plane.angular_velocity_radps = to_vec3(state.angular_velocity_radps);
+  plane.inverse_mass_per_kg = state.inverse_mass_per_kg;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) plane.inverse_inertia_world[static_cast<std::size_t>(3 * r + c)] =
+        state.inverse_inertia_world(r, c);
+  }
+  return plane;
+}
+
+std::uint32_t FeatureExtractor::extract(const FingerSample& finger, std::span<const ObjectState> states,
+                                        double world_period_s, std::array<Plane, kMaxPlanes>& planes) const {
+  within_reach(finger, states, world_period_s, reach_scratch_);
+  // Sorted nearest first, so a crowded neighbourhood keeps the kMaxPlanes planes the finger can touch soonest.
+  const std::size_t count = std::min<std::size_t>(reach_scratch_.size(), kMaxPlanes);
+  for (std::size_t i = 0; i < count; ++i) planes[i] = make_plane(reach_scratch_[i], states);
+  for (std::size_t i = count; i < kMaxPlanes; ++i) planes[i] = Plane{};
+  return static_cast<std::uint32_t>(count);
+}
+
+}  // namespace impetus

@@ -1,0 +1,67 @@
+#pragma once
+// Paper §3.1 and DESIGN.md §1 step 4: the planes of the objects near the finger.
+//
+// An object is *within reach* when its surface is at most
+//     reach = base radius + (finger speed + object speed) · T_w
+// from the finger (inside counts: the signed distance is negative), so nothing either of them can reach before the next
+// world step is missed. The floor (object_id = scene.floor_object_id()) and static objects give planes too.
+//
+// The extractor keeps a SpatialGrid of every object's bounding box swept by its own speed·T_w; index() rebuilds it
+// once per world step and extract() then only tests the objects in the cells around the finger.
+
+#include "common/link_types.h"
+#include "common/scene.h"
+#include "world_manager/body_geometry.h"
+#include "world_manager/object_state.h"
+#include "world_manager/spatial_grid.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace impetus {
+
+struct FingerSample {
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
+};
+
+// One object within reach and its nearest surface point to the finger.
+struct ReachCandidate {
+  std::int32_t object_id = -1;
+  SurfacePoint surface;
+};
+
+class FeatureExtractor {
+ public:
+  // Keeps a reference to `scene`, which must outlive the extractor.
+  explicit FeatureExtractor(const Scene& scene);
+
+  // Re-indexes the objects after the world moved; `states[i]` is scene object i. O(N log N).
+  void index(std::span<const ObjectState> states, double world_period_s);
+
+  // Every object (and the floor) within reach, nearest first (ties by id). `states` must be those last indexed.
+  void within_reach(const FingerSample& finger, std::span<const ObjectState> states, double world_period_s,
+                    std::vector<ReachCandidate>& out) const;
+
+  // Fills planes[0..count) with the nearest kMaxPlanes objects within reach and returns count (paper §3.1).
+  std::uint32_t extract(const FingerSample& finger, std::span<const ObjectState> states, double world_period_s,
+                        std::array<Plane, kMaxPlanes>& planes) const;
+
+  // For tests and benchmarks: how many objects the last query tested exactly.
+  std::size_t last_candidate_count() const { return candidate_ids_.size(); }
+
+ private:
+  Plane make_plane(const ReachCandidate& candidate, std::span<const ObjectState> states) const;
+
+  const Scene& scene_;
+  SpatialGrid grid_;
+  std::vector<Eigen::AlignedBox3d> swept_bounds_;
+  mutable std::vector<std::int32_t> candidate_ids_;     // reused between queries: no allocation per step
+  mutable std::vector<ReachCandidate> reach_scratch_;
+};
+
+}  // namespace impetus
