@@ -13,6 +13,12 @@ std::int64_t monotonic_now_ns() {
   return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
 }
 
+std::int64_t thread_cpu_now_ns() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+}
+
 int LatencyHistogram::bin_of(std::int64_t value_ns) {
   const std::int64_t value = std::max<std::int64_t>(value_ns, 0);
   if (value < kFineWidthNs * kFineBins) return static_cast<int>(value / kFineWidthNs);
@@ -28,6 +34,7 @@ std::int64_t LatencyHistogram::upper_edge_ns(int bin) {
 void LatencyHistogram::record(std::int64_t value_ns) {
   ++counts_[bin_of(value_ns)];
   ++count_;
+  sum_ns_ += value_ns;
   max_ns_ = std::max(max_ns_, value_ns);
 }
 
@@ -47,6 +54,7 @@ std::int64_t LatencyHistogram::percentile_ns(double fraction) const {
 void LatencyHistogram::clear() {
   counts_.fill(0);
   count_ = 0;
+  sum_ns_ = 0;
   max_ns_ = 0;
 }
 

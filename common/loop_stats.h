@@ -34,6 +34,7 @@ class LatencyHistogram {
   std::int64_t percentile_ns(double fraction) const;  // fraction in [0, 1]; 0 if empty
   std::int64_t max_ns() const { return max_ns_; }
   std::uint64_t count() const { return count_; }
+  double mean_ns() const { return count_ ? static_cast<double>(sum_ns_) / static_cast<double>(count_) : 0.0; }
   void clear();
 
  private:
@@ -48,9 +49,12 @@ class LatencyHistogram {
 
   std::array<std::uint64_t, kBins> counts_{};
   std::uint64_t count_ = 0;
+  std::int64_t sum_ns_ = 0;
   std::int64_t max_ns_ = 0;
 };
 
 std::int64_t monotonic_now_ns();
+// CPU time consumed by the calling thread (CLOCK_THREAD_CPUTIME_ID): what a step costs, whatever else the machine does.
+std::int64_t thread_cpu_now_ns();
 
 }  // namespace impetus

@@ -3,6 +3,7 @@
 # prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
 #
 #   scripts/run.sh --scene FILE --trajectory SPEC [--coupling impulse|position|local] [--rate HZ] [--phase TICKS]
+#                  [--substeps N]
 #                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet]
 #                  [-- extra haptic_controller flags, e.g. --stiffness 5000]
 #
@@ -11,10 +12,10 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${IMPETUS_BUILD_DIR:-$root/build}"
 
-usage() { sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "run.sh: $*" >&2; exit 2; }
 
-scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
+substeps="" scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
 haptic_extra=()
 while (($#)); do
   case "$1" in
@@ -22,6 +23,7 @@ while (($#)); do
     --trajectory) trajectory="${2:?}"; shift 2 ;;
     --coupling) coupling="${2:?}"; shift 2 ;;
     --rate) rate="${2:?}"; shift 2 ;;
+    --substeps) substeps="${2:?}"; shift 2 ;;
     --phase) phase="${2:?}"; shift 2 ;;
     --clock) clock="${2:?}"; shift 2 ;;
     --duration) duration="${2:?}"; shift 2 ;;
@@ -47,6 +49,7 @@ shm="impetus_run_$$_$RANDOM"
 world_args=(--scene "$scene" --coupling "$coupling" --clock "$clock" --phase "$phase" --shm "$shm"
             --log "$out/world.csv" --summary "$out/world.json")
 [ -n "$rate" ] && world_args+=(--rate "$rate")
+[ -n "$substeps" ] && world_args+=(--substeps "$substeps")
 haptic_args=(--clock "$clock" --duration "$duration" --shm "$shm" --log "$out/haptic.csv"
              --summary "$out/haptic.json" "${haptic_extra[@]}")
 device_args=(--clock "$clock" --trajectory "$trajectory" --shm "$shm" --log "$out/device.csv")
@@ -84,7 +87,7 @@ for segment in "/dev/shm/$shm.world" "/dev/shm/$shm.device"; do
 done
 ((status == 0)) || exit "$status"
 
-args=("$out" --set "scene=$scene" --set "trajectory=$trajectory" --set "coupling=$coupling" --set "rate=$rate"
+args=("$out" --set "scene=$scene" --set "trajectory=$trajectory" --set "coupling=$coupling" --set "rate=$rate" --set "substeps_override=$substeps"
       --set "phase_ticks=$phase" --set "clock=$clock" --set "duration_s=$duration"
       --set "wall_start=$start" --set "wall_end=$end")
 ((quiet)) && args+=(--quiet)

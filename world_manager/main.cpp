@@ -27,6 +27,7 @@ namespace {
 struct Options {
   std::string scene_path;
   std::optional<double> rate_hz;
+  std::optional<int> substeps;
   Coupling coupling = Coupling::impulse;
   ClockMode clock = ClockMode::realtime;
   std::uint64_t phase_ticks = 0;
@@ -39,7 +40,8 @@ struct Options {
 
 nlohmann::json to_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-nlohmann::json summary_of(const World& world, const Options& options, const LoopStats& stats) {
+nlohmann::json summary_of(const World& world, const Options& options, const LoopStats& stats,
+                          const LatencyHistogram& step_cpu_ns) {
   nlohmann::json objects = nlohmann::json::object();
   const auto states = world.states();
   for (std::size_t id = 0; id < world.scene().objects.size(); ++id) {
@@ -65,7 +67,11 @@ nlohmann::json summary_of(const World& world, const Options& options, const Loop
             {"lateness_p99_ns", stats.lateness_p99_ns},
             {"lateness_max_ns", stats.lateness_max_ns},
             {"static_impulse_Ns", to_json(world.total_static_impulse_Ns())},
-            {"mechanical_energy_J", world.mechanical_energy_J()}}},
+            {"mechanical_energy_J", world.mechanical_energy_J()},
+            {"cpu_per_step_p50_us", step_cpu_ns.percentile_ns(0.5) / 1e3},
+            {"cpu_per_step_p99_us", step_cpu_ns.percentile_ns(0.99) / 1e3},
+            {"cpu_per_step_mean_us", step_cpu_ns.mean_ns() / 1e3},
+            {"cpu_per_simulated_s", step_cpu_ns.mean_ns() * 1e-9 / world.world_period_s()}}},
           {"config",
            {{"scene", options.scene_path},
             {"world_rate_hz", 1.0 / world.world_period_s()},
@@ -79,7 +85,7 @@ nlohmann::json summary_of(const World& world, const Options& options, const Loop
 class WorldDaemon {
  public:
   explicit WorldDaemon(const Options& options)
-      : options_(options), scene_(load_scene(options.scene_path)), world_(scene_, world_options(options)) {
+      : options_(options), scene_(scene_with_overrides(options)), world_(scene_, world_options(options)) {
     if (options.clock == ClockMode::lockstep) {
       const double ticks = world_.world_period_s() * options.haptic_rate_hz;
       if (std::fabs(ticks - std::round(ticks)) > 1e-9 || ticks < 1.0) {
@@ -122,7 +128,7 @@ class WorldDaemon {
     }
     if (!options_.summary_path.empty()) {
       std::ofstream summary(options_.summary_path);
-      summary << summary_of(world_, options_, stats_).dump(2) << '\n';
+      summary << summary_of(world_, options_, stats_, step_cpu_ns_).dump(2) << '\n';
       if (!summary) throw std::runtime_error("cannot write summary '" + options_.summary_path + "'");
     }
     std::fprintf(stderr, "world_manager: %llu steps, %.3f s simulated\n",
@@ -131,6 +137,12 @@ class WorldDaemon {
   }
 
  private:
+  static Scene scene_with_overrides(const Options& options) {
+    Scene scene = load_scene(options.scene_path);
+    if (options.substeps) scene.physics.substeps = *options.substeps;
+    return scene;
+  }
+
   static WorldOptions world_options(const Options& options) {
     WorldOptions world;
     world.coupling = options.coupling;
@@ -152,7 +164,9 @@ class WorldDaemon {
         ++stats_.rejected_frames;
       }
     }
+    const std::int64_t cpu_before_ns = thread_cpu_now_ns();
     const PlaneFrame& frame = world_.step(have_report_ ? &report_ : nullptr);
+    step_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
     link.planes.write(frame);
     if (log_) log_->write_row(*log_file_);
     ++stats_.ticks;
@@ -213,6 +227,7 @@ class WorldDaemon {
   HapticReport report_{};
   bool have_report_ = false;
   LoopStats stats_;
+  LatencyHistogram step_cpu_ns_;  // CPU time of World::step (coupling + ODE + features), per step
 };
 
 }  // namespace
@@ -226,6 +241,8 @@ int main(int argc, char** argv) {
   app.add_option("--scene", options.scene_path, "scene file (JSON, see scenes/)")->required()->check(CLI::ExistingFile);
   app.add_option("--rate", options.rate_hz, "world rate in Hz (default: the scene's physics.world_rate_hz)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--substeps", options.substeps, "ODE steps per world period (default: the scene's physics.substeps)")
+      ->check(CLI::Range(1, 10000));
   app.add_option("--coupling", options.coupling, "impulse (paper §2.2), position (the previous method) or local")
       ->transform(CLI::CheckedTransformer(kCouplingNames, CLI::ignore_case));
   app.add_option("--clock", options.clock, "realtime or lockstep")

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The main job: on a fresh Debian machine, installs what is missing, builds, and runs the paper's tap trial in real
+# time (world manager at 20 Hz with impulse coupling, 1 kHz haptic controller, simulated SPIDAR and finger), prints
+# the outcome and writes a plot of the cube and the finger over time to out/demo/trial.png.
+#   scripts/demo.sh [extra scripts/run.sh arguments, e.g. --coupling position]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/build.sh build
+out=out/demo
+rm -rf "$out"
+bash scripts/run.sh --scene scenes/tap.json --trajectory tap --clock realtime --coupling impulse --out "$out" "$@"
+MPLBACKEND=Agg /usr/bin/python3 scripts/plot_trial.py "$out" --out "$out/trial.png"

@@ -1,0 +1,162 @@
+#!/usr/bin/python3
+"""Phase sensitivity of the tap trial (paper Fig. 5): stop position of the cube against the world clock's phase.
+
+Runs the tap scene through the real processes in lockstep at the world rate (default 20 Hz) for PHASES phases spread
+over one world period, once per coupling, plus the single-rate reference (world at the haptic rate, 1 kHz). Writes
+OUT/phase.csv, OUT/phase.md and OUT/phase_xt.png (x(t) of the cube per phase, side by side like Fig. 5), and prints
+the table. With --check it exits 1 unless the paper's claim holds: impulse spread <= --max-ratio x position spread,
+and the reference's own spread is below --reference-tolerance metres.
+"""
+import argparse
+import concurrent.futures
+import csv
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+
+def run_trial(out_dir, scene, trajectory, coupling, rate, phase, extra):
+    out_dir.mkdir(parents=True, exist_ok=True)
+    command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), "--trajectory", trajectory,
+               "--coupling", coupling, "--rate", str(rate), "--phase", str(phase), "--clock", "lockstep",
+               "--out", str(out_dir), "--quiet"] + extra
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise RuntimeError(f"trial failed ({' '.join(command)}):\n{result.stdout}{result.stderr}")
+    summary = json.loads((out_dir / "summary.json").read_text())
+    return summary
+
+
+def cube_track(out_dir, name):
+    times, xs = [], []
+    with open(out_dir / "world.csv") as f:
+        for row in csv.DictReader(f):
+            times.append(float(row["time_s"]))
+            xs.append(float(row[f"{name}.x_m"]))
+    return times, xs
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "out/phase")
+    parser.add_argument("--scene", type=pathlib.Path, default=ROOT / "scenes/tap.json")
+    parser.add_argument("--object", default="cube", help="the dynamic object whose stop position is measured")
+    parser.add_argument("--trajectory", default="tap")
+    parser.add_argument("--rate", type=float, default=20.0, help="world rate under test, Hz")
+    parser.add_argument("--haptic-rate", type=float, default=1000.0)
+    parser.add_argument("--phases", type=int, default=10, help="phases spread evenly over one world period")
+    parser.add_argument("--couplings", default="position,impulse")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--plot", action=argparse.BooleanOptionalAction, default=True)
+    parser.add_argument("--check", action="store_true", help="exit 1 unless the paper's claim holds")
+    parser.add_argument("--max-ratio", type=float, default=0.5,
+                        help="--check: largest allowed impulse spread / position spread (the paper's claim: 0.5)")
+    parser.add_argument("--reference-tolerance", type=float, default=1e-4,
+                        help="--check: largest allowed phase spread of the 1 kHz reference, m")
+    args = parser.parse_args()
+
+    ticks_per_step = round(args.haptic_rate / args.rate)
+    phases = sorted({round(k * ticks_per_step / args.phases) for k in range(args.phases)})
+    couplings = args.couplings.split(",")
+    jobs = []
+    for coupling in couplings:
+        for phase in phases:
+            jobs.append((coupling, args.rate, phase))
+    # The reference: world at the haptic rate. Its "phase" only delays the first step by whole ticks, so its spread
+    # measures how repeatable the trial itself is.
+    for phase in range(min(args.phases, 10)):
+        jobs.append(("reference", args.haptic_rate, phase))
+
+    results = {}
+    done = 0
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        futures = {}
+        for label, rate, phase in jobs:
+            coupling = "impulse" if label == "reference" else label
+            trial_dir = args.out / f"{label}-phase{phase:03d}"
+            futures[pool.submit(run_trial, trial_dir, args.scene, args.trajectory, coupling, rate, phase, [])] = (
+                label, phase, trial_dir)
+        for future in concurrent.futures.as_completed(futures):
+            label, phase, trial_dir = futures[future]
+            summary = future.result()
+            results[(label, phase)] = (summary["objects"][args.object]["position"][0], trial_dir,
+                                       summary["config"].get("wall_time_s", 0.0))
+            done += 1
+            print(f"\r{done}/{len(jobs)} trials", end="", file=sys.stderr, flush=True)
+    print(file=sys.stderr)
+
+    reference = [results[("reference", p)][0] for p in range(min(args.phases, 10))]
+    reference_mean = sum(reference) / len(reference)
+    start = json.loads(args.scene.read_text())
+    start_x = next(o["position_m"][0] for o in start["objects"] if o["name"] == args.object)
+    rows, stats = [], {}
+    for label in couplings + ["reference"]:
+        label_phases = phases if label != "reference" else list(range(min(args.phases, 10)))
+        stops = [results[(label, p)][0] for p in label_phases]
+        for p, x in zip(label_phases, stops):
+            rows.append({"coupling": label, "phase_ticks": p, "stop_x_m": x, "bias_m": x - reference_mean})
+        mean = sum(stops) / len(stops)
+        stats[label] = {"spread_m": max(stops) - min(stops), "mean_m": mean, "bias_m": mean - reference_mean,
+                        "bias_pct_of_travel": 100.0 * (mean - reference_mean) / (reference_mean - start_x)}
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    with open(args.out / "phase.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=["coupling", "phase_ticks", "stop_x_m", "bias_m"])
+        writer.writeheader()
+        writer.writerows(rows)
+    lines = [f"Tap trial, world {args.rate:g} Hz vs the {args.haptic_rate:g} Hz reference "
+             f"(reference stop x = {reference_mean:.4f} m, travel {reference_mean - start_x:.4f} m)", "",
+             "| coupling | phases | stop x mean (m) | phase spread (mm) | bias vs reference (mm) | bias (% of travel) |",
+             "|---|---|---|---|---|---|"]
+    for label, s in stats.items():
+        count = len(phases) if label != "reference" else min(args.phases, 10)
+        lines.append(f"| {label} | {count} | {s['mean_m']:.4f} | {1e3 * s['spread_m']:.2f} | "
+                     f"{1e3 * s['bias_m']:+.2f} | {s['bias_pct_of_travel']:+.1f} |")
+    if "position" in stats and "impulse" in stats and stats["position"]["spread_m"] > 0:
+        ratio = stats["impulse"]["spread_m"] / stats["position"]["spread_m"]
+        lines += ["", f"impulse spread / position spread = {ratio:.3f}"]
+    table = "\n".join(lines)
+    (args.out / "phase.md").write_text(table + "\n")
+    (args.out / "phase.json").write_text(json.dumps(stats, indent=2) + "\n")
+    print(table)
+
+    if args.plot:
+        os.environ.setdefault("MPLBACKEND", "Agg")
+        import matplotlib.pyplot as plt
+        fig, axes = plt.subplots(1, len(couplings), figsize=(5 * len(couplings), 3.6), sharey=True)
+        if len(couplings) == 1:
+            axes = [axes]
+        ref_t, ref_x = cube_track(results[("reference", 0)][1], args.object)
+        for ax, label in zip(axes, couplings):
+            for p in phases:
+                t, x = cube_track(results[(label, p)][1], args.object)
+                ax.plot(t, x, lw=1, alpha=0.8)
+            ax.plot(ref_t, ref_x, "k--", lw=1.5, label=f"{args.haptic_rate:g} Hz reference")
+            ax.set_title(f"{label} coupling, world {args.rate:g} Hz, {len(phases)} phases")
+            ax.set_xlabel("time (s)")
+            ax.grid(alpha=0.3)
+            ax.legend(loc="lower right", fontsize=8)
+        axes[0].set_ylabel(f"{args.object} x (m)")
+        fig.tight_layout()
+        fig.savefig(args.out / "phase_xt.png", dpi=90)
+        print(f"plot: {args.out / 'phase_xt.png'}")
+
+    if args.check:
+        failures = []
+        ratio = stats["impulse"]["spread_m"] / stats["position"]["spread_m"]
+        if ratio > args.max_ratio:
+            failures.append(f"impulse spread / position spread = {ratio:.3f} > {args.max_ratio}")
+        if stats["reference"]["spread_m"] > args.reference_tolerance:
+            failures.append(f"reference spread {stats['reference']['spread_m']:.2e} m > {args.reference_tolerance}")
+        if failures:
+            print("CHECK FAILED: " + "; ".join(failures))
+            sys.exit(1)
+        print("check passed")
+
+
+if __name__ == "__main__":
+    main()
