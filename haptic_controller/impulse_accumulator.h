@@ -1,0 +1,63 @@
+#pragma once
+// Impulse integration (paper §3.4, DESIGN.md §1 haptic tick step 5): the user's force on the world is the reaction
+// −f_j of the force rendered on the finger. Each tick it is shared among the active constraints in proportion to
+// their multipliers (the normal load each plane carries: a finger pressing a cube onto the floor loads only the cube's
+// plane, so the cube gets the push and passes it on to the floor in the world's own simulation), and accumulated per
+// object exactly, tick by tick:
+//     impulse_Ns          += −f_k·Δt
+//     angular_impulse_Nms += (contact − com) × (−f_k·Δt)      (contact = the proxy, com interpolated)
+// rather than the paper's single F_i at one point p_i. Planes without kPlaneDynamic (floor, fixed objects) feed
+// report.static_impulse_Ns.
+//
+// The report holds running totals (ObjectImpulse in common/link_types.h). When all kMaxImpulseEntries entries are in
+// use, an entry whose last_tick ≤ the world's report_tick_applied (for this haptic session) is final — the world has
+// applied all of it — and is reused for the new object with a new epoch (a session-wide counter, so an object's epoch
+// changes at every re-allocation). If no entry is final the share is kept in a dropped total and counted; nothing
+// throws or allocates. Invariant: Σ entries + static + evicted + dropped == Σ −f·Δt rendered.
+//
+// Owned by the servo thread.
+
+#include "common/link_types.h"
+#include "haptic_controller/contact_plane.h"
+#include "haptic_controller/proxy_projection.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+
+namespace impetus {
+
+class ImpulseAccumulator {
+ public:
+  explicit ImpulseAccumulator(std::uint64_t haptic_session);
+
+  // Learns how far the world has applied our reports (eviction rule).
+  void on_plane_frame(const PlaneFrame& frame);
+
+  // Adds the reaction of one tick: `force_on_finger_N` rendered for `dt_s` at haptic tick `tick` (≥ 1). With no
+  // active constraint the force must be zero (nothing touched); a nonzero force then is kept in the dropped total.
+  void add(const PlaneSet& planes, const ProxySolution& contact, const Eigen::Vector3d& force_on_finger_N, double dt_s,
+           std::uint64_t tick);
+
+  HapticReport& report() { return report_; }
+  const HapticReport& report() const { return report_; }
+
+  const Eigen::Vector3d& total_impulse_Ns() const { return total_Ns_; }      // Σ −f·Δt rendered
+  const Eigen::Vector3d& evicted_impulse_Ns() const { return evicted_Ns_; }  // totals of entries reused since
+  const Eigen::Vector3d& dropped_impulse_Ns() const { return dropped_Ns_; }  // never reported (table full)
+  std::uint64_t dropped_shares() const { return dropped_shares_; }
+
+ private:
+  ObjectImpulse* entry_for(std::int32_t object_id);
+
+  HapticReport report_{};
+  std::uint64_t applied_tick_ = 0;
+  bool applied_this_session_ = false;
+  std::uint32_t epoch_counter_ = 0;
+  Eigen::Vector3d total_Ns_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d evicted_Ns_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dropped_Ns_ = Eigen::Vector3d::Zero();
+  std::uint64_t dropped_shares_ = 0;
+};
+
+}  // namespace impetus

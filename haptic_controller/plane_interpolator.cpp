@@ -1,0 +1,79 @@
+#include "haptic_controller/plane_interpolator.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace impetus {
+namespace {
+
+// Normals further apart than 90° are not blended (see the header): cos 90° = 0.
+constexpr double kMinBlendCosine = 0.0;
+// Above this weight a flipped plane is frame i's: the midpoint of the world period.
+constexpr double kFlipSwitchWeight = 0.5;
+
+Eigen::Vector3d lerp(const Vec3& from, const Vec3& to, double w) {
+  return (1.0 - w) * to_eigen(from) + w * to_eigen(to);
+}
+
+// Index in `previous` of the `occurrence`-th plane of `object_id`, or -1.
+int find_match(const PlaneFrame& previous, std::int32_t object_id, int occurrence) {
+  const std::uint32_t count = std::min(previous.plane_count, kMaxPlanes);
+  for (std::uint32_t k = 0; k < count; ++k) {
+    if (previous.planes[k].object_id == object_id && occurrence-- == 0) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+}  // namespace
+
+ContactPlane to_contact_plane(const Plane& plane) {
+  ContactPlane out;
+  out.object_id = plane.object_id;
+  out.flags = plane.flags;
+  out.point_m = to_eigen(plane.point_m);
+  out.normal = to_eigen(plane.normal);
+  out.com_m = to_eigen(plane.com_m);
+  out.velocity_mps = to_eigen(plane.velocity_mps);
+  out.angular_velocity_radps = to_eigen(plane.angular_velocity_radps);
+  out.static_friction = plane.static_friction;
+  out.dynamic_friction = plane.dynamic_friction;
+  return out;
+}
+
+double interpolation_weight(double now_s, double frame_arrival_s, double world_period_s) {
+  const double w = (now_s - frame_arrival_s) / world_period_s;
+  if (!(world_period_s > 0.0) || !std::isfinite(w)) return 1.0;
+  return std::clamp(w, 0.0, 1.0);
+}
+
+void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, double w, PlaneSet& out) {
+  w = std::isfinite(w) ? std::clamp(w, 0.0, 1.0) : 1.0;
+  const std::uint32_t count = std::min(current.plane_count, kMaxPlanes);
+  out.count = count;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const Plane& now = current.planes[k];
+    ContactPlane& plane = out.planes[k];
+    plane = to_contact_plane(now);  // velocities, friction, flags: frame i's
+
+    int occurrence = 0;
+    for (std::uint32_t q = 0; q < k; ++q) occurrence += current.planes[q].object_id == now.object_id ? 1 : 0;
+    const int match = find_match(previous, now.object_id, occurrence);
+    if (match < 0) continue;  // new object: starts at frame i's value
+    const Plane& before = previous.planes[match];
+
+    if (to_eigen(before.normal).dot(to_eigen(now.normal)) < kMinBlendCosine) {
+      if (w < kFlipSwitchWeight) {  // switch whole planes at the midpoint instead of blending through zero
+        plane.point_m = to_eigen(before.point_m);
+        plane.normal = to_eigen(before.normal);
+        plane.com_m = to_eigen(before.com_m);
+      }
+      continue;
+    }
+    plane.point_m = lerp(before.point_m, now.point_m, w);
+    plane.com_m = lerp(before.com_m, now.com_m, w);
+    const Eigen::Vector3d normal = lerp(before.normal, now.normal, w);
+    plane.normal = normal / normal.norm();  // |normal| ≥ 1/√2 for unit inputs with dot ≥ 0
+  }
+}
+
+}  // namespace impetus

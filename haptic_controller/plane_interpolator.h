@@ -1,0 +1,29 @@
+#pragma once
+// Plane interpolation between world frames i−1 and i (paper §3.2, DESIGN.md §1 haptic tick step 2).
+//
+//   P_H = w·P_Wi + (1 − w)·P_W(i−1),   N_H = w·N_Wi + (1 − w)·N_W(i−1)   (paper §3.2 with w = j/n)
+//
+// Rules beyond the paper:
+//  * Planes are matched across frames by object_id (the k-th plane of an object in frame i with its k-th plane in
+//    frame i−1). A plane whose object is absent from frame i−1 starts at frame i's value (no sweep from nowhere); an
+//    object absent from frame i is gone.
+//  * The interpolated normal is renormalised. If the two normals are more than 90° apart (dot < 0: the finger passed
+//    over an edge or through a thin object and the nearest point jumped to another face), linear blending would pass
+//    through a vanishing normal and sweep the plane through the object; instead the whole plane switches from frame
+//    i−1's to frame i's at the midpoint, w ≥ ½. For dot ≥ 0 the blended normal has length ≥ 1/√2, never near zero.
+//  * The centre of mass is interpolated like the point; velocities, friction and flags are frame i's (the newest
+//    state the world has sent, §6.2).
+
+#include "common/link_types.h"
+#include "haptic_controller/contact_plane.h"
+
+namespace impetus {
+
+// w = (now − arrival of frame i) / T_w, clamped to [0, 1]; 1 if the period is not positive or anything is NaN.
+double interpolation_weight(double now_s, double frame_arrival_s, double world_period_s);
+
+// Fills `out` with frame i's planes interpolated at weight w from frame i−1. `previous` may be the same object as
+// `current` (first frame of a session). Allocation-free.
+void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, double w, PlaneSet& out);
+
+}  // namespace impetus

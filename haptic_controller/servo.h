@@ -1,0 +1,100 @@
+#pragma once
+// The 1 kHz haptic servo (DESIGN.md §1 "One haptic tick"): composes SPIDAR kinematics, plane interpolation (§3.2),
+// the god-object with friction (§3.3, §6.2), force rendering (§3.3), impulse integration (§3.4) and tension
+// distribution. main.cpp wires it to the clock, the world link and the device port; tests drive it directly.
+//
+// Threading: one servo thread owns the object; on_plane_frame, tick and report are called from that thread only.
+// Real time: the constructor preallocates everything; on_plane_frame and tick never allocate, lock, block or throw.
+
+#include "common/device_geometry.h"
+#include "common/link_types.h"
+#include "haptic_controller/contact_plane.h"
+#include "haptic_controller/force_renderer.h"
+#include "haptic_controller/god_object.h"
+#include "haptic_controller/impulse_accumulator.h"
+#include "haptic_controller/spidar_kinematics.h"
+
+#include <array>
+#include <cstdint>
+#include <limits>
+
+namespace impetus {
+
+struct ServoOptions {
+  // Spring k_p and damper k_d of §3.3. NaN: take the scene's value from the world frame. If the world sends no
+  // positive value either, stiffness falls back to kFallbackStiffness_Npm and damping to the passivity default
+  // passivity_damping_Nspm(k, tick_period_s) (force_renderer.h).
+  double stiffness_Npm = std::numeric_limits<double>::quiet_NaN();
+  double damping_Nspm = std::numeric_limits<double>::quiet_NaN();
+  double tick_period_s = 1e-3;  // nominal servo period T, for the default damping only; forces use the real dt
+  SpidarGeometry geometry{};
+};
+
+// The DESIGN.md default for --stiffness when nothing else is given.
+inline constexpr double kFallbackStiffness_Npm = 2000.0;
+// A world frame older than this many world periods is stale: the servo keeps rendering its last planes (w = 1).
+inline constexpr double kStaleWorldPeriods = 3.0;
+
+struct TickResult {
+  Vec3 finger_m{};  // C_j (last valid position when no device)
+  Vec3 proxy_m{};   // D_j
+  Vec3 force_N{};   // on the finger, after clamping (zero on fault, without device, or out of contact)
+  std::array<double, kStringCount> tension_N{};  // to command; t_min on every string without device
+  bool finger_valid = false;  // a device reading gave a finite finger position this tick
+  bool saturated = false;     // the strings could not render force_N exactly (nearest feasible force commanded)
+  bool fault = false;         // non-finite finger or force this tick: force zeroed
+  bool world_stale = false;   // the newest world frame is older than kStaleWorldPeriods
+  bool sticking = false;      // friction holds the proxy
+  int active_planes = 0;      // constraints holding the proxy (0 free, 1 face, 2 edge, 3 corner; 4 infeasible pinch)
+  double interpolation_weight = 1.0;  // w of §3.2
+};
+
+struct ServoCounters {
+  std::uint64_t ticks = 0;
+  std::uint64_t faults = 0;            // non-finite finger position or force
+  std::uint64_t force_clamps = 0;      // |f| limited to max_force_N
+  std::uint64_t saturations = 0;       // tension distribution could not reach the force
+  std::uint64_t infeasible_contacts = 0;  // pinch: no point outside all planes
+  std::uint64_t stale_world_ticks = 0;
+  std::uint64_t no_device_ticks = 0;
+  std::uint64_t dropped_impulse_shares = 0;  // reaction shares that found no report entry
+};
+
+class HapticServo {
+ public:
+  HapticServo(const ServoOptions& options, std::uint64_t haptic_session);
+
+  // A validated world frame arrived at servo time now_s. Frames of a new world session restart interpolation.
+  void on_plane_frame(const PlaneFrame& frame, double now_s);
+
+  // One tick at servo time now_s, dt_s after the previous tick (real elapsed time). device == nullptr means no
+  // device is attached or its state is stale: no finger, minimum tensions, no contact, nothing accumulated.
+  const TickResult& tick(const DeviceState* device, double now_s, double dt_s);
+
+  // Cumulative impulses and the finger, updated by every tick; the caller seals and publishes it.
+  const HapticReport& report() const { return accumulator_.report(); }
+  const ServoCounters& counters() const { return counters_; }
+  const ImpulseAccumulator& accumulator() const { return accumulator_; }
+  const PlaneSet& planes() const { return planes_; }  // the interpolated planes of the last tick
+
+ private:
+  void idle_tick(bool fault);
+
+  ServoOptions options_;
+  SpidarKinematics kinematics_;
+  std::array<Eigen::Vector3d, kStringCount> motors_m_;
+  PlaneFrame previous_frame_{};
+  PlaneFrame current_frame_{};
+  bool have_frame_ = false;
+  double frame_arrival_s_ = 0.0;
+  PlaneSet planes_{};
+  GodObject god_object_;
+  ForceRenderer renderer_;
+  ImpulseAccumulator accumulator_;
+  Eigen::Vector3d finger_m_ = Eigen::Vector3d::Zero();
+  bool finger_known_ = false;
+  TickResult result_{};
+  ServoCounters counters_{};
+};
+
+}  // namespace impetus

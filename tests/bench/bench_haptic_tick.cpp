@@ -1,0 +1,79 @@
+// Tick cost of the haptic servo (interpolation + proxy + force + accumulation + tensions) against the number of
+// planes in the world frame: p50 / p99 in ns. Prints only; no assertions.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "haptic_controller/servo.h"
+#include "haptic_controller/spidar_kinematics.h"
+
+using namespace impetus;
+
+namespace {
+
+constexpr int kTicks = 20000;
+constexpr int kTicksPerWorldStep = 50;  // 1 kHz servo, 20 Hz world
+
+// Planes around the workspace centre facing it, at 2–6 cm, a few of them moving and with friction, so the finger
+// wandering near the centre touches several at once.
+PlaneFrame make_frame(int planes, std::uint64_t index, double phase) {
+  PlaneFrame frame;
+  frame.frame_index = index;
+  frame.world_session = 1;
+  frame.world_period_s = kTicksPerWorldStep * 1e-3;
+  frame.stiffness_Npm = 2000.0;
+  const SpidarGeometry geometry;
+  for (int k = 0; k < planes; ++k) {
+    const double a = 2.399963 * k;  // golden-angle spiral over the sphere
+    const double z = 1.0 - 2.0 * (k + 0.5) / planes;
+    const double r = std::sqrt(1.0 - z * z);
+    const Eigen::Vector3d inward(-r * std::cos(a), -r * std::sin(a), -z);
+    const double distance_m = 0.02 + 0.04 * ((k * 7) % 11) / 10.0 + 0.002 * std::sin(phase + k);
+    Plane& plane = frame.planes[frame.plane_count++];
+    plane.object_id = k;
+    plane.flags = k % 2 ? kPlaneDynamic : 0u;
+    plane.normal = to_vec3(inward);
+    plane.point_m = to_vec3(to_eigen(geometry.centre_m) - distance_m * inward);
+    plane.com_m = to_vec3(to_eigen(plane.point_m) - 0.025 * inward);
+    plane.velocity_mps = {0.01, 0.0, 0.0};
+    plane.static_friction = 0.5;
+    plane.dynamic_friction = 0.3;
+  }
+  return frame;
+}
+
+void run(int planes) {
+  ServoOptions options;
+  HapticServo servo(options, 1);
+  const SpidarKinematics kinematics(options.geometry);
+  std::vector<double> ns(kTicks);
+  DeviceState state;
+  int contact_ticks = 0;
+  for (int tick = 0; tick < kTicks; ++tick) {
+    const double now_s = tick * 1e-3;
+    if (tick % kTicksPerWorldStep == 0)
+      servo.on_plane_frame(make_frame(planes, tick / kTicksPerWorldStep, now_s), now_s);
+    const Eigen::Vector3d finger =
+        to_eigen(options.geometry.centre_m) +
+        0.05 * Eigen::Vector3d(std::sin(tick * 0.0031), std::sin(tick * 0.0023), std::sin(tick * 0.0017));
+    state.encoder_counts = kinematics.encoder_counts(finger);
+    const auto start = std::chrono::steady_clock::now();
+    const TickResult& result = servo.tick(&state, now_s, 1e-3);
+    const auto stop = std::chrono::steady_clock::now();
+    ns[tick] = std::chrono::duration<double, std::nano>(stop - start).count();
+    contact_ticks += result.active_planes > 0 ? 1 : 0;
+  }
+  std::sort(ns.begin(), ns.end());
+  std::printf("planes %3d  tick p50 %8.0f ns  p99 %8.0f ns  max %8.0f ns  (contact ticks %.0f%%)\n", planes,
+              ns[kTicks / 2], ns[kTicks * 99 / 100], ns.back(), 100.0 * contact_ticks / kTicks);
+}
+
+}  // namespace
+
+int main() {
+  for (const int planes : {1, 4, 16, 64}) run(planes);
+  return 0;
+}

@@ -1,0 +1,92 @@
+// Real-time discipline: tick() and on_plane_frame() never touch the heap. Global operator new/delete are replaced for
+// the whole test binary, but count only while `g_counting` is set, so other tests are unaffected.
+//
+// Under AddressSanitizer the sanitizer owns operator new/delete (some allocations reach its own operator new, and our
+// free() of them is reported as a mismatch), so the replacement and the two counting tests are compiled only in
+// unsanitized builds; the plain Release build is the one that proves the property.
+
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <new>
+
+#include "haptic_controller/servo.h"
+#include "haptic_controller/spidar_kinematics.h"
+#include "test_support.h"
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define IMPETUS_COUNT_ALLOCATIONS 0
+#else
+#define IMPETUS_COUNT_ALLOCATIONS 1
+#endif
+
+#if IMPETUS_COUNT_ALLOCATIONS
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+
+void* counted_allocation(std::size_t size) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+}  // namespace
+
+void* operator new(std::size_t size) { return counted_allocation(size); }
+void* operator new[](std::size_t size) { return counted_allocation(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#endif
+
+using namespace impetus;
+using Eigen::Vector3d;
+using impetus::test::make_frame;
+using impetus::test::wire_plane;
+
+#if IMPETUS_COUNT_ALLOCATIONS
+TEST_CASE("the servo tick allocates nothing over 10^4 ticks") {
+  ServoOptions options;
+  HapticServo servo(options, 3);
+  const SpidarKinematics kinematics(options.geometry);
+  PlaneFrame frame = make_frame({wire_plane(0, {0, 0, 0}, {0, 0, 1}, false), wire_plane(1, {0, 0, 0.05}, {0, 0, 1}),
+                                 wire_plane(2, {0.03, 0, 0}, {-1, 0, 0}), wire_plane(3, {0, 0.02, 0}, {0, -1, 1})});
+  for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
+    frame.planes[k].static_friction = 0.6;
+    frame.planes[k].dynamic_friction = 0.4;
+    frame.planes[k].velocity_mps = {0.01, 0.0, 0.0};
+  }
+  DeviceState state;
+
+  g_allocations = 0;
+  g_counting = true;
+  for (int tick = 1; tick <= 10000; ++tick) {
+    const double now_s = tick * 1e-3;
+    if (tick % 50 == 1) {
+      frame.frame_index = tick / 50;
+      frame.planes[1].point_m[2] = 0.05 + 0.002 * std::sin(tick * 1e-3);
+      frame.report_tick_applied = static_cast<std::uint64_t>(tick - 1);
+      frame.report_session_applied = 3;
+      servo.on_plane_frame(frame, now_s);
+    }
+    // The finger wanders through free space, the cube, the edge and the corner.
+    const Vector3d finger(0.02 * std::sin(tick * 0.003), 0.015 * std::cos(tick * 0.002),
+                          0.04 + 0.03 * std::sin(tick * 0.001));
+    state.encoder_counts = kinematics.encoder_counts(finger);
+    servo.tick(tick % 997 == 0 ? nullptr : &state, now_s, 1e-3);
+  }
+  g_counting = false;
+  REQUIRE(g_allocations == 0);
+  REQUIRE(servo.counters().ticks == 10000);
+}
+
+TEST_CASE("the allocation counter does count (the test above can fail)") {
+  g_allocations = 0;
+  g_counting = true;
+  auto* p = new int(3);
+  g_counting = false;
+  delete p;
+  REQUIRE(g_allocations == 1);
+}
+#endif

@@ -1,0 +1,92 @@
+#include "haptic_controller/plane_interpolator.h"
+#include "test_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+
+using namespace impetus;
+using impetus::test::make_frame;
+using impetus::test::wire_plane;
+using Eigen::Vector3d;
+
+TEST_CASE("interpolation weight is the elapsed fraction of the world period, clamped") {
+  REQUIRE(interpolation_weight(1.0, 1.0, 0.05) == 0.0);
+  REQUIRE(interpolation_weight(1.025, 1.0, 0.05) == Approx(0.5));
+  REQUIRE(interpolation_weight(1.2, 1.0, 0.05) == 1.0);
+  REQUIRE(interpolation_weight(0.9, 1.0, 0.05) == 0.0);
+  REQUIRE(interpolation_weight(1.0, 1.0, 0.0) == 1.0);
+  REQUIRE(interpolation_weight(std::numeric_limits<double>::quiet_NaN(), 1.0, 0.05) == 1.0);
+  // Lockstep: now = tick · 1 ms exactly, n = 50 ticks per world step: w = ticks since arrival / n.
+  for (int j = 0; j <= 50; ++j) REQUIRE(interpolation_weight(0.1 + j * 1e-3, 0.1, 0.05) == Approx(j / 50.0));
+}
+
+TEST_CASE("planes are blended between frames i−1 and i (paper 3.2), normals renormalised") {
+  const PlaneFrame previous = make_frame({wire_plane(7, {0, 0, 0}, {0, 0, 1})}, 0);
+  const PlaneFrame current = make_frame({wire_plane(7, {0.01, 0, 0.02}, {1, 0, 1})}, 1);
+  PlaneSet out;
+  interpolate_planes(previous, current, 0.0, out);
+  REQUIRE(out.count == 1);
+  REQUIRE((out.planes[0].point_m - Vector3d::Zero()).norm() < 1e-15);
+  REQUIRE((out.planes[0].normal - Vector3d::UnitZ()).norm() < 1e-15);
+  interpolate_planes(previous, current, 0.25, out);
+  REQUIRE((out.planes[0].point_m - Vector3d(0.0025, 0, 0.005)).norm() < 1e-15);
+  const Vector3d blend = 0.75 * Vector3d::UnitZ() + 0.25 * Vector3d(1, 0, 1).normalized();
+  REQUIRE((out.planes[0].normal - blend.normalized()).norm() < 1e-15);
+  REQUIRE(out.planes[0].normal.norm() == Approx(1.0).epsilon(1e-15));
+  interpolate_planes(previous, current, 1.0, out);
+  REQUIRE((out.planes[0].point_m - Vector3d(0.01, 0, 0.02)).norm() < 1e-15);
+  interpolate_planes(previous, current, 7.0, out);  // clamped
+  REQUIRE((out.planes[0].point_m - Vector3d(0.01, 0, 0.02)).norm() < 1e-15);
+}
+
+TEST_CASE("planes are matched by object id, not by position in the frame; new objects start at frame i") {
+  const PlaneFrame previous =
+      make_frame({wire_plane(1, {0, 0, 0}, {0, 0, 1}), wire_plane(2, {0.1, 0, 0}, {1, 0, 0})}, 0);
+  PlaneFrame current = make_frame({wire_plane(2, {0.2, 0, 0}, {1, 0, 0}), wire_plane(3, {0, 0.3, 0}, {0, 1, 0}),
+                                   wire_plane(1, {0, 0, 0.04}, {0, 0, 1})},
+                                  1);
+  current.planes[0].velocity_mps = {1.0, 2.0, 3.0};
+  current.planes[0].static_friction = 0.7;
+  PlaneSet out;
+  interpolate_planes(previous, current, 0.5, out);
+  REQUIRE(out.count == 3);
+  REQUIRE(out.planes[0].object_id == 2);
+  REQUIRE(out.planes[0].point_m.x() == Approx(0.15));
+  REQUIRE(out.planes[0].velocity_mps == Vector3d(1.0, 2.0, 3.0));  // velocities and friction are frame i's
+  REQUIRE(out.planes[0].static_friction == 0.7);
+  REQUIRE(out.planes[1].object_id == 3);
+  REQUIRE(out.planes[1].point_m.y() == 0.3);  // appeared in frame i: no sweep from anywhere
+  REQUIRE(out.planes[2].object_id == 1);
+  REQUIRE(out.planes[2].point_m.z() == Approx(0.02));
+  REQUIRE(out.planes[2].com_m.z() == Approx(0.02 - 0.025));
+}
+
+TEST_CASE("a flipped normal switches planes at the midpoint instead of sweeping through the object") {
+  const PlaneFrame previous = make_frame({wire_plane(5, {0, 0, 0.01}, {0, 0, 1})}, 0);
+  const PlaneFrame current = make_frame({wire_plane(5, {0, 0, -0.01}, {0, 0, -1})}, 1);
+  PlaneSet out;
+  for (int j = 0; j <= 50; ++j) {
+    const double w = j / 50.0;
+    interpolate_planes(previous, current, w, out);
+    REQUIRE(out.planes[0].normal.allFinite());
+    REQUIRE(out.planes[0].normal.norm() == Approx(1.0));
+    const bool newer = w >= 0.5;
+    REQUIRE(out.planes[0].normal.z() == (newer ? -1.0 : 1.0));
+    REQUIRE(out.planes[0].point_m.z() == (newer ? -0.01 : 0.01));
+  }
+}
+
+TEST_CASE("normals 90 degrees apart blend without vanishing") {
+  const PlaneFrame previous = make_frame({wire_plane(5, {0, 0, 0}, {0, 0, 1})}, 0);
+  const PlaneFrame current = make_frame({wire_plane(5, {0, 0, 0}, {1, 0, 0})}, 1);
+  PlaneSet out;
+  interpolate_planes(previous, current, 0.5, out);
+  REQUIRE((out.planes[0].normal - Vector3d(1, 0, 1).normalized()).norm() < 1e-15);
+  // Nearly antiparallel: still a clean switch, never a near-zero normal.
+  const PlaneFrame almost = make_frame({wire_plane(5, {0, 0, 0}, {1e-12, 0, -1})}, 1);
+  interpolate_planes(previous, almost, 0.5, out);
+  REQUIRE(out.planes[0].normal.allFinite());
+  REQUIRE(out.planes[0].normal.norm() == Approx(1.0));
+}

@@ -1,0 +1,109 @@
+#include "haptic_controller/servo.h"
+#include "haptic_controller/spidar_kinematics.h"
+#include "test_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace impetus;
+using impetus::test::make_frame;
+using impetus::test::wire_plane;
+using Eigen::Vector3d;
+
+namespace {
+
+DeviceState device_at(const SpidarKinematics& kinematics, const Vector3d& finger_m) {
+  DeviceState state;
+  state.encoder_counts = kinematics.encoder_counts(finger_m);
+  return state;
+}
+
+// The floor (static, id 0) at z = 0 and the top of a dynamic 5 cm cube (id 1) at z = 0.05.
+PlaneFrame cube_on_floor(std::uint64_t index) {
+  PlaneFrame frame = make_frame({wire_plane(0, {0, 0, 0}, {0, 0, 1}, false), wire_plane(1, {0, 0, 0.05}, {0, 0, 1})},
+                                index);
+  frame.stiffness_Npm = 2000.0;
+  return frame;
+}
+
+}  // namespace
+
+TEST_CASE("servo: a finger pressing on a cube on the floor is pushed up and the cube is pushed down") {
+  ServoOptions options;
+  HapticServo servo(options, 5);
+  const SpidarKinematics kinematics(options.geometry);
+  servo.on_plane_frame(cube_on_floor(0), 0.0);
+  const Vector3d finger(0.0, 0.0, 0.047);  // 3 mm into the cube
+  TickResult r{};
+  for (int tick = 1; tick <= 100; ++tick) {
+    const DeviceState state = device_at(kinematics, finger);
+    r = servo.tick(&state, tick * 1e-3, 1e-3);
+  }
+  REQUIRE(r.finger_valid);
+  REQUIRE(r.active_planes == 1);
+  REQUIRE(r.proxy_m[2] == Approx(0.05).margin(1e-12));
+  REQUIRE(r.force_N[2] == Approx(2000.0 * 0.003).margin(2000.0 * 2e-5));  // k·depth, within a count's resolution
+  REQUIRE(!r.saturated);
+  REQUIRE(!r.fault);
+  const HapticReport& report = servo.report();
+  REQUIRE(report.tick == 100);
+  REQUIRE(report.haptic_session == 5);
+  REQUIRE(report.finger_valid == 1);
+  REQUIRE(report.entry_count == 1);
+  REQUIRE(report.entries[0].object_id == 1);
+  REQUIRE(report.entries[0].impulse_Ns[2] < 0.0);
+  REQUIRE(report.entries[0].impulse_Ns[2] == Approx(-servo.accumulator().total_impulse_Ns().norm()));
+  REQUIRE(report.static_impulse_Ns[2] == 0.0);
+}
+
+TEST_CASE("servo: no device means no finger, minimum tensions, zero force, nothing accumulated") {
+  ServoOptions options;
+  HapticServo servo(options, 5);
+  servo.on_plane_frame(cube_on_floor(0), 0.0);
+  const TickResult& r = servo.tick(nullptr, 1e-3, 1e-3);
+  REQUIRE(!r.finger_valid);
+  REQUIRE(r.active_planes == 0);
+  REQUIRE(Eigen::Vector3d(to_eigen(r.force_N)) == Vector3d::Zero());
+  for (const double t : r.tension_N) REQUIRE(t == options.geometry.tension_min_N);
+  REQUIRE(servo.report().finger_valid == 0);
+  REQUIRE(servo.counters().no_device_ticks == 1);
+  REQUIRE(servo.accumulator().total_impulse_Ns() == Vector3d::Zero());
+}
+
+TEST_CASE("servo: garbage encoder counts give zero force and a counted fault") {
+  ServoOptions options;
+  options.geometry.metres_per_count = std::nan("");
+  HapticServo servo(options, 5);
+  servo.on_plane_frame(cube_on_floor(0), 0.0);
+  DeviceState state;
+  state.encoder_counts = {1, 2, 3, 4};
+  const TickResult& r = servo.tick(&state, 1e-3, 1e-3);
+  REQUIRE(r.fault);
+  REQUIRE(Eigen::Vector3d(to_eigen(r.force_N)) == Vector3d::Zero());
+  REQUIRE(servo.counters().faults == 1);
+}
+
+TEST_CASE("servo: lockstep interpolation weight is ticks since arrival / n, and a stale world keeps its planes") {
+  ServoOptions options;
+  options.stiffness_Npm = 500.0;  // the flag overrides the scene
+  HapticServo servo(options, 5);
+  const SpidarKinematics kinematics(options.geometry);
+  PlaneFrame first = make_frame({wire_plane(1, {0, 0, 0.0}, {0, 0, 1})}, 0, 0.05);
+  PlaneFrame second = make_frame({wire_plane(1, {0, 0, 0.01}, {0, 0, 1})}, 1, 0.05);
+  servo.on_plane_frame(first, 0.0);
+  servo.on_plane_frame(second, 0.05);
+  const Vector3d finger(0.0, 0.0, -0.002);
+  const DeviceState state = device_at(kinematics, finger);
+  for (int j = 0; j <= 50; j += 10) {
+    const TickResult& r = servo.tick(&state, 0.05 + j * 1e-3, 1e-3);
+    REQUIRE(r.interpolation_weight == Approx(j / 50.0));
+    REQUIRE(servo.planes().planes[0].point_m.z() == Approx(0.01 * j / 50.0));
+    REQUIRE(!r.world_stale);
+  }
+  const TickResult& stale = servo.tick(&state, 0.05 + 0.2, 1e-3);
+  REQUIRE(stale.world_stale);
+  REQUIRE(stale.interpolation_weight == 1.0);
+  REQUIRE(servo.planes().planes[0].point_m.z() == Approx(0.01));
+  REQUIRE(stale.force_N[2] == Approx(500.0 * 0.012).margin(500.0 * 2e-5));
+}

@@ -1,0 +1,52 @@
+#pragma once
+// Builders shared by the haptic_controller tests.
+
+#include "common/link_types.h"
+#include "haptic_controller/contact_plane.h"
+
+#include <Eigen/Core>
+
+#include <initializer_list>
+
+namespace impetus::test {
+
+inline ContactPlane make_plane(const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal, int object_id = 0,
+                               bool dynamic = false, double static_friction = 0.0, double dynamic_friction = 0.0) {
+  ContactPlane plane;
+  plane.object_id = object_id;
+  plane.flags = dynamic ? kPlaneDynamic : 0u;
+  plane.point_m = point_m;
+  plane.normal = normal.normalized();
+  plane.com_m = point_m - 0.025 * plane.normal;  // a 5 cm object behind its surface
+  plane.static_friction = static_friction;
+  plane.dynamic_friction = dynamic_friction;
+  return plane;
+}
+
+inline PlaneSet make_set(std::initializer_list<ContactPlane> planes) {
+  PlaneSet set;
+  for (const ContactPlane& plane : planes) set.planes[set.count++] = plane;
+  return set;
+}
+
+inline Plane wire_plane(int object_id, const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
+                        bool dynamic = true) {
+  Plane plane;
+  plane.object_id = object_id;
+  plane.flags = dynamic ? kPlaneDynamic : 0u;
+  plane.point_m = to_vec3(point_m);
+  plane.normal = to_vec3(normal.normalized());
+  plane.com_m = to_vec3(point_m - 0.025 * normal.normalized());
+  return plane;
+}
+
+inline PlaneFrame make_frame(std::initializer_list<Plane> planes, std::uint64_t index = 0, double period_s = 0.05) {
+  PlaneFrame frame;
+  frame.frame_index = index;
+  frame.world_session = 1;
+  frame.world_period_s = period_s;
+  for (const Plane& plane : planes) frame.planes[frame.plane_count++] = plane;
+  return frame;
+}
+
+}  // namespace impetus::test
