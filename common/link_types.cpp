@@ -86,6 +86,7 @@ FrameError validate(const HapticReport& report) {
   if (report.checksum != frame_checksum(report)) return FrameError::checksum;
   if (report.entry_count > kMaxImpulseEntries) return FrameError::count_out_of_range;
   if (!finite(report.haptic_time_s) || !all_finite(report.finger_m) || !all_finite(report.finger_velocity_mps) ||
+      !all_finite(report.proxy_m) ||
       !all_finite(report.static_impulse_Ns)) {
     return FrameError::not_finite;
   }

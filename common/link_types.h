@@ -77,6 +77,9 @@ struct HapticReport {
   double haptic_time_s = 0.0;       // session time at this tick
   Vec3 finger_m{};                  // C_j
   Vec3 finger_velocity_mps{};
+  // D_j, the god-object proxy: always outside every plane, so the world extracts the next planes around it rather
+  // than around a finger that may have pushed deep into (or through) a thin object.
+  Vec3 proxy_m{};
   std::uint32_t finger_valid = 0;   // 0 while no device is attached: position coupling must not use finger_m
   std::uint32_t entry_count = 0;
   Vec3 static_impulse_Ns{};         // share of the reaction that went into static geometry (floor, fixed objects)

@@ -68,6 +68,7 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
   finger_known_ = true;
   result_.finger_m = to_vec3(finger_m);
   report.finger_m = result_.finger_m;
+  report.proxy_m = result_.finger_m;  // until the proxy of this tick is known
   report.finger_velocity_mps = to_vec3(finger_velocity_mps);
   report.finger_valid = 1;
 
@@ -92,6 +93,7 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
     return result_;
   }
   result_.proxy_m = to_vec3(contact.contact.proxy_m);
+  report.proxy_m = result_.proxy_m;
   result_.active_planes = contact.contact.active_count;
   result_.sticking = contact.sticking;
   if (contact.contact.infeasible) ++counters_.infeasible_contacts;

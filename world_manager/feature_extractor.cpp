@@ -54,7 +54,8 @@ void FeatureExtractor::within_reach(const FingerSample& finger, std::span<const 
                                     double world_period_s, std::vector<ReachCandidate>& out) const {
   out.clear();
   const double finger_speed_mps = finger.velocity_mps.norm();
-  const double finger_reach_m = scene_.haptic.reach_radius_m + finger_speed_mps * world_period_s;
+  const double base_reach_m = scene_.haptic.reach_radius_m + finger.reach_extra_m;
+  const double finger_reach_m = base_reach_m + finger_speed_mps * world_period_s;
   const Eigen::AlignedBox3d query(finger.position_m.array() - finger_reach_m,
                                   finger.position_m.array() + finger_reach_m);
   grid_.query(query, candidate_ids_);
@@ -64,8 +65,7 @@ void FeatureExtractor::within_reach(const FingerSample& finger, std::span<const 
     const SurfacePoint surface =
         nearest_surface_point(scene_.objects[static_cast<std::size_t>(id)].shape, state.pose, finger.position_m);
     // DESIGN.md §1 step 4: reach = base radius + (finger speed + object speed)·T_w.
-    const double reach_m =
-        scene_.haptic.reach_radius_m + (finger_speed_mps + state.velocity_mps.norm()) * world_period_s;
+    const double reach_m = base_reach_m + (finger_speed_mps + state.velocity_mps.norm()) * world_period_s;
     // A NaN distance fails this test: a broken object gives no plane rather than a frame the haptic side rejects.
     if (surface.signed_distance_m <= reach_m && surface.point_m.allFinite() && surface.normal.allFinite()) {
       out.push_back({id, surface});

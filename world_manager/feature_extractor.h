@@ -24,9 +24,13 @@
 
 namespace impetus {
 
+// Where the planes are extracted around: the haptic proxy when the report has one (it never enters an object, so a
+// finger pushed deep into a thin plate still gets the plate's near face), else the finger itself. `reach_extra_m`
+// widens the reach by how far the finger is from that point, so nothing between proxy and finger is missed.
 struct FingerSample {
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
+  double reach_extra_m = 0.0;
 };
 
 // One object within reach and its nearest surface point to the finger.

@@ -210,6 +210,13 @@ const PlaneFrame& World::step(const HapticReport* report) {
     if (finger_valid_) {
       finger_.position_m = to_eigen(report->finger_m);
       finger_.velocity_mps = to_eigen(report->finger_velocity_mps);
+      // Planes come from around the proxy (feature_extractor.h, FingerSample); a report without a finite proxy
+      // falls back to the finger.
+      plane_query_ = finger_;
+      if (all_finite(report->proxy_m)) {
+        plane_query_.position_m = to_eigen(report->proxy_m);
+        plane_query_.reach_extra_m = (finger_.position_m - plane_query_.position_m).norm();
+      }
     }
   }
 
@@ -359,7 +366,7 @@ void World::publish(const HapticReport* report) {
   frame_.stiffness_Npm = scene_.haptic.stiffness_Npm;
   frame_.damping_Nspm = scene_.haptic.damping_Nspm;
   // Without a finger there is nothing to be near: no planes until a device reports one.
-  frame_.plane_count = finger_valid_ ? features_.extract(finger_, states_, period_s_, frame_.planes) : 0;
+  frame_.plane_count = finger_valid_ ? features_.extract(plane_query_, states_, period_s_, frame_.planes) : 0;
   if (!finger_valid_) frame_.planes.fill(Plane{});
   seal(frame_);
 }

@@ -110,7 +110,8 @@ class World {
   Eigen::Vector3d total_static_impulse_Ns_ = Eigen::Vector3d::Zero();
   std::uint64_t rejected_entries_ = 0;
 
-  FingerSample finger_;
+  FingerSample finger_;       // the sampled finger: position coupling's penetration
+  FingerSample plane_query_;  // where planes are extracted: the proxy, reach widened to cover the finger
   bool finger_valid_ = false;
   double time_s_ = 0.0;
   std::uint64_t steps_taken_ = 0;
