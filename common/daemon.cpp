@@ -41,4 +41,17 @@ std::string check_writable_path(const std::string& path) {
   return "";
 }
 
+void add_clock_flag(CLI::App& app, ClockMode& clock) {
+  app.add_option("--clock", clock, "realtime or lockstep (all three processes must agree)")
+      ->transform(CLI::CheckedTransformer(kClockNames, CLI::ignore_case));
+}
+
+void add_shm_flag(CLI::App& app, std::string& shm) {
+  app.add_option("--shm", shm, "shared-memory name of the link (default impetus)");
+}
+
+void add_output_flag(CLI::App& app, const std::string& flag, std::string& path, const std::string& description) {
+  app.add_option(flag, path, description)->check(CLI::Validator(check_writable_path, "WRITABLE"));
+}
+
 }  // namespace impetus

@@ -4,6 +4,7 @@
 #include <sys/mman.h>
 #include <sys/prctl.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
@@ -50,6 +51,20 @@ TickTiming RealtimeClock::wait_next() {
   timing.elapsed_s = static_cast<double>(wake_ns - previous_wake_ns_) * 1e-9;
   previous_wake_ns_ = wake_ns;
   return timing;
+}
+
+LoopStats loop_stats_now(const RealtimeClock* clock) {
+  LoopStats stats;
+  stats.heartbeat_ns = monotonic_now_ns();
+  stats.pid = static_cast<std::int32_t>(getpid());
+  if (clock) {
+    stats.skipped_periods = clock->skipped_periods();
+    stats.lateness_p50_ns = clock->lateness().percentile_ns(0.5);
+    stats.lateness_p99_ns = clock->lateness().percentile_ns(0.99);
+    stats.lateness_p999_ns = clock->lateness().percentile_ns(0.999);
+    stats.lateness_max_ns = clock->lateness().max_ns();
+  }
+  return stats;
 }
 
 std::string request_realtime(int fifo_priority) {

@@ -45,6 +45,10 @@ class RealtimeClock {
   LatencyHistogram lateness_;
 };
 
+// A statistics snapshot of the calling process: heartbeat now, pid, and — given the clock of a real-time loop — its
+// wake-up lateness and skipped periods. The caller adds its own counters (ticks, faults, rejected frames).
+LoopStats loop_stats_now(const RealtimeClock* clock);
+
 // Asks for SCHED_FIFO at `priority`, locks memory (mlockall) and sets a 1 ns timer slack for the calling thread.
 // Returns "" if everything was granted, else a warning naming what was refused and why; the caller prints it and
 // carries on (DESIGN.md §3).

@@ -19,8 +19,13 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <atomic>
+#include <chrono>
+#include <memory>
 #include <optional>
 #include <random>
+#include <thread>
+#include <vector>
 
 namespace impetus {
 namespace {
@@ -103,8 +108,10 @@ class HapticDaemon {
       log_.emplace(options.log_path, kLogHeader, format_row, kLogRows,
                    options.clock == ClockMode::lockstep ? LogOverflow::wait : LogOverflow::drop);
     }
-    world_.emplace(open_when_ready<WorldLinkLayout>(world_link_name(options.shm), options.world_wait_s));
-    const WorldLinkConfig& config = (*world_)->config;
+    worlds_.push_back(std::make_unique<Segment<WorldLinkLayout>>(
+        open_when_ready<WorldLinkLayout>(world_link_name(options.shm), options.world_wait_s)));
+    world_.store(&**worlds_.back(), std::memory_order_release);
+    const WorldLinkConfig& config = world()->config;
     if (config.clock != options.clock) {
       throw std::runtime_error(std::string("the world manager runs --clock ") + to_string(config.clock) +
                                " but the haptic controller was started with --clock " + to_string(options.clock));
@@ -116,12 +123,12 @@ class HapticDaemon {
       throw std::runtime_error("in lockstep the world period (" + std::to_string(config.world_period_s) +
                                " s) must be a whole number of haptic ticks");
     }
-    (*world_)->haptic_pid.store(static_cast<std::int32_t>(getpid()));
+    world()->haptic_pid.store(static_cast<std::int32_t>(getpid()));
   }
 
   int run() {
     std::fprintf(stderr, "haptic_controller: %.0f Hz, %s clock, world at %.1f Hz, device port '%s'\n",
-                 options_.rate_hz, to_string(options_.clock), (*world_)->config.world_rate_hz, port_.name().c_str());
+                 options_.rate_hz, to_string(options_.clock), world()->config.world_rate_hz, port_.name().c_str());
     if (options_.clock == ClockMode::lockstep) {
       run_lockstep();
     } else {
@@ -147,6 +154,28 @@ class HapticDaemon {
     return servo;
   }
 
+  WorldLinkLayout* world() const { return world_.load(std::memory_order_acquire); }
+
+  // Not real-time (opens a segment, reads /proc): called from the supervisor thread in real time and between
+  // turns in lockstep. If the world we follow has died and a new world manager has created the link again, switch
+  // to it. Returns true if it switched.
+  bool try_reattach_world() {
+    if (worlds_.back()->creator_alive()) return false;
+    try {
+      auto fresh = std::make_unique<Segment<WorldLinkLayout>>(
+          Segment<WorldLinkLayout>::open(world_link_name(options_.shm)));
+      if (!fresh->creator_alive() || (*fresh)->config.clock != options_.clock) return false;
+      (*fresh)->haptic_pid.store(static_cast<std::int32_t>(getpid()));
+      worlds_.push_back(std::move(fresh));
+      world_.store(&**worlds_.back(), std::memory_order_release);
+      world_attaches_.fetch_add(1);
+      std::fprintf(stderr, "haptic_controller: re-attached to a restarted world manager\n");
+      return true;
+    } catch (const SegmentError&) {
+      return false;  // not (yet) there: the world keeps its last planes meanwhile
+    }
+  }
+
   std::uint64_t max_ticks() const {
     return options_.duration_s > 0.0 ? static_cast<std::uint64_t>(std::llround(options_.duration_s * options_.rate_hz))
                                      : std::numeric_limits<std::uint64_t>::max();
@@ -160,6 +189,7 @@ class HapticDaemon {
     port_->device_pid.store(0, std::memory_order_release);
     attached_pid_ = 0;
     last_device_sequence_ = 0;
+    have_device_state_ = false;
   }
 
   // Lockstep: the device takes its turn for `tick`; returns its new state, or nullptr without a device.
@@ -189,7 +219,12 @@ class HapticDaemon {
       return nullptr;
     }
     if (read_device_state()) device_fresh_s_ = now_s;
-    if (now_s - device_fresh_s_ > kDeviceStale_s || !have_device_state_) return nullptr;
+    if (now_s - device_fresh_s_ > kDeviceStale_s || !have_device_state_) {
+      // A stale device gets minimum tension; a dead one (kill(pid, 0) is a cheap syscall, not I/O) also loses its
+      // slot so that a new device can attach.
+      if (!process_alive(pid)) release_device();
+      return nullptr;
+    }
     return &device_state_;
   }
 
@@ -208,7 +243,12 @@ class HapticDaemon {
 
   void read_world_frame(double now_s) {
     PlaneFrame& frame = frame_buffer_;
-    if (!(*world_)->planes.try_read(frame, last_frame_sequence_)) return;
+    WorldLinkLayout* current = world();
+    if (current != frames_from_) {  // re-attached to a restarted world: its sequence numbers start afresh
+      frames_from_ = current;
+      last_frame_sequence_ = 0;
+    }
+    if (!current->planes.try_read(frame, last_frame_sequence_)) return;
     if (validate(frame) != FrameError::ok) {
       ++rejected_frames_;
       return;
@@ -230,7 +270,7 @@ class HapticDaemon {
 
     report_ = servo_.report();
     seal(report_);
-    (*world_)->report.write(report_);
+    world()->report.write(report_);
 
     if (log_) {
       HapticLogRow row{};
@@ -266,8 +306,7 @@ class HapticDaemon {
   }
 
   void run_lockstep() {
-    WorldLinkLayout& world = **world_;
-    const std::uint64_t phase = world.config.phase_ticks;
+    const std::uint64_t phase = world()->config.phase_ticks;
     const std::uint64_t ticks = max_ticks();
     bool world_alive = true;
     for (std::uint64_t tick = 0; tick < ticks && wait_for_device(); ++tick) {
@@ -275,10 +314,13 @@ class HapticDaemon {
       const double now_s = static_cast<double>(tick) * period_s_;
       const DeviceState* device = device_turn_lockstep(tick);
       servo_tick(device, tick, now_s, period_s_, 0);
-      if (world_alive && tick >= phase && (tick - phase) % ticks_per_step_ == 0) {
-        world.world_turn.give(tick);
+      const bool world_step_due = tick >= phase && (tick - phase) % ticks_per_step_ == 0;
+      if (world_step_due && !world_alive) world_alive = try_reattach_world();
+      if (world_step_due && world_alive) {
+        WorldLinkLayout& link = *world();
+        link.world_turn.give(tick);
         const TurnResult result =
-            world.world_turn.wait_done([&] { return (*world_).creator_alive(); }, kTurnTimeout_s);
+            link.world_turn.wait_done([&] { return worlds_.back()->creator_alive(); }, kTurnTimeout_s);
         if (result == TurnResult::ok) {
           read_world_frame(now_s);
         } else {
@@ -288,7 +330,7 @@ class HapticDaemon {
       }
       if (tick % 100 == 0) publish_stats(nullptr);
     }
-    world.world_turn.request_shutdown();
+    world()->world_turn.request_shutdown();
     port_->device_turn.request_shutdown();
   }
 
@@ -297,6 +339,14 @@ class HapticDaemon {
       const std::string warning = request_realtime(80);
       if (!warning.empty()) std::fprintf(stderr, "haptic_controller: warning: %s\n", warning.c_str());
     }
+    // The supervisor does what the servo loop must not: liveness checks through /proc and re-opening segments.
+    std::atomic<bool> loop_done{false};
+    std::thread supervisor([&] {
+      while (!loop_done.load()) {
+        try_reattach_world();
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+    });
     RealtimeClock clock(period_s_);
     const std::uint64_t ticks = max_ticks();
     while (!g_stop_requested.load() && clock.ticks() < ticks) {
@@ -306,26 +356,19 @@ class HapticDaemon {
       servo_tick(device, timing.index, timing.now_s, timing.elapsed_s, timing.lateness_ns);
       if (timing.index % 100 == 0) publish_stats(&clock);
     }
+    loop_done.store(true);
+    supervisor.join();
     publish_stats(&clock);
     clock_stats_ = clock.lateness();
     skipped_periods_ = clock.skipped_periods();
   }
 
   void publish_stats(const RealtimeClock* clock) {
-    LoopStats stats;
-    stats.heartbeat_ns = monotonic_now_ns();
-    stats.pid = static_cast<std::int32_t>(getpid());
+    LoopStats stats = loop_stats_now(clock);
     stats.ticks = servo_.counters().ticks;
     stats.faults = servo_.counters().faults;
     stats.rejected_frames = rejected_frames_;
-    if (clock) {
-      stats.skipped_periods = clock->skipped_periods();
-      stats.lateness_p50_ns = clock->lateness().percentile_ns(0.5);
-      stats.lateness_p99_ns = clock->lateness().percentile_ns(0.99);
-      stats.lateness_p999_ns = clock->lateness().percentile_ns(0.999);
-      stats.lateness_max_ns = clock->lateness().max_ns();
-    }
-    (*world_)->haptic_stats.write(stats);
+    world()->haptic_stats.write(stats);
   }
 
   void write_summary() const {
@@ -349,6 +392,7 @@ class HapticDaemon {
           {"no_device_ticks", counters.no_device_ticks},
           {"dropped_impulse_shares", counters.dropped_impulse_shares},
           {"rejected_frames", rejected_frames_},
+          {"world_attaches", world_attaches_.load()},
           {"log_rows_dropped", log_ ? log_->dropped() : 0},
           {"max_force_N", max_force_N_},
           {"skipped_periods", skipped_periods_},
@@ -370,7 +414,12 @@ class HapticDaemon {
   double period_s_;
   HapticServo servo_;
   Segment<DevicePortLayout> port_;
-  std::optional<Segment<WorldLinkLayout>> world_;
+  // Every world link we attached to, oldest first. A restarted world manager creates a new segment; the old mapping
+  // stays alive here (never unmapped while the servo loop might still read it) and `world_` moves to the new one.
+  std::vector<std::unique_ptr<Segment<WorldLinkLayout>>> worlds_;
+  std::atomic<WorldLinkLayout*> world_{nullptr};
+  WorldLinkLayout* frames_from_ = nullptr;
+  std::atomic<std::uint64_t> world_attaches_{1};
   std::optional<RtLog<HapticLogRow>> log_;
   std::uint64_t ticks_per_step_ = 1;
   std::int32_t attached_pid_ = 0;
@@ -401,15 +450,13 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--damping", options.damping_Nspm, "k_d in N·s/m (default: the scene's)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--clock", options.clock, "realtime or lockstep")
-      ->transform(CLI::CheckedTransformer(kClockNames, CLI::ignore_case));
+  add_clock_flag(app, options.clock);
   app.add_option("--duration", options.duration_s, "seconds to run (default: until stopped)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--log", options.log_path, "CSV log: finger, proxy, force, accumulated impulse, lateness per tick")
-      ->check(CLI::Validator(check_writable_path, "WRITABLE"));
-  app.add_option("--summary", options.summary_path, "JSON summary written at exit (loop statistics, faults)")
-      ->check(CLI::Validator(check_writable_path, "WRITABLE"));
-  app.add_option("--shm", options.shm, "shared-memory name of the link (default impetus)");
+  add_output_flag(app, "--log", options.log_path,
+                  "CSV log: finger, proxy, force, accumulated impulse, lateness per tick");
+  add_output_flag(app, "--summary", options.summary_path, "JSON summary written at exit (loop statistics, faults)");
+  add_shm_flag(app, options.shm);
   app.add_option("--world-wait", options.world_wait_s, "seconds to wait for the world manager's link (10)")
       ->check(CLI::PositiveNumber);
   app.add_flag("!--no-realtime-priority", options.realtime_priority,

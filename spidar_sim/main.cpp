@@ -84,18 +84,9 @@ class DeviceSession {
   }
 
   void publish_stats(const RealtimeClock* clock) {
-    LoopStats stats;
-    stats.heartbeat_ns = monotonic_now_ns();
-    stats.pid = static_cast<std::int32_t>(getpid());
+    LoopStats stats = loop_stats_now(clock);
     stats.ticks = ticks_;
     stats.rejected_frames = rejected_;
-    if (clock) {
-      stats.skipped_periods = clock->skipped_periods();
-      stats.lateness_p50_ns = clock->lateness().percentile_ns(0.5);
-      stats.lateness_p99_ns = clock->lateness().percentile_ns(0.99);
-      stats.lateness_p999_ns = clock->lateness().percentile_ns(0.999);
-      stats.lateness_max_ns = clock->lateness().max_ns();
-    }
     port_->device_stats.write(stats);
   }
 
@@ -157,8 +148,11 @@ int run(const Options& options) {
   } else {
     constexpr double kDevicePeriod_s = 1e-3;  // the device's own servo rate; the finger sub-steps inside it
     RealtimeClock clock(kDevicePeriod_s);
-    while (!g_stop_requested.load() && !sim.finished() && port.creator_alive()) {
+    bool haptic_alive = true;
+    while (!g_stop_requested.load() && !sim.finished() && haptic_alive) {
       const TickTiming timing = clock.wait_next();
+      // Liveness reads /proc: ten times a second is plenty to notice a dead haptic controller.
+      if (timing.index % 100 == 0) haptic_alive = port.creator_alive();
       // After a host stall the finger is advanced by the real elapsed time, capped so one tick stays a tick.
       session.step(std::min(timing.elapsed_s, DeviceSim::kMaxTick_s));
       if (timing.index % 100 == 0) session.publish_stats(&clock);
@@ -183,11 +177,9 @@ int main(int argc, char** argv) {
   app.add_option("--trajectory", options.trajectory,
                  "CSV file with header t,x,y,z, or a built-in: tap|press|slide|circle[:key=value,...]")
       ->required();
-  app.add_option("--clock", options.clock, "realtime or lockstep (must match the haptic controller)")
-      ->transform(CLI::CheckedTransformer(kClockNames, CLI::ignore_case));
-  app.add_option("--log", options.log_path, "CSV log: time, target, finger, velocity, force, tensions, counts")
-      ->check(CLI::Validator(check_writable_path, "WRITABLE"));
-  app.add_option("--shm", options.shm, "shared-memory name of the link (default impetus)");
+  add_clock_flag(app, options.clock);
+  add_output_flag(app, "--log", options.log_path, "CSV log: time, target, finger, velocity, force, tensions, counts");
+  add_shm_flag(app, options.shm);
   app.add_option("--attach-timeout", options.attach_timeout_s, "seconds to wait for the haptic controller's port")
       ->check(CLI::PositiveNumber);
   app.add_option("--hand-stiffness", options.finger.hand_stiffness_Npm, "hand impedance stiffness, N/m (300)")

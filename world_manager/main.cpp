@@ -16,6 +16,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -156,32 +157,36 @@ class WorldDaemon {
     WorldLinkLayout& link = **link_;
     HapticReport incoming{};
     std::uint64_t any = 0;
+    const std::int64_t now_ns = monotonic_now_ns();
     if (link.report.try_read(incoming, any)) {
       if (validate(incoming) == FrameError::ok) {
+        if (!have_report_ || incoming.haptic_session != report_.haptic_session || incoming.tick != report_.tick) {
+          report_fresh_ns_ = now_ns;
+        }
         report_ = incoming;
         have_report_ = true;
       } else {
-        ++stats_.rejected_frames;
+        ++rejected_reports_;
       }
+    }
+    // A haptic controller that stopped reporting (killed, stalled) no longer knows where the finger is: drop the
+    // finger so position coupling stops pushing with a stale sample. Its impulse totals stay as they were, so the
+    // ledger applies nothing more from them; a restarted controller starts a new session from zero.
+    if (options_.clock == ClockMode::realtime && have_report_ &&
+        now_ns - report_fresh_ns_ > haptic_stale_ns()) {
+      report_.finger_valid = 0;
     }
     const std::int64_t cpu_before_ns = thread_cpu_now_ns();
     const PlaneFrame& frame = world_.step(have_report_ ? &report_ : nullptr);
     step_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
     link.planes.write(frame);
     if (log_) log_->write_row(*log_file_);
-    ++stats_.ticks;
   }
 
   void publish_stats(const RealtimeClock* clock) {
-    stats_.heartbeat_ns = monotonic_now_ns();
-    stats_.pid = static_cast<std::int32_t>(getpid());
-    if (clock) {
-      stats_.skipped_periods = clock->skipped_periods();
-      stats_.lateness_p50_ns = clock->lateness().percentile_ns(0.5);
-      stats_.lateness_p99_ns = clock->lateness().percentile_ns(0.99);
-      stats_.lateness_p999_ns = clock->lateness().percentile_ns(0.999);
-      stats_.lateness_max_ns = clock->lateness().max_ns();
-    }
+    stats_ = loop_stats_now(clock);
+    stats_.ticks = world_.steps_taken();
+    stats_.rejected_frames = rejected_reports_;
     (*link_)->world_stats.write(stats_);
   }
 
@@ -224,9 +229,16 @@ class WorldDaemon {
   std::optional<std::ofstream> log_file_;
   std::optional<WorldLog> log_;
   std::optional<Segment<WorldLinkLayout>> link_;
+  // Three world periods without a new report (at least 100 ms, several host stalls) is a haptic controller gone.
+  std::int64_t haptic_stale_ns() const {
+    return static_cast<std::int64_t>(std::max(3.0 * world_.world_period_s(), 0.1) * 1e9);
+  }
+
   HapticReport report_{};
   bool have_report_ = false;
-  LoopStats stats_;
+  std::int64_t report_fresh_ns_ = 0;
+  LoopStats stats_;  // the last published snapshot, also written to the summary
+  std::uint64_t rejected_reports_ = 0;
   LatencyHistogram step_cpu_ns_;  // CPU time of World::step (coupling + ODE + features), per step
 };
 
@@ -245,17 +257,14 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 10000));
   app.add_option("--coupling", options.coupling, "impulse (paper §2.2), position (the previous method) or local")
       ->transform(CLI::CheckedTransformer(kCouplingNames, CLI::ignore_case));
-  app.add_option("--clock", options.clock, "realtime or lockstep")
-      ->transform(CLI::CheckedTransformer(kClockNames, CLI::ignore_case));
+  add_clock_flag(app, options.clock);
   app.add_option("--phase", options.phase_ticks, "lockstep: world step i happens at haptic tick i*n + PHASE")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--duration", options.duration_s, "seconds of world time to run (default: until stopped)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--log", options.log_path, "CSV log of every dynamic object per step")
-      ->check(CLI::Validator(check_writable_path, "WRITABLE"));
-  app.add_option("--summary", options.summary_path, "JSON summary written at exit (objects, loop statistics)")
-      ->check(CLI::Validator(check_writable_path, "WRITABLE"));
-  app.add_option("--shm", options.shm, "shared-memory name of the link (default impetus)");
+  add_output_flag(app, "--log", options.log_path, "CSV log of every dynamic object per step");
+  add_output_flag(app, "--summary", options.summary_path, "JSON summary written at exit (objects, loop statistics)");
+  add_shm_flag(app, options.shm);
   app.add_option("--haptic-rate", options.haptic_rate_hz, "haptic rate the lockstep phase is counted in (1000)")
       ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);

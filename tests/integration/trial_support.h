@@ -4,15 +4,25 @@
 
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <chrono>
 #include <string>
+#include <thread>
+#include <vector>
 
 namespace impetus::test {
+
+// SpidarGeometry::max_force_N (10 N) plus rounding: the clamp rescales the force vector to 10 N, and the norm of the
+// rescaled vector can come out an ulp or two above it.
+inline constexpr double kDeviceMaxForce_N = 10.0 * (1.0 + 1e-12);
 
 inline std::filesystem::path out_dir(const std::string& name) {
   const auto dir = std::filesystem::path(IMPETUS_BINARY_DIR) / "test-out" / (name + "-" + std::to_string(getpid()));
@@ -57,5 +67,38 @@ inline Trial run_trial(const std::string& name, const std::string& arguments) {
   if (trial.exit_status == 0) trial.summary = read_json(trial.dir / "summary.json");
   return trial;
 }
+
+
+// Starts a daemon in the background with its output in `log`; returns its pid.
+inline pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, STDOUT_FILENO);
+    dup2(fd, STDERR_FILENO);
+    std::vector<char*> args;
+    for (const auto& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// Waits up to `timeout_s` for a child; returns its exit status, or -1 (and kills it) if it did not exit in time.
+inline int wait_for(pid_t pid, double timeout_s) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > give_up) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
 
 }  // namespace impetus::test

@@ -1,0 +1,176 @@
+// Faults in real time (issue 8): processes killed with SIGKILL mid-contact and restarted, and garbage written into a
+// live segment. No timing is asserted (this VM has host stalls); the tests check that the survivors keep running,
+// forces stay bounded, nothing bursts, and the restarted process re-attaches.
+
+#include "common/link_names.h"
+#include "common/segment.h"
+#include "common/world_link.h"
+#include "trial_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include "csv_columns.h"
+#include <random>
+
+namespace impetus {
+namespace {
+
+struct Daemons {
+  std::filesystem::path dir;
+  std::string shm;
+  std::string scene = std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json";
+
+  pid_t world(const std::string& tag) const {
+    return test::spawn({test::binary("world_manager"), "--scene", scene, "--shm", shm, "--log",
+                        (dir / ("world" + tag + ".csv")).string(), "--summary", (dir / ("world" + tag + ".json")).string()},
+                       dir / ("world" + tag + ".out"));
+  }
+  pid_t haptic(const std::string& tag) const {
+    return test::spawn({test::binary("haptic_controller"), "--shm", shm, "--log", (dir / ("haptic" + tag + ".csv")).string(),
+                        "--summary", (dir / ("haptic" + tag + ".json")).string()},
+                       dir / ("haptic" + tag + ".out"));
+  }
+  pid_t device(const std::string& tag, const std::string& trajectory) const {
+    return test::spawn({test::binary("spidar_sim"), "--shm", shm, "--trajectory", trajectory},
+                       dir / ("device" + tag + ".out"));
+  }
+  bool segments_left() const {
+    return std::filesystem::exists("/dev/shm/" + world_link_name(shm)) ||
+           std::filesystem::exists("/dev/shm/" + device_port_name(shm));
+  }
+};
+
+Daemons make_daemons(const std::string& name) {
+  Daemons daemons;
+  daemons.dir = test::out_dir(name);
+  daemons.shm = "impetus_test_" + name + "_" + std::to_string(getpid());
+  return daemons;
+}
+
+void sleep_s(double seconds) { std::this_thread::sleep_for(std::chrono::duration<double>(seconds)); }
+
+// Pressing down on the cube's top face (z = 0.05) 1 cm deep: the finger stays in contact for the whole hold.
+const std::string kPress = "press:x=0.03,surface_z=0.05,depth=0.01,hold=";
+
+}  // namespace
+
+TEST_CASE("killing the world manager mid-contact: the haptic controller keeps the last planes and re-attaches") {
+  const Daemons daemons = make_daemons("killworld");
+  pid_t world = daemons.world("1");
+  const pid_t haptic = daemons.haptic("");
+  const pid_t device = daemons.device("", kPress + "3");
+  sleep_s(1.2);  // the press reaches the cube after ~0.4 s
+  kill(world, SIGKILL);
+  CHECK(test::wait_for(world, 5.0) == -1);  // killed, not exited
+  sleep_s(0.5);  // ten world periods without a world: the servo must call its planes stale and keep them
+  world = daemons.world("2");
+  CHECK(test::wait_for(device, 30.0) == 0);
+  kill(haptic, SIGTERM);
+  CHECK(test::wait_for(haptic, 10.0) == 0);
+  kill(world, SIGTERM);
+  CHECK(test::wait_for(world, 10.0) == 0);
+  INFO(test::read_text(daemons.dir / "haptic.out"));
+
+  const auto summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
+  CHECK(summary["world_attaches"] == 2);
+  CHECK(summary["faults"] == 0);
+  CHECK(summary["max_force_N"].get<double>() <= test::kDeviceMaxForce_N);
+  CHECK(summary["stale_world_ticks"].get<int>() > 0);
+  // The restarted world's cube starts where the scene says, so the press finds it again: the second world applied
+  // a downward impulse (the finger kept pressing after the re-attach).
+  const auto second = test::read_json(daemons.dir / "world2.json");
+  CHECK(second["objects"]["cube"]["impulse_Ns"][2].get<double>() < -0.1);
+  CHECK_FALSE(daemons.segments_left());
+}
+
+TEST_CASE("killing the haptic controller: the world keeps stepping and a restarted controller causes no burst") {
+  const Daemons daemons = make_daemons("killhaptic");
+  const pid_t world = daemons.world("");
+  pid_t haptic = daemons.haptic("1");
+  const pid_t device = daemons.device("1", kPress + "3");
+  sleep_s(1.5);  // pressing for ~1 s: the running total on the cube is about −(k·depth)·1 s, several N·s
+  kill(haptic, SIGKILL);
+  CHECK(test::wait_for(haptic, 5.0) == -1);
+  // The device notices its haptic controller is gone and leaves.
+  CHECK(test::wait_for(device, 10.0) == 0);
+  sleep_s(0.5);
+  haptic = daemons.haptic("2");
+  const pid_t device2 = daemons.device("2", kPress + "1");
+  CHECK(test::wait_for(device2, 30.0) == 0);
+  kill(haptic, SIGTERM);
+  CHECK(test::wait_for(haptic, 10.0) == 0);
+  kill(world, SIGTERM);
+  CHECK(test::wait_for(world, 10.0) == 0);
+
+  // If the restarted counter were subtracted from the old baseline, the cube would be launched upward by several
+  // N·s; pressed down onto the floor it must instead never rise above its resting height (plus ODE's contact slack).
+  const auto world_log = test::read_csv_columns(daemons.dir / "world.csv");
+  const auto& z = world_log.at("cube.z_m");
+  REQUIRE(z.size() > 40);
+  double highest_m = 0.0;
+  for (double value : z) highest_m = std::max(highest_m, value);
+  CHECK(highest_m < 0.025 + 1e-3);
+  const auto summary = test::read_json(daemons.dir / "world.json");
+  CHECK(summary["world"]["steps"].get<int>() > 40);
+  CHECK_FALSE(daemons.segments_left());
+}
+
+TEST_CASE("killing spidar_sim: minimum tension is commanded and a new device attaches") {
+  const Daemons daemons = make_daemons("killdevice");
+  const pid_t world = daemons.world("");
+  const pid_t haptic = daemons.haptic("");
+  const pid_t device = daemons.device("1", kPress + "5");
+  sleep_s(1.0);
+  kill(device, SIGKILL);
+  CHECK(test::wait_for(device, 5.0) == -1);
+  sleep_s(0.3);
+  const pid_t device2 = daemons.device("2", kPress + "0.5");
+  CHECK(test::wait_for(device2, 30.0) == 0);
+  CHECK_THAT(test::read_text(daemons.dir / "device2.out"), Catch::Contains("attached"));
+  kill(haptic, SIGTERM);
+  CHECK(test::wait_for(haptic, 10.0) == 0);
+  kill(world, SIGTERM);
+  CHECK(test::wait_for(world, 10.0) == 0);
+  const auto summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
+  CHECK(summary["no_device_ticks"].get<int>() > 0);  // the gap between the two devices: no device, no force
+  CHECK(summary["faults"] == 0);
+  CHECK_FALSE(daemons.segments_left());
+}
+
+TEST_CASE("random bytes written into a live world link are rejected and counted while both sides keep running") {
+  const Daemons daemons = make_daemons("scribble");
+  const pid_t world = daemons.world("");
+  const pid_t haptic = daemons.haptic("");
+  const pid_t device = daemons.device("", kPress + "2");
+  sleep_s(0.8);
+  {
+    auto link = Segment<WorldLinkLayout>::open(world_link_name(daemons.shm));
+    std::mt19937_64 random(11);
+    // Scribble over both channels, sequence words included, as a buggy or hostile process would.
+    auto scribble = [&](void* start, std::size_t size) {
+      auto* bytes = static_cast<unsigned char*>(start);
+      const std::size_t offset = random() % size;
+      const std::size_t length = std::min<std::size_t>(size - offset, 1 + random() % 512);
+      for (std::size_t k = 0; k < length; ++k) bytes[offset + k] = static_cast<unsigned char>(random());
+    };
+    for (int round = 0; round < 200; ++round) {
+      scribble(&link->planes, sizeof(link->planes));
+      scribble(&link->report, sizeof(link->report));
+      sleep_s(0.005);
+    }
+  }
+  CHECK(test::wait_for(device, 30.0) == 0);
+  kill(haptic, SIGTERM);
+  CHECK(test::wait_for(haptic, 10.0) == 0);
+  kill(world, SIGTERM);
+  CHECK(test::wait_for(world, 10.0) == 0);
+  const auto haptic_summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
+  const auto world_summary = test::read_json(daemons.dir / "world.json")["world"];
+  CHECK(haptic_summary["rejected_frames"].get<int>() + world_summary["rejected_reports"].get<int>() > 0);
+  CHECK(haptic_summary["faults"] == 0);
+  CHECK(haptic_summary["max_force_N"].get<double>() <= test::kDeviceMaxForce_N);
+  CHECK_FALSE(daemons.segments_left());
+}
+
+}  // namespace impetus
