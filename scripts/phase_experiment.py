@@ -8,27 +8,14 @@ the table. With --check it exits 1 unless the paper's claim holds: impulse sprea
 and the reference's own spread is below --reference-tolerance metres.
 """
 import argparse
-import concurrent.futures
 import csv
 import json
 import os
 import pathlib
-import subprocess
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-
-
-def run_trial(out_dir, scene, trajectory, coupling, rate, phase, extra):
-    out_dir.mkdir(parents=True, exist_ok=True)
-    command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), "--trajectory", trajectory,
-               "--coupling", coupling, "--rate", str(rate), "--phase", str(phase), "--clock", "lockstep",
-               "--out", str(out_dir), "--quiet"] + extra
-    result = subprocess.run(command, capture_output=True, text=True)
-    if result.returncode != 0:
-        raise RuntimeError(f"trial failed ({' '.join(command)}):\n{result.stdout}{result.stderr}")
-    summary = json.loads((out_dir / "summary.json").read_text())
-    return summary
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from trials import ROOT, run_parallel, run_trial  # noqa: E402  (shared with speed_vs_error.py)
 
 
 def cube_track(out_dir, name):
@@ -77,20 +64,17 @@ def main():
 
     results = {}
     done = 0
-    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        futures = {}
-        for label, rate, phase in jobs:
-            coupling = "impulse" if label == "reference" else label
-            trial_dir = args.out / f"{label}-phase{phase:03d}"
-            futures[pool.submit(run_trial, trial_dir, args.scene, args.trajectory, coupling, rate, phase, [])] = (
-                label, phase, trial_dir)
-        for future in concurrent.futures.as_completed(futures):
-            label, phase, trial_dir = futures[future]
-            summary = future.result()
-            results[(label, phase)] = (summary["objects"][args.object]["position"][0], trial_dir,
-                                       summary["config"].get("wall_time_s", 0.0))
-            done += 1
-            print(f"\r{done}/{len(jobs)} trials", end="", file=sys.stderr, flush=True)
+    tasks = []
+    for label, rate, phase in jobs:
+        coupling = "impulse" if label == "reference" else label
+        trial_dir = args.out / f"{label}-phase{phase:03d}"
+        tasks.append(((label, phase, trial_dir), run_trial,
+                      (trial_dir, args.scene, args.trajectory, coupling, rate, phase, [])))
+    for (label, phase, trial_dir), summary in run_parallel(tasks, args.jobs):
+        results[(label, phase)] = (summary["objects"][args.object]["position"][0], trial_dir,
+                                   summary["config"].get("wall_time_s", 0.0))
+        done += 1
+        print(f"\r{done}/{len(jobs)} trials", end="", file=sys.stderr, flush=True)
     print(file=sys.stderr)
 
     reference = [results[("reference", p)][0] for p in range(min(args.phases, 10))]

@@ -1,0 +1,120 @@
+#!/usr/bin/env bash
+# Builds Impetus (scripts/build.sh build) and runs its benchmarks, printing the numbers. Asserts nothing: timing on a
+# shared 2-core VM is a measurement, not a pass/fail test (issue 7, "Benchmarks").
+#   scripts/bench.sh [--short]       --short: 5 s instead of 30 s for the real-time loop benchmark
+#
+#   1. haptic tick cost vs number of planes            build/tests/bench_haptic_tick
+#   2. world step and feature query vs object count    build/tests/bench_world
+#   3. channel latency between processes               build/tests/bench_channel
+#   4. 1 kHz real-time loop lateness (FIFO + mlock)    build/tests/bench_rt_loop SECONDS
+#   5. lockstep throughput of the tap trial (simulated s per wall s, target >= 50x) via scripts/run.sh
+#   6. peak RSS of each process during a tap trial
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+cd "$root"
+
+rt_seconds=30
+while (($#)); do
+  case "$1" in
+    --short) rt_seconds=5; shift ;;
+    -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "bench.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+
+bash scripts/build.sh build
+build="$root/build"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+
+section() { printf '\n== %s\n' "$*"; }
+# Runs a benchmark program if it was built; a missing one (not written yet) or a failing one is reported, not fatal.
+bench() {
+  local program="$build/tests/$1"; shift
+  if [ ! -x "$program" ]; then
+    echo "(skipped: $program does not exist yet)"
+    return 0
+  fi
+  "$program" "$@" || echo "(${program##*/} exited with status $?)"
+}
+
+section "1. Haptic tick cost vs number of planes (ns)"
+bench bench_haptic_tick
+
+section "2. World step and feature query vs number of objects"
+bench bench_world
+
+section "3. Channel latency between processes"
+bench bench_channel
+
+section "4. Real-time loop lateness at 1 kHz, ${rt_seconds} s per mode (ordinary, then SCHED_FIFO + mlockall)"
+bench bench_rt_loop "$rt_seconds"
+
+section "5. Lockstep throughput: tap trial (world 20 Hz, impulse coupling), 5 runs one after another"
+# Simulated seconds are the world's (summary world.time_s); wall time is run.sh's, from launching the three processes
+# to their clean exit, so start-up and shared-memory set-up count against the throughput. The same trial with a 20 s
+# final hold separates that fixed cost from the steady-state rate (the marginal simulated s per wall s).
+for i in 1 2 3 4 5; do
+  bash scripts/run.sh --scene scenes/tap.json --trajectory tap --out "$tmp/throughput$i" --quiet
+done
+bash scripts/run.sh --scene scenes/tap.json --trajectory tap:hold=20 --out "$tmp/throughput-long" --quiet
+/usr/bin/python3 - "$tmp" <<'PY'
+import json, pathlib, statistics, sys
+def run(name):
+    s = json.loads((pathlib.Path(sys.argv[1]) / name / "summary.json").read_text())
+    return s["world"]["time_s"], s["config"]["wall_time_s"]
+runs = [run(f"throughput{i}") for i in range(1, 6)]
+for sim, wall in runs:
+    print(f"  {sim:.3f} s simulated in {wall:.3f} s wall: {sim / wall:6.1f}x real time")
+median = statistics.median(sim / wall for sim, wall in runs)
+print(f"  median {median:.1f}x real time (target >= 50x: {'met' if median >= 50 else 'NOT met'})")
+sim, wall = run("throughput-long")
+short_sim = statistics.median(s for s, _ in runs)
+short_wall = statistics.median(w for _, w in runs)
+steady = (sim - short_sim) / (wall - short_wall)
+print(f"  tap:hold=20: {sim:.3f} s simulated in {wall:.3f} s wall: {sim / wall:.1f}x real time; steady state "
+      f"(long minus median short) {steady:.1f}x, so ~{max(short_wall - short_sim / steady, 0):.3f} s of each "
+      f"trial's wall time is start-up and shutdown")
+PY
+
+section "6. Peak RSS of each process during a lockstep trial (tap trajectory)"
+# run.sh starts $IMPETUS_BUILD_DIR/NAME/NAME. Here each of those is a wrapper that runs the real binary under
+# /usr/bin/time (its ru_maxrss is the binary's own peak; time's fork is tiny, whereas a Python launcher's pages would
+# be counted in it) and passes run.sh's SIGTERM on to the binary, since GNU time itself would die of it.
+if [ ! -x /usr/bin/time ]; then
+  echo "(skipped: /usr/bin/time is missing; scripts/deps.sh installs the Debian package 'time')"
+  exit 0
+fi
+for name in world_manager haptic_controller spidar_sim; do
+  mkdir -p "$tmp/wrapped/$name"
+  {
+    echo '#!/usr/bin/env bash'
+    printf 'report=%q\n' "$tmp/rss.$name"
+    printf '/usr/bin/time -f "%%x %%M" -o "$report" %q "$@" &\n' "$build/$name/$name"
+    cat <<'WRAPPER'
+timer=$!
+# The binary is time's only child: pass run.sh's signals on to it.
+forward() { kill -"$1" $(cat /proc/$timer/task/$timer/children 2>/dev/null) 2>/dev/null || true; }
+trap 'forward TERM' TERM
+trap 'forward INT' INT
+# A trapped signal interrupts wait, so wait until time has really exited. Its exit status is taken from its report
+# (%x), not from wait, whose status after an interrupted wait is not reliable.
+wait $timer 2>/dev/null || true
+while kill -0 $timer 2>/dev/null; do wait $timer 2>/dev/null || true; done
+signal="$(sed -n 's/^Command terminated by signal \([0-9]*\).*/\1/p' "$report")"
+[ -n "$signal" ] && exit $((128 + signal))
+read -r code _ < <(tail -n 1 "$report")
+exit "${code:-1}"
+WRAPPER
+  } >"$tmp/wrapped/$name/$name"
+  chmod +x "$tmp/wrapped/$name/$name"
+done
+for scene in tap spheres; do
+  IMPETUS_BUILD_DIR="$tmp/wrapped" bash scripts/run.sh --scene "scenes/$scene.json" --trajectory tap \
+    --out "$tmp/rss-$scene" --quiet || { echo "  (the $scene trial failed; see above)"; continue; }
+  echo "  scenes/$scene.json:"
+  for name in world_manager haptic_controller spidar_sim; do
+    read -r _ kb < <(tail -n 1 "$tmp/rss.$name")
+    awk -v name="$name" -v kb="$kb" 'BEGIN { printf "    %-18s peak RSS %6.1f MiB\n", name, kb / 1024 }'
+  done
+done
