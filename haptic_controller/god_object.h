@@ -6,6 +6,13 @@
 // apply_friction (stick/slip of the proxy on the surface). The reported active constraints and multipliers are the
 // frictionless ones: the normal load each plane carries, by which the reaction is shared among objects (§3.4).
 // Owned by the servo thread; allocation-free.
+//
+// A finger that starts inside an object (the device attaches, or the finger reappears, with the fingertip already
+// behind a surface) is not kicked out to the nearest face: that would render a force of k·depth — the device maximum
+// for a centimetre — for energy nobody put in. Instead, at the start of a finger session the planes the finger is
+// already behind are disarmed: they do not constrain the proxy until the finger has come out of them (or the object
+// has left the frame), after which they act normally. Planes the finger is in front of at the start, and every plane
+// that appears later, act at once — so a plane that moves onto the finger still pushes it out.
 
 #include "haptic_controller/contact_plane.h"
 #include "haptic_controller/friction.h"
@@ -28,11 +35,27 @@ class GodObject {
   // No contact memory (device detached, session restart).
   void reset();
 
+  // The finger has just become known (first valid device reading after none): the next solve that sees planes
+  // disarms those the finger is behind.
+  void begin_finger_session();
+
+  // Planes currently disarmed because the finger started behind them.
+  int disarmed_count() const { return disarmed_count_; }
+
   const GodObjectResult& result() const { return result_; }
 
  private:
+  // The planes that constrain the proxy this tick: `planes` minus the disarmed ones. Returns `planes` itself when
+  // nothing is disarmed (the usual case, no copy); otherwise fills armed_ and armed_index_.
+  const PlaneSet& armed_planes(const PlaneSet& planes, const Eigen::Vector3d& finger_m);
+
   FrictionAnchor anchor_;
   GodObjectResult result_;
+  bool session_starting_ = false;
+  std::array<std::int32_t, kMaxPlanes> disarmed_ids_{};
+  int disarmed_count_ = 0;
+  PlaneSet armed_;
+  std::array<int, kMaxPlanes> armed_index_{};  // armed_ index → index in the caller's PlaneSet
 };
 
 }  // namespace impetus

@@ -34,10 +34,11 @@ TEST_CASE("servo: a finger pressing on a cube on the floor is pushed up and the 
   HapticServo servo(options, 5);
   const SpidarKinematics kinematics(options.geometry);
   servo.on_plane_frame(cube_on_floor(0), 0.0);
-  const Vector3d finger(0.0, 0.0, 0.047);  // 3 mm into the cube
+  const Vector3d above(0.0, 0.0, 0.055);   // the finger arrives from above the cube...
+  const Vector3d finger(0.0, 0.0, 0.047);  // ...and presses 3 mm into it
   TickResult r{};
   for (int tick = 1; tick <= 100; ++tick) {
-    const DeviceState state = device_at(kinematics, finger);
+    const DeviceState state = device_at(kinematics, tick == 1 ? above : finger);
     r = servo.tick(&state, tick * 1e-3, 1e-3);
   }
   REQUIRE(r.finger_valid);
@@ -95,6 +96,8 @@ TEST_CASE("servo: lockstep interpolation weight is ticks since arrival / n, and 
   servo.on_plane_frame(second, 0.05);
   const Vector3d finger(0.0, 0.0, -0.002);
   const DeviceState state = device_at(kinematics, finger);
+  const DeviceState arriving = device_at(kinematics, Vector3d(0.0, 0.0, 0.02));  // first seen outside the surface
+  servo.tick(&arriving, 0.05, 1e-3);
   for (int j = 0; j <= 50; j += 10) {
     const TickResult& r = servo.tick(&state, 0.05 + j * 1e-3, 1e-3);
     REQUIRE(r.interpolation_weight == Approx(j / 50.0));
@@ -106,4 +109,28 @@ TEST_CASE("servo: lockstep interpolation weight is ticks since arrival / n, and 
   REQUIRE(stale.interpolation_weight == 1.0);
   REQUIRE(servo.planes().planes[0].point_m.z() == Approx(0.01));
   REQUIRE(stale.force_N[2] == Approx(500.0 * 0.012).margin(500.0 * 2e-5));
+}
+
+TEST_CASE("servo: a finger that appears inside an object is not kicked out until it has left the object") {
+  ServoOptions options;
+  HapticServo servo(options, 5);
+  const SpidarKinematics kinematics(options.geometry);
+  servo.on_plane_frame(cube_on_floor(0), 0.0);
+  const DeviceState inside = device_at(kinematics, Vector3d(0.0, 0.0, 0.045));  // 5 mm into the cube
+  const DeviceState outside = device_at(kinematics, Vector3d(0.0, 0.0, 0.052));
+  for (int tick = 1; tick <= 20; ++tick) {
+    const TickResult& r = servo.tick(&inside, tick * 1e-3, 1e-3);
+    REQUIRE(r.active_planes == 0);
+    REQUIRE(Eigen::Vector3d(to_eigen(r.force_N)) == Vector3d::Zero());
+  }
+  servo.tick(&outside, 0.021, 1e-3);  // out of the cube: its plane is armed from now on
+  const TickResult& back_in = servo.tick(&inside, 0.022, 1e-3);
+  REQUIRE(back_in.active_planes == 1);
+  REQUIRE(back_in.force_N[2] > 0.0);
+
+  // The device goes away and comes back with the finger inside: disarmed again, no kick.
+  servo.tick(nullptr, 0.023, 1e-3);
+  const TickResult& reattached = servo.tick(&inside, 0.024, 1e-3);
+  REQUIRE(reattached.active_planes == 0);
+  REQUIRE(Eigen::Vector3d(to_eigen(reattached.force_N)) == Vector3d::Zero());
 }
