@@ -54,10 +54,12 @@ std::uint64_t frame_checksum(const DeviceState& state) { return checksum_words(s
 FrameError validate(const PlaneFrame& frame) {
   if (frame.checksum != frame_checksum(frame)) return FrameError::checksum;
   if (frame.plane_count > kMaxPlanes) return FrameError::count_out_of_range;
-  if (!finite(frame.world_time_s) || !finite(frame.stiffness_Npm) || !finite(frame.damping_Nspm)) {
+  if (!finite(frame.world_time_s) || !finite(frame.stiffness_Npm) || !finite(frame.damping_Nspm) ||
+      !all_finite(frame.gravity_mps2) || !finite(frame.world_substep_s)) {
     return FrameError::not_finite;
   }
   if (!(frame.world_period_s > 0.0) || !finite(frame.world_period_s)) return FrameError::bad_period;
+  if (frame.world_substep_s < 0.0) return FrameError::bad_period;
   if (static_cast<std::uint32_t>(frame.coupling) > static_cast<std::uint32_t>(Coupling::local)) {
     return FrameError::bad_coupling;
   }
@@ -70,6 +72,15 @@ FrameError validate(const PlaneFrame& frame) {
     }
     for (double value : plane.inverse_inertia_world) {
       if (!finite(value)) return FrameError::not_finite;
+    }
+    if (plane.local_contact_count > kMaxLocalContacts) return FrameError::count_out_of_range;
+    for (std::uint32_t c = 0; c < plane.local_contact_count; ++c) {
+      const LocalContact& contact = plane.local_contacts[c];
+      if (!all_finite(contact.normal) || !finite(contact.friction)) return FrameError::not_finite;
+      const double length = std::sqrt(contact.normal[0] * contact.normal[0] + contact.normal[1] * contact.normal[1] +
+                                      contact.normal[2] * contact.normal[2]);
+      if (std::fabs(length - 1.0) > kUnitNormalTolerance) return FrameError::normal_not_unit;
+      if (contact.friction < 0.0) return FrameError::bad_friction;
     }
     const double norm = std::sqrt(plane.normal[0] * plane.normal[0] + plane.normal[1] * plane.normal[1] +
                                   plane.normal[2] * plane.normal[2]);
@@ -92,7 +103,10 @@ FrameError validate(const HapticReport& report) {
   }
   for (std::uint32_t k = 0; k < report.entry_count; ++k) {
     const ObjectImpulse& entry = report.entries[k];
-    if (!all_finite(entry.impulse_Ns) || !all_finite(entry.angular_impulse_Nms)) return FrameError::not_finite;
+    if (!all_finite(entry.impulse_Ns) || !all_finite(entry.angular_impulse_Nms) ||
+        !all_finite(entry.impulse_moment_Nss) || !all_finite(entry.angular_impulse_moment_Nmss)) {
+      return FrameError::not_finite;
+    }
   }
   return FrameError::ok;
 }

@@ -20,8 +20,19 @@ enum class Coupling : std::uint32_t {
   local = 2,     // paper §6.3: the haptic side also moves the touched object between world steps (issue 9)
 };
 
+// Contacts of one object that the local response model respects (issue 9, paper §6.3).
+inline constexpr std::uint32_t kMaxLocalContacts = 4;
+
 // Plane flags.
 inline constexpr std::uint32_t kPlaneDynamic = 1u << 0;  // the object moves; impulses on it are applied by the world
+
+// One contact of a dynamic object with the rest of the world, as the world saw it in its last substep: a unilateral
+// constraint for the haptic side's local model (haptic_controller/local_dynamics.h). Contacts with a movable body are
+// treated as immovable there: the model then under-predicts the motion, which is the safe (passive) error.
+struct LocalContact {
+  Vec3 normal{};          // unit; the direction the contact pushes the object (out of the other body)
+  double friction = 0.0;  // Coulomb coefficient of the pair, dimensionless, >= 0
+};
 
 // One plane of paper §3.1: the nearest surface point of an object to the finger and the outward normal there, plus
 // what the haptic side needs for friction (§6.2) and for splitting the reaction among objects.
@@ -39,6 +50,12 @@ struct Plane {
   // side must then treat the object as immovable between world steps.
   double inverse_mass_per_kg = 0.0;
   std::array<double, 9> inverse_inertia_world{};  // row-major, 1/(kg·m²), about the centre of mass
+  // Local coupling only: the object's contacts (floor, walls, other objects) at the end of the step, so the local
+  // model cannot move it into them and applies their Coulomb friction (a cube sliding on the floor loses μ·g·Δt of
+  // speed per tick, as in the world). Other couplings leave them empty.
+  std::uint32_t local_contact_count = 0;
+  std::uint32_t reserved = 0;  // keeps the layout in whole 64-bit words (checksum)
+  std::array<LocalContact, kMaxLocalContacts> local_contacts{};
 };
 
 // World → haptic, published once per world step i (DESIGN.md §1 step 5).
@@ -54,6 +71,10 @@ struct PlaneFrame {
   // Haptic parameters from the scene; the haptic controller's flags override them.
   double stiffness_Npm = 0.0;
   double damping_Nspm = 0.0;
+  // Local coupling: the scene's gravity and the world's integration step inside its period (T_w / substeps), so the
+  // haptic side's local model integrates the drift (gravity, supports, friction) on the same grid as the world.
+  Vec3 gravity_mps2{};
+  double world_substep_s = 0.0;  // 0: unknown (the model then applies the drift every tick)
   std::array<Plane, kMaxPlanes> planes{};
   std::uint64_t checksum = 0;  // frame_checksum() of everything above; set by the writer
 };
@@ -67,6 +88,11 @@ struct ObjectImpulse {
   std::uint32_t epoch = 0;
   Vec3 impulse_Ns{};              // ∑ −f_k·Δt over ticks, shared to this object (paper §3.4)
   Vec3 angular_impulse_Nms{};     // ∑ (contact − CoM) × (−f_k·Δt), about the centre of mass
+  // First moments in time, ∑ impulse_k·t_k with t_k the haptic session time of tick k (N·s², N·m·s²). With the
+  // report's haptic_time_s they tell the world *when* within its period the impulse was rendered, so local coupling
+  // applies it at that time and the world's next state agrees with what the haptic side showed (world.h).
+  Vec3 impulse_moment_Nss{};
+  Vec3 angular_impulse_moment_Nmss{};
   std::uint64_t last_tick = 0;    // last haptic tick that added to this entry
 };
 

@@ -169,7 +169,12 @@ Floor parse_floor(const Node& node) {
 PhysicsParams parse_physics(const Node& node) {
   node.expect_keys({"world_rate_hz", "substeps", "solver_iterations", "erp", "cfm", "auto_disable", "seed"});
   PhysicsParams physics;
-  if (node.has("world_rate_hz")) physics.world_rate_hz = node.child("world_rate_hz").positive();
+  if (node.has("world_rate_hz")) {
+    const Node rate = node.child("world_rate_hz");
+    physics.world_rate_hz = rate.positive();
+    // A denormal rate is positive but its period 1/rate is infinite.
+    if (!std::isfinite(physics.world_period_s())) rate.fail("too small: the world period 1/rate is not finite");
+  }
   if (node.has("substeps")) physics.substeps = node.child("substeps").positive_int();
   if (node.has("solver_iterations")) physics.solver_iterations = node.child("solver_iterations").positive_int();
   if (node.has("erp")) physics.erp = node.child("erp").in_unit_interval();
@@ -267,6 +272,11 @@ SceneObject parse_object(const Node& node) {
     }
     object.mass_kg = has_mass ? node.child("mass_kg").positive()
                               : node.child("density_kgpm3").positive() * object.shape.volume_m3();
+    // Each factor can be valid while the product over- or underflows; ODE needs a positive finite mass.
+    if (!has_mass && !(object.mass_kg > 0.0 && std::isfinite(object.mass_kg))) {
+      node.child("density_kgpm3").fail("density × volume is not a positive finite mass (" +
+                                       std::to_string(object.mass_kg) + " kg)");
+    }
   } else {
     // A static object is immovable: a mass or a velocity would be silently ignored, so it is an error.
     for (std::string_view key : {"mass_kg", "density_kgpm3", "linear_velocity_mps", "angular_velocity_radps"}) {
@@ -356,13 +366,18 @@ Scene load_scene(const std::string& path) {
   if (!file) throw SceneError(path + ": cannot open scene file");
   std::stringstream text;
   text << file.rdbuf();
+  return parse_scene_text(text.str(), path);
+}
+
+Scene parse_scene_text(std::string_view text, const std::string& source_name) {
   nlohmann::json document;
   try {
-    document = nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::parse_error& error) {
-    throw SceneError(path + ": not valid JSON: " + error.what());
+    document = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& error) {
+    // Not only parse_error: a number too large for a double ("1e400") throws out_of_range (406) from the parser.
+    throw SceneError(source_name + ": not valid JSON: " + error.what());
   }
-  return parse_scene(document, path);
+  return parse_scene(document, source_name);
 }
 
 }  // namespace impetus

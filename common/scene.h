@@ -54,6 +54,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace impetus {
@@ -150,5 +151,7 @@ struct Scene {
 Scene load_scene(const std::string& path);
 // Validates an already-parsed document; `source_name` prefixes every error message.
 Scene parse_scene(const nlohmann::json& document, const std::string& source_name);
+// Parses and validates scene text (the body of load_scene without the file); throws SceneError, also for bad JSON.
+Scene parse_scene_text(std::string_view text, const std::string& source_name);
 
 }  // namespace impetus

@@ -81,6 +81,31 @@ bool segment_finite(const TrajectorySegment& seg) {
          std::isfinite(seg.begin_angle_rad) && std::isfinite(seg.end_angle_rad);
 }
 
+// Finite parameters can still overflow when evaluated: a line from −1e308 to 1e308 has an infinite length, a circle
+// of radius 1e308 around x = 1e308 leaves the doubles, and a step of 1e−320 s has an infinite speed. Bounds every
+// intermediate of point_on_path and velocity_at (|cos|, |sin| <= 1, s in [0, 1], ds/dτ <= 2 for every easing),
+// so a trajectory that passes evaluates to finite numbers at any time.
+bool segment_evaluable(const TrajectorySegment& seg) {
+  constexpr double kMaxEasedRate = 2.0;  // accelerate/decelerate peak; smooth peaks at π/2, linear at 1
+  Eigen::Vector3d reach;                 // bound on |P(s)| per component
+  Eigen::Vector3d rate;                  // bound on |dP/ds| per component
+  if (seg.path == TrajectorySegment::Path::line) {
+    const Eigen::Vector3d delta = to_eigen(seg.to_m) - to_eigen(seg.from_m);
+    reach = to_eigen(seg.from_m).cwiseAbs() + delta.cwiseAbs();
+    rate = delta.cwiseAbs();
+  } else {
+    const double sweep = seg.end_angle_rad - seg.begin_angle_rad;
+    const Eigen::Vector3d axes = to_eigen(seg.axis_u).cwiseAbs() + to_eigen(seg.axis_v).cwiseAbs();
+    reach = to_eigen(seg.centre_m).cwiseAbs() + seg.radius_m * axes;
+    rate = std::abs(seg.radius_m * sweep) * axes;
+  }
+  if (!reach.allFinite() || !rate.allFinite()) return false;
+  const double span = seg.end_s - seg.begin_s;
+  if (!(span > 0.0)) return true;  // velocity_at does not divide by an empty span
+  const double per_second = kMaxEasedRate / span;
+  return std::isfinite(per_second) && (rate * per_second).allFinite();
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // Shared parsing helpers
 
@@ -149,6 +174,10 @@ Trajectory::Trajectory(std::vector<TrajectorySegment> segments, std::string desc
   for (std::size_t i = 0; i < segments_.size(); ++i) {
     const TrajectorySegment& seg = segments_[i];
     if (!segment_finite(seg)) throw TrajectoryError(description_ + ": segment " + std::to_string(i) + " is not finite");
+    if (!segment_evaluable(seg)) {
+      throw TrajectoryError(description_ + ": segment " + std::to_string(i) +
+                            " has positions or speeds too large to represent");
+    }
     if (seg.end_s < seg.begin_s) {
       throw TrajectoryError(description_ + ": segment " + std::to_string(i) + " ends before it begins");
     }
@@ -220,7 +249,10 @@ Vec3 Trajectory::velocity_at(double t_s) const {
 Trajectory load_trajectory_csv(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw TrajectoryError(path + ": cannot open trajectory file: " + std::strerror(errno));
+  return parse_trajectory_csv(in, path);
+}
 
+Trajectory parse_trajectory_csv(std::istream& in, const std::string& path) {
   std::vector<Waypoint> waypoints;
   int previous_line = 0;
   std::string line_text;

@@ -67,6 +67,7 @@
 
 #include "common/vec3.h"
 
+#include <istream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -143,6 +144,9 @@ Trajectory load_trajectory(const std::string& spec_or_path);
 
 // The parts of load_trajectory, for callers that know which they have.
 Trajectory load_trajectory_csv(const std::string& path);
+// The CSV format read from a stream (load_trajectory_csv opens the file and calls this); `source_name` stands for the
+// file in error messages and becomes the description. Lets tests and the fuzzer feed text without a file.
+Trajectory parse_trajectory_csv(std::istream& in, const std::string& source_name);
 Trajectory make_builtin_trajectory(const std::string& spec);
 bool is_builtin_trajectory_name(const std::string& name);
 

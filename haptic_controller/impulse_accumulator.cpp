@@ -42,6 +42,7 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
                              const Eigen::Vector3d& force_on_finger_N, double dt_s, std::uint64_t tick) {
   const Eigen::Vector3d reaction_Ns = -force_on_finger_N * dt_s;  // paper §3.4: the user's push on the world
   total_Ns_ += reaction_Ns;
+  last_share_count_ = 0;
   if (reaction_Ns.isZero(0.0)) return;  // nothing to share (and no multiplier is trusted when the force was zeroed)
 
   double weight_sum = 0.0;
@@ -56,6 +57,9 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     const double share = weight_sum > 0.0 ? contact.active[j].multiplier_m / weight_sum : 1.0 / contact.active_count;
     const Eigen::Vector3d impulse_Ns = share * reaction_Ns;
     const ContactPlane& plane = planes.planes[contact.active[j].plane];
+    const Eigen::Vector3d angular_Nms = (contact.proxy_m - plane.com_m).cross(impulse_Ns);
+    last_shares_[static_cast<std::size_t>(last_share_count_++)] = {plane.object_id, plane.dynamic(), impulse_Ns,
+                                                                   angular_Nms};
     if (!plane.dynamic()) {
       add_to(report_.static_impulse_Ns, impulse_Ns);
       continue;
@@ -67,7 +71,10 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
       continue;
     }
     add_to(entry->impulse_Ns, impulse_Ns);
-    add_to(entry->angular_impulse_Nms, (contact.proxy_m - plane.com_m).cross(impulse_Ns));
+    add_to(entry->angular_impulse_Nms, angular_Nms);
+    // First moments in time (link_types.h ObjectImpulse): where in the world period this impulse belongs.
+    add_to(entry->impulse_moment_Nss, impulse_Ns * report_.haptic_time_s);
+    add_to(entry->angular_impulse_moment_Nmss, angular_Nms * report_.haptic_time_s);
     entry->last_tick = tick;
   }
 }

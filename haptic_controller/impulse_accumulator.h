@@ -15,6 +15,10 @@
 // changes at every re-allocation). If no entry is final the share is kept in a dropped total and counted; nothing
 // throws or allocates. Invariant: Σ entries + static + evicted + dropped == Σ −f·Δt rendered.
 //
+// Each entry also carries the first moments Σ impulse_k·t_k (t_k = report().haptic_time_s, which the servo sets before
+// add()), so the world can place the impulse in time (local coupling, world.h). The shares of the last add() are kept
+// for the local model (local_dynamics.h), which moves the touched objects tick by tick.
+//
 // Owned by the servo thread.
 
 #include "common/link_types.h"
@@ -23,9 +27,18 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 
 namespace impetus {
+
+// One object's share of the reaction in the last tick.
+struct ImpulseShare {
+  std::int32_t object_id = -1;
+  bool dynamic = false;
+  Eigen::Vector3d impulse_Ns = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_impulse_Nms = Eigen::Vector3d::Zero();  // about the plane's com_m
+};
 
 class ImpulseAccumulator {
  public:
@@ -47,6 +60,10 @@ class ImpulseAccumulator {
   const Eigen::Vector3d& dropped_impulse_Ns() const { return dropped_Ns_; }  // never reported (table full)
   std::uint64_t dropped_shares() const { return dropped_shares_; }
 
+  // The shares of the last add(), one per active constraint (empty when nothing was pushed).
+  const ImpulseShare* last_shares() const { return last_shares_.data(); }
+  int last_share_count() const { return last_share_count_; }
+
  private:
   ObjectImpulse* entry_for(std::int32_t object_id);
 
@@ -58,6 +75,8 @@ class ImpulseAccumulator {
   Eigen::Vector3d evicted_Ns_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d dropped_Ns_ = Eigen::Vector3d::Zero();
   std::uint64_t dropped_shares_ = 0;
+  std::array<ImpulseShare, kMaxActiveConstraints + 1> last_shares_{};
+  int last_share_count_ = 0;
 };
 
 }  // namespace impetus

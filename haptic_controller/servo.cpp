@@ -3,12 +3,30 @@
 #include "haptic_controller/plane_interpolator.h"
 #include "haptic_controller/tension_distribution.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace impetus {
 namespace {
 
 double positive_or(double value, double fallback) { return value > 0.0 && std::isfinite(value) ? value : fallback; }
+
+int occurrence_in(const PlaneSet& set, std::uint32_t k) {
+  int occurrence = 0;
+  for (std::uint32_t q = 0; q < k; ++q) occurrence += set.planes[q].object_id == set.planes[k].object_id ? 1 : 0;
+  return occurrence;
+}
+
+int find_in(const PlaneSet& set, std::int32_t object_id, int occurrence) {
+  for (std::uint32_t k = 0; k < set.count; ++k) {
+    if (set.planes[k].object_id == object_id && occurrence-- == 0) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+double signed_distance_m(const Eigen::Vector3d& x_m, const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal) {
+  return normal.dot(x_m - point_m);
+}
 
 }  // namespace
 
@@ -24,6 +42,13 @@ HapticServo::HapticServo(const ServoOptions& options, std::uint64_t haptic_sessi
 void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   // Interpolate from the previous frame of the same world session only; the first frame starts where it is.
   const bool continues = have_frame_ && frame.world_session == current_frame_.world_session;
+  if (frame.coupling == Coupling::local) {
+    // Local coupling (paper §6.3): restart the model from the world's state, blending from what the finger felt.
+    local_.on_plane_frame(frame, continues ? &planes_ : nullptr, to_eigen(result_.proxy_m));
+    if (continues) counters_.local_model_error_max_m = std::max(counters_.local_model_error_max_m,
+                                                                local_.last_model_error_m());
+  }
+  frame_since_last_tick_ = true;
   previous_frame_ = continues ? current_frame_ : frame;
   current_frame_ = frame;
   have_frame_ = true;
@@ -31,7 +56,51 @@ void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   accumulator_.on_plane_frame(frame);
 }
 
+void HapticServo::measure_frame_boundary(const ProxySolution& contact) {
+  // ServoCounters::frame_jump_max_m: second difference across the boundary at the proxy of the tick before.
+  if (frame_since_last_tick_) {
+    bool measured = false;
+    for (int k = 0; k < watched_count_; ++k) {
+      const WatchedPlane& seen = watched_[static_cast<std::size_t>(k)];
+      const int now = find_in(planes_, seen.object_id, seen.occurrence);
+      if (!seen.has_previous || now < 0) continue;
+      const ContactPlane& plane = planes_.planes[static_cast<std::size_t>(now)];
+      const double d_now = signed_distance_m(seen.proxy_m, plane.point_m, plane.normal);
+      const double d_last = signed_distance_m(seen.proxy_m, seen.point_m, seen.normal);
+      const double d_before = signed_distance_m(seen.proxy_m, seen.previous_point_m, seen.previous_normal);
+      counters_.frame_jump_max_m = std::max(counters_.frame_jump_max_m, std::fabs(d_now - 2.0 * d_last + d_before));
+      measured = true;
+    }
+    if (measured) ++counters_.contact_frame_boundaries;
+  }
+  frame_since_last_tick_ = false;
+
+  std::array<WatchedPlane, kMaxActiveConstraints + 1> next{};
+  int next_count = 0;
+  for (int j = 0; j < contact.active_count && j < static_cast<int>(next.size()); ++j) {
+    const auto index = static_cast<std::uint32_t>(contact.active[j].plane);
+    const ContactPlane& plane = planes_.planes[index];
+    WatchedPlane& entry = next[static_cast<std::size_t>(next_count++)];
+    entry.object_id = plane.object_id;
+    entry.occurrence = occurrence_in(planes_, index);
+    entry.point_m = plane.point_m;
+    entry.normal = plane.normal;
+    entry.proxy_m = contact.proxy_m;
+    for (int k = 0; k < watched_count_; ++k) {
+      const WatchedPlane& seen = watched_[static_cast<std::size_t>(k)];
+      if (seen.object_id == entry.object_id && seen.occurrence == entry.occurrence) {
+        entry.has_previous = true;
+        entry.previous_point_m = seen.point_m;
+        entry.previous_normal = seen.normal;
+      }
+    }
+  }
+  watched_ = next;
+  watched_count_ = next_count;
+}
+
 void HapticServo::idle_tick(bool fault) {
+  watched_count_ = 0;
   god_object_.reset();
   renderer_.reset();
   result_.force_N = {};
@@ -80,7 +149,13 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
     w = interpolation_weight(now_s, frame_arrival_s_, current_frame_.world_period_s);
     result_.world_stale = now_s - frame_arrival_s_ > kStaleWorldPeriods * current_frame_.world_period_s;
     if (result_.world_stale) ++counters_.stale_world_ticks;
-    interpolate_planes(previous_frame_, current_frame_, w, planes_);
+    if (current_frame_.coupling == Coupling::local) {
+      // Local coupling: the frame's planes carried by the local model (a stale world: the model holds still).
+      if (!result_.world_stale) local_.advance(dt_s);
+      local_.render(w, to_eigen(result_.proxy_m), planes_);
+    } else {
+      interpolate_planes(previous_frame_, current_frame_, w, planes_);
+    }
   } else {
     planes_.count = 0;
   }
@@ -95,6 +170,7 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
   }
   result_.proxy_m = to_vec3(contact.contact.proxy_m);
   report.proxy_m = result_.proxy_m;
+  measure_frame_boundary(contact.contact);
   result_.active_planes = contact.contact.active_count;
   result_.sticking = contact.sticking;
   if (contact.contact.infeasible) ++counters_.infeasible_contacts;
@@ -120,6 +196,13 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
   accumulator_.add(planes_, contact.contact, force_N, dt_s > 0.0 && std::isfinite(dt_s) ? dt_s : 0.0,
                    counters_.ticks);
   counters_.dropped_impulse_shares = accumulator_.dropped_shares();
+  if (have_frame_ && current_frame_.coupling == Coupling::local) {
+    // The objects give way at the haptic rate (paper §6.3): this tick's shares move the local model.
+    for (int k = 0; k < accumulator_.last_share_count(); ++k) {
+      const ImpulseShare& share = accumulator_.last_shares()[k];
+      if (share.dynamic) local_.apply_impulse(share.object_id, share.impulse_Ns, share.angular_impulse_Nms);
+    }
+  }
 
   // 6. String tensions.
   const TensionSolution tensions = distribute_tension(force_N, finger_m, motors_m_, options_.geometry.tension_min_N,

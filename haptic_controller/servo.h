@@ -12,6 +12,7 @@
 #include "haptic_controller/force_renderer.h"
 #include "haptic_controller/god_object.h"
 #include "haptic_controller/impulse_accumulator.h"
+#include "haptic_controller/local_dynamics.h"
 #include "haptic_controller/spidar_kinematics.h"
 
 #include <array>
@@ -58,6 +59,16 @@ struct ServoCounters {
   std::uint64_t stale_world_ticks = 0;
   std::uint64_t no_device_ticks = 0;
   std::uint64_t dropped_impulse_shares = 0;  // reaction shares that found no report entry
+  // Frame-boundary continuity (issue 9), any coupling. At the first tick after a world frame, for every plane that
+  // held the proxy in the tick before: the second difference of the plane's signed distance at that proxy over the
+  // three ticks around the boundary, |d_j − 2·d_{j−1} + d_{j−2}|. Steady plane motion cancels; what remains is the
+  // jump (or the velocity kink × Δt) the finger feels when the new frame takes over, plus the plane's own
+  // acceleration × Δt² (≈ 0.02 mm for 20 N on 1 kg).
+  std::uint64_t contact_frame_boundaries = 0;  // boundaries measured (planes in contact across them)
+  double frame_jump_max_m = 0.0;
+  // Local coupling: the largest disagreement, at the proxy, between the plane the finger was feeling and the world's
+  // new plane of a touched object when a frame arrived (before the blend hides it; local_dynamics.h).
+  double local_model_error_max_m = 0.0;
 };
 
 class HapticServo {
@@ -76,9 +87,23 @@ class HapticServo {
   const ServoCounters& counters() const { return counters_; }
   const ImpulseAccumulator& accumulator() const { return accumulator_; }
   const PlaneSet& planes() const { return planes_; }  // the interpolated planes of the last tick
+  const LocalDynamics& local_dynamics() const { return local_; }  // local coupling's model (tests)
 
  private:
   void idle_tick(bool fault);
+  void measure_frame_boundary(const ProxySolution& contact);
+
+  // A plane that held the proxy in the last tick, with its value one tick before (frame-boundary diagnostic).
+  struct WatchedPlane {
+    std::int32_t object_id = -1;
+    int occurrence = 0;
+    Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+    bool has_previous = false;
+    Eigen::Vector3d previous_point_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d previous_normal = Eigen::Vector3d::UnitZ();
+    Eigen::Vector3d proxy_m = Eigen::Vector3d::Zero();
+  };
 
   ServoOptions options_;
   SpidarKinematics kinematics_;
@@ -91,6 +116,10 @@ class HapticServo {
   GodObject god_object_;
   ForceRenderer renderer_;
   ImpulseAccumulator accumulator_;
+  LocalDynamics local_;
+  bool frame_since_last_tick_ = false;
+  std::array<WatchedPlane, kMaxActiveConstraints + 1> watched_{};
+  int watched_count_ = 0;
   Eigen::Vector3d finger_m_ = Eigen::Vector3d::Zero();
   bool finger_known_ = false;
   TickResult result_{};

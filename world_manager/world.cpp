@@ -2,6 +2,7 @@
 
 #include <ode/ode.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -19,6 +20,9 @@ constexpr int kMaxContactsPerPair = 8;
 // Below this approach speed a contact does not bounce: resting and sliding objects would otherwise chatter on every
 // substep's tiny penetration-correction velocity (ERP pushes at a few mm/s).
 constexpr double kBounceThreshold_mps = 0.05;
+// Two contact normals of one object closer than this (cosine) are one constraint for the local model: the four
+// corner contacts of a box resting on the floor are one support.
+constexpr double kSameContactCosine = 0.999;
 
 void* id_to_data(std::size_t id) { return reinterpret_cast<void*>(static_cast<std::uintptr_t>(id)); }
 std::size_t data_to_id(void* data) { return static_cast<std::size_t>(reinterpret_cast<std::uintptr_t>(data)); }
@@ -42,6 +46,23 @@ struct World::OdeHandles {
   std::vector<dGeomID> geoms;     // per object
   std::vector<Material> materials;  // per id, the floor last
   double substep_s = 0.0;
+  // Local coupling: contacts of each object seen in the last substep of a step (link_types.h LocalContact).
+  bool record_contacts = false;
+  std::vector<std::array<LocalContact, kMaxLocalContacts>> local_contacts;  // per object id
+  std::vector<std::uint32_t> local_contact_counts;
+
+  void record_contact(std::size_t id, const Eigen::Vector3d& normal, double friction) {
+    if (id >= local_contact_counts.size()) return;
+    std::uint32_t& count = local_contact_counts[id];
+    for (std::uint32_t c = 0; c < count; ++c) {
+      LocalContact& known = local_contacts[id][c];
+      if (to_eigen(known.normal).dot(normal) > kSameContactCosine) {
+        known.friction = std::max(known.friction, friction);
+        return;
+      }
+    }
+    if (count < kMaxLocalContacts) local_contacts[id][count++] = {to_vec3(normal), friction};
+  }
 
   ~OdeHandles() {
     if (contacts != nullptr) dJointGroupDestroy(contacts);
@@ -75,6 +96,14 @@ struct World::OdeHandles {
       }
       dJointID joint = dJointCreateContact(self->world, self->contacts, &contacts[i]);
       dJointAttach(joint, body_a, body_b);
+      if (self->record_contacts) {
+        // ODE's normal points into geom 1 (contact.h): the contact pushes body a along +n and body b along −n.
+        const dReal* n = contacts[i].geom.normal;
+        const Eigen::Vector3d normal(n[0], n[1], n[2]);
+        if (!(normal.squaredNorm() > 0.0) || !normal.allFinite()) continue;
+        if (body_a != nullptr) self->record_contact(data_to_id(dGeomGetData(a)), normal.normalized(), surface.mu);
+        if (body_b != nullptr) self->record_contact(data_to_id(dGeomGetData(b)), -normal.normalized(), surface.mu);
+      }
     }
   }
 };
@@ -97,6 +126,11 @@ World::World(const Scene& scene, const WorldOptions& options)
       states_(scene.objects.size()),
       inverse_inertia_body_(scene.objects.size(), Eigen::Matrix3d::Zero()),
       ledger_(scene.objects.size() + 1),
+      moment_ledger_(scene.objects.size() + 1),
+      local_impulse_schedule_Ns_(scene.objects.size(),
+                                 std::vector<Eigen::Vector3d>(static_cast<std::size_t>(scene.physics.substeps) + 1,
+                                                              Eigen::Vector3d::Zero())),
+      local_angular_schedule_Nms_(local_impulse_schedule_Ns_),
       features_(scene_),
       step_impulse_Ns_(scene.objects.size(), Eigen::Vector3d::Zero()),
       total_impulse_Ns_(scene.objects.size(), Eigen::Vector3d::Zero()),
@@ -131,6 +165,8 @@ World::World(const Scene& scene, const WorldOptions& options)
   dWorldSetAutoDisableFlag(ode.world, scene_.physics.auto_disable ? 1 : 0);
 
   ode.bodies.assign(scene_.objects.size(), nullptr);
+  ode.local_contacts.assign(scene_.objects.size(), {});
+  ode.local_contact_counts.assign(scene_.objects.size(), 0);
   ode.geoms.assign(scene_.objects.size(), nullptr);
   for (std::size_t id = 0; id < scene_.objects.size(); ++id) {
     const SceneObject& object = scene_.objects[id];
@@ -197,6 +233,8 @@ World::World(const Scene& scene, const WorldOptions& options)
   frame_.world_session = options_.world_session;
   frame_.world_period_s = period_s_;
   frame_.coupling = options_.coupling;
+  frame_.gravity_mps2 = scene_.gravity_mps2;
+  frame_.world_substep_s = ode.substep_s;
 }
 
 World::~World() = default;
@@ -244,6 +282,14 @@ void World::apply_report_impulses(const HapticReport& report) {
   // Impulse coupling applies the differences; position coupling still advances the baselines (so the counters stay
   // in step) but leaves the motion to the penalty force, as the paper's previous method did.
   const bool apply = options_.coupling != Coupling::position;
+  const bool local = options_.coupling == Coupling::local;
+  // Local coupling places each impulse at the time it was rendered (schedule_local_impulse). The impulses of this
+  // report were rendered after the previous report we applied and up to this one: that window maps onto this step.
+  const bool known_start = last_report_session_ == report.haptic_session && report.haptic_time_s > last_report_time_s_;
+  const double window_s = known_start ? report.haptic_time_s - last_report_time_s_ : period_s_;
+  const double window_start_s = report.haptic_time_s - window_s;
+  last_report_session_ = report.haptic_session;
+  last_report_time_s_ = report.haptic_time_s;
   const std::size_t floor_id = scene_.objects.size();
   const std::uint32_t count = std::min(report.entry_count, kMaxImpulseEntries);
   for (std::uint32_t i = 0; i < count; ++i) {
@@ -255,8 +301,16 @@ void World::apply_report_impulses(const HapticReport& report) {
     }
     const auto id = static_cast<std::size_t>(entry.object_id);
     const ImpulseDelta delta = ledger_.take(report.haptic_session, entry);
+    ObjectImpulse moments = entry;  // the moments through the same ledger rules (session, epoch, baseline)
+    moments.impulse_Ns = entry.impulse_moment_Nss;
+    moments.angular_impulse_Nms = entry.angular_impulse_moment_Nmss;
+    const ImpulseDelta moment = moment_ledger_.take(report.haptic_session, moments);
     if (id < floor_id && scene_.objects[id].dynamic) {
-      if (apply) apply_velocity_change(id, delta.impulse_Ns, delta.angular_impulse_Nms);
+      if (local && all_finite(entry.impulse_moment_Nss) && all_finite(entry.angular_impulse_moment_Nmss)) {
+        schedule_local_impulse(id, delta, moment, window_start_s, window_s);
+      } else if (apply) {
+        apply_velocity_change(id, delta.impulse_Ns, delta.angular_impulse_Nms);
+      }
     } else {
       total_static_impulse_Ns_ += delta.impulse_Ns;  // the haptic side named static geometry: it absorbs the push
     }
@@ -281,6 +335,96 @@ void World::apply_velocity_change(std::size_t id, const Eigen::Vector3d& impulse
   step_impulse_Ns_[id] += impulse_Ns;
   total_impulse_Ns_[id] += impulse_Ns;
   total_angular_impulse_Nms_[id] += angular_impulse_Nms;
+}
+
+void World::schedule_local_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment,
+                                   double window_start_s, double window_s) {
+  // Local coupling (issue 9, paper §6.3). The haptic side moved the object tick by tick: an impulse J_k rendered at
+  // haptic time t_k has displaced it by J_k·(t_end − t_k)/m by the end of the window. ODE's semi-implicit Euler step
+  // gives a force held during substep s (length h) exactly the effect of an impulse at time s·h (v changes at the end
+  // of the substep, x then integrates the new v), so the world reproduces both the momentum Σ J_k and the displacement
+  // Σ J_k·(t_end − t_k)/m by putting each axis's impulse at its centroid time
+  //     c = (Σ J_k·t_k − t_start·Σ J_k) / Σ J_k      (from the report's first moments, link_types.h)
+  // split between the two substeps around c: (1 − α) at ⌊c/h⌋ and α at ⌊c/h⌋ + 1, α = frac(c/h). Slot `substeps` is
+  // after the last substep: a velocity change with no displacement (an impulse in the very last tick). The world's
+  // next state then agrees with what the finger felt exactly for a free body; with contacts, up to how friction
+  // sees the impulse compressed to its centroid (it only acts while the object slides: ≈ 0.3 mm at the start of a
+  // tap, while the contact itself is blended, local_dynamics.h).
+  const int substeps = scene_.physics.substeps;
+  const double h = period_s_ / substeps;
+  const double scale = period_s_ / window_s;  // lockstep: 1; real time: the window mapped onto this step
+  auto place = [&](double amount, double first_moment, int axis, std::vector<Eigen::Vector3d>& schedule) {
+    // Moment about the window's start, mapped onto this step: Σ J_k·c_k with c_k ∈ [0, T_w].
+    const double moment = (first_moment - window_start_s * amount) * scale;
+    if (!std::isfinite(moment)) {  // cannot place it: all of it after the last substep (velocity only)
+      schedule[static_cast<std::size_t>(substeps)][axis] += amount;
+      return;
+    }
+    const double c = amount != 0.0 ? moment / amount : -1.0;
+    if (c >= 0.0 && c <= period_s_) {
+      const double slots = c / h;
+      const int k = std::min(static_cast<int>(std::floor(slots)), substeps);
+      const double alpha = k < substeps ? slots - k : 0.0;
+      schedule[static_cast<std::size_t>(k)][axis] += (1.0 - alpha) * amount;
+      if (alpha > 0.0) schedule[static_cast<std::size_t>(k + 1)][axis] += alpha * amount;
+    } else if (amount != 0.0 || moment != 0.0) {
+      // The impulse changed sign within the window (its centroid lies outside it, or it summed to zero): split it
+      // between the window's ends, b at T_w and a = J − b at 0, with b·T_w = Σ J_k·c_k: still exact in momentum and
+      // in displacement for a free body.
+      const double at_end = moment / period_s_;
+      schedule[0][axis] += amount - at_end;
+      schedule[static_cast<std::size_t>(substeps)][axis] += at_end;
+    }
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    place(delta.impulse_Ns[axis], moment.impulse_Ns[axis], axis, local_impulse_schedule_Ns_[id]);
+    place(delta.angular_impulse_Nms[axis], moment.angular_impulse_Nms[axis], axis, local_angular_schedule_Nms_[id]);
+  }
+  dBodyEnable(ode_->bodies[id]);  // a sleeping body must wake to move
+  step_impulse_Ns_[id] += delta.impulse_Ns;
+  total_impulse_Ns_[id] += delta.impulse_Ns;
+  total_angular_impulse_Nms_[id] += delta.angular_impulse_Nms;
+}
+
+void World::apply_local_schedule(int slot) {
+  // Substep slots: the scheduled impulse as a force held for one substep (ODE clears forces after every step).
+  // Slot `substeps`: what is left after the last substep, as an instantaneous velocity change.
+  const int substeps = scene_.physics.substeps;
+  const double h = period_s_ / substeps;
+  for (std::size_t id = 0; id < local_impulse_schedule_Ns_.size(); ++id) {
+    Eigen::Vector3d& impulse_Ns = local_impulse_schedule_Ns_[id][static_cast<std::size_t>(slot)];
+    Eigen::Vector3d& angular_Nms = local_angular_schedule_Nms_[id][static_cast<std::size_t>(slot)];
+    if (impulse_Ns.isZero(0.0) && angular_Nms.isZero(0.0)) continue;
+    dBodyID body = ode_->bodies[id];
+    if (slot < substeps) {
+      dBodyAddForce(body, impulse_Ns.x() / h, impulse_Ns.y() / h, impulse_Ns.z() / h);
+      dBodyAddTorque(body, angular_Nms.x() / h, angular_Nms.y() / h, angular_Nms.z() / h);
+    } else {
+      const dReal* v = dBodyGetLinearVel(body);
+      const dReal* w = dBodyGetAngularVel(body);
+      const Eigen::Vector3d velocity = Eigen::Vector3d(v[0], v[1], v[2]) + states_[id].inverse_mass_per_kg * impulse_Ns;
+      const Eigen::Vector3d angular =
+          Eigen::Vector3d(w[0], w[1], w[2]) + states_[id].inverse_inertia_world * angular_Nms;
+      dBodySetLinearVel(body, velocity.x(), velocity.y(), velocity.z());
+      dBodySetAngularVel(body, angular.x(), angular.y(), angular.z());
+    }
+    impulse_Ns.setZero();
+    angular_Nms.setZero();
+  }
+}
+
+void World::attach_local_contacts() {
+  // Local coupling: each dynamic object's plane carries the contacts the object had in the last substep, the
+  // constraints of the haptic side's local model (link_types.h LocalContact).
+  for (std::uint32_t k = 0; k < frame_.plane_count; ++k) {
+    Plane& plane = frame_.planes[k];
+    plane.local_contact_count = 0;
+    if ((plane.flags & kPlaneDynamic) == 0 || plane.object_id < 0) continue;
+    const auto id = static_cast<std::size_t>(plane.object_id);
+    if (id >= ode_->local_contact_counts.size()) continue;
+    plane.local_contact_count = ode_->local_contact_counts[id];
+    plane.local_contacts = ode_->local_contacts[id];
+  }
 }
 
 void World::compute_position_coupling() {
@@ -324,10 +468,15 @@ void World::advance_ode() {
                            point_m.z());
       }
     }
+    if (options_.coupling == Coupling::local) apply_local_schedule(substep);
+    ode.record_contacts = options_.coupling == Coupling::local && substep + 1 == scene_.physics.substeps;
+    if (ode.record_contacts) std::fill(ode.local_contact_counts.begin(), ode.local_contact_counts.end(), 0u);
     dSpaceCollide(ode.space, &ode, &OdeHandles::near_callback);
+    ode.record_contacts = false;
     dWorldQuickStep(ode.world, ode.substep_s);
     dJointGroupEmpty(ode.contacts);
   }
+  if (options_.coupling == Coupling::local) apply_local_schedule(scene_.physics.substeps);
   random_state_ = dRandGetSeed();
 }
 
@@ -368,6 +517,7 @@ void World::publish(const HapticReport* report) {
   // Without a finger there is nothing to be near: no planes until a device reports one.
   frame_.plane_count = finger_valid_ ? features_.extract(plane_query_, states_, period_s_, frame_.planes) : 0;
   if (!finger_valid_) frame_.planes.fill(Plane{});
+  if (options_.coupling == Coupling::local) attach_local_contacts();
   seal(frame_);
 }
 

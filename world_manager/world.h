@@ -83,6 +83,10 @@ class World {
   struct OdeHandles;
 
   void apply_report_impulses(const HapticReport& report);
+  void schedule_local_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment,
+                              double window_start_s, double window_s);
+  void apply_local_schedule(int slot);
+  void attach_local_contacts();
   void apply_velocity_change(std::size_t id, const Eigen::Vector3d& impulse_Ns,
                              const Eigen::Vector3d& angular_impulse_Nms);
   void compute_position_coupling();
@@ -101,6 +105,16 @@ class World {
   std::vector<ObjectState> states_;
   std::vector<Eigen::Matrix3d> inverse_inertia_body_;  // per object; zero for static ones
   ImpulseLedger ledger_;
+  // Local coupling (issue 9): the same running totals' first moments in time (ObjectImpulse::impulse_moment_Nss),
+  // differenced with the same session/epoch rules as the impulses themselves.
+  ImpulseLedger moment_ledger_;
+  // When the impulses of the current step were rendered: the haptic time of the previous report applied.
+  std::uint64_t last_report_session_ = 0;
+  double last_report_time_s_ = 0.0;
+  // Per object, the impulse and angular impulse to apply in each ODE substep of this step (slot `substeps` = after
+  // the last substep: a pure velocity change). Zero outside local coupling.
+  std::vector<std::vector<Eigen::Vector3d>> local_impulse_schedule_Ns_;
+  std::vector<std::vector<Eigen::Vector3d>> local_angular_schedule_Nms_;
   FeatureExtractor features_;
   std::vector<Eigen::Vector3d> step_impulse_Ns_;
   std::vector<Eigen::Vector3d> total_impulse_Ns_;

@@ -1,0 +1,61 @@
+// Fuzz target: scene files. Bytes → parse_scene_text (nlohmann::json::parse, then parse_scene), exactly what
+// load_scene does after reading the file. Expected outcomes: a Scene or a SceneError (bad JSON included). Any other
+// exception escapes and terminates: it is a bug, since a daemon's main would report it as an unknown error instead of
+// pointing at the field. An accepted scene must hold only numbers the world manager can use.
+
+#include "common/scene.h"
+#include "fuzz/fuzz_check.h"
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+namespace {
+
+bool finite3(const impetus::Vec3& v) { return impetus::all_finite(v); }
+
+bool material_ok(const impetus::Material& m) {
+  return std::isfinite(m.static_friction) && std::isfinite(m.dynamic_friction) && std::isfinite(m.restitution) &&
+         m.dynamic_friction >= 0.0 && m.dynamic_friction <= m.static_friction && m.restitution >= 0.0 &&
+         m.restitution <= 1.0;
+}
+
+// What scene.h promises about a scene that parsed.
+void check_scene(const impetus::Scene& scene) {
+  FUZZ_CHECK(finite3(scene.gravity_mps2));
+  FUZZ_CHECK(std::isfinite(scene.floor.height_m));
+  FUZZ_CHECK(material_ok(scene.floor.material));
+  const impetus::PhysicsParams& physics = scene.physics;
+  FUZZ_CHECK(physics.world_rate_hz > 0.0 && std::isfinite(physics.world_rate_hz));
+  FUZZ_CHECK(std::isfinite(physics.world_period_s()));
+  FUZZ_CHECK(physics.substeps > 0 && physics.solver_iterations > 0);
+  FUZZ_CHECK(physics.erp >= 0.0 && physics.erp <= 1.0);
+  FUZZ_CHECK(physics.cfm >= 0.0 && std::isfinite(physics.cfm));
+  const impetus::HapticParams& haptic = scene.haptic;
+  FUZZ_CHECK(haptic.reach_radius_m > 0.0 && std::isfinite(haptic.reach_radius_m));
+  FUZZ_CHECK(haptic.stiffness_Npm > 0.0 && std::isfinite(haptic.stiffness_Npm));
+  FUZZ_CHECK(haptic.damping_Nspm >= 0.0 && std::isfinite(haptic.damping_Nspm));
+  FUZZ_CHECK(material_ok(haptic.finger_material));
+  for (const impetus::SceneObject& object : scene.objects) {
+    FUZZ_CHECK(!object.name.empty());
+    FUZZ_CHECK(finite3(object.position_m) && finite3(object.linear_velocity_mps) &&
+               finite3(object.angular_velocity_radps));
+    for (double q : object.orientation_wxyz) FUZZ_CHECK(std::isfinite(q));
+    FUZZ_CHECK(material_ok(object.material));
+    const impetus::Shape& shape = object.shape;
+    FUZZ_CHECK(finite3(shape.box_size_m) && std::isfinite(shape.radius_m) && std::isfinite(shape.length_m));
+    // A dynamic body's mass goes to ODE's dMassAdjust: zero, infinite or NaN breaks the whole world step.
+    if (object.dynamic) FUZZ_CHECK(object.mass_kg > 0.0 && std::isfinite(object.mass_kg));
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  try {
+    check_scene(impetus::parse_scene_text(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json"));
+  } catch (const impetus::SceneError&) {
+  }
+  return 0;
+}

@@ -1,0 +1,19 @@
+// Fuzz target: built-in trajectory specs (`NAME[:key=value,...]`) through make_builtin_trajectory. Expected outcomes:
+// a Trajectory or a TrajectoryError; an accepted trajectory must evaluate to finite positions and velocities.
+
+#include "common/trajectory.h"
+#include "fuzz/fuzz_check.h"
+#include "fuzz/trajectory_check.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string spec(reinterpret_cast<const char*>(data), size);
+  try {
+    impetus::fuzz::check_trajectory(impetus::make_builtin_trajectory(spec));
+  } catch (const impetus::TrajectoryError&) {
+  }
+  return 0;
+}

@@ -1,0 +1,248 @@
+#include "haptic_controller/local_dynamics.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace impetus {
+namespace {
+
+// Normals further apart than 90° are not blended; such a plane switches at the midpoint (plane_interpolator.h).
+constexpr double kMinBlendCosine = 0.0;
+constexpr double kFlipSwitchWeight = 0.5;
+// Supports whose normals are this close (cosine) are one support direction for the spin rule.
+constexpr double kParallelSupportCosine = 0.999;
+// Gauss–Seidel passes over the contacts: enough for a corner of three supports to settle.
+constexpr int kContactPasses = 3;
+// Bound on drift substeps applied in one tick (a tick longer than the world's substep, e.g. after a stall).
+constexpr int kMaxDriftChunksPerTick = 8;
+
+// Index of the `occurrence`-th plane of `object_id` in `set`, or −1.
+int find_in_set(const PlaneSet& set, std::int32_t object_id, int occurrence) {
+  const std::uint32_t count = std::min(set.count, kMaxPlanes);
+  for (std::uint32_t k = 0; k < count; ++k) {
+    if (set.planes[k].object_id == object_id && occurrence-- == 0) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+int occurrence_in_frame(const PlaneFrame& frame, std::uint32_t k) {
+  int occurrence = 0;
+  for (std::uint32_t q = 0; q < k; ++q) occurrence += frame.planes[q].object_id == frame.planes[k].object_id ? 1 : 0;
+  return occurrence;
+}
+
+}  // namespace
+
+LocalBody* LocalDynamics::find_mutable(std::int32_t object_id) {
+  for (std::uint32_t b = 0; b < body_count_; ++b) {
+    if (bodies_[b].object_id == object_id) return &bodies_[b];
+  }
+  return nullptr;
+}
+
+const LocalBody* LocalDynamics::find(std::int32_t object_id) const {
+  for (std::uint32_t b = 0; b < body_count_; ++b) {
+    if (bodies_[b].object_id == object_id) return &bodies_[b];
+  }
+  return nullptr;
+}
+
+void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* displayed,
+                                   const Eigen::Vector3d& proxy_m) {
+  // Which objects the finger was touching when the frame arrived: they keep the passivity hold (local_dynamics.h).
+  std::array<std::int32_t, kMaxPlanes> touched_ids{};
+  std::uint32_t touched_count = 0;
+  for (std::uint32_t b = 0; b < body_count_; ++b) {
+    if (bodies_[b].touched) touched_ids[touched_count++] = bodies_[b].object_id;
+  }
+  auto was_touched = [&](std::int32_t id) {
+    return std::find(touched_ids.begin(), touched_ids.begin() + touched_count, id) != touched_ids.begin() + touched_count;
+  };
+
+  frame_ = frame;
+  plane_count_ = std::min(frame.plane_count, kMaxPlanes);
+  gravity_mps2_ = to_eigen(frame.gravity_mps2);
+  substep_s_ = frame.world_substep_s > 0.0 && frame.world_substep_s <= frame.world_period_s ? frame.world_substep_s
+                                                                                            : 0.0;
+  elapsed_s_ = 0.0;
+  next_drift_s_ = 0.0;
+  body_count_ = 0;
+  last_model_error_m_ = 0.0;
+  for (std::uint32_t k = 0; k < plane_count_; ++k) {
+    const Plane& plane = frame_.planes[k];
+    body_of_plane_[k] = -1;
+    // Without a response model the object is immovable between world steps (link_types.h): rendered at the frame.
+    if ((plane.flags & kPlaneDynamic) == 0 || !(plane.inverse_mass_per_kg > 0.0)) continue;
+    int index = -1;
+    for (std::uint32_t b = 0; b < body_count_; ++b) {
+      if (bodies_[b].object_id == plane.object_id) index = static_cast<int>(b);
+    }
+    if (index < 0) {
+      index = static_cast<int>(body_count_++);
+      LocalBody& body = bodies_[static_cast<std::size_t>(index)];
+      body = LocalBody{};
+      body.object_id = plane.object_id;
+      body.inverse_mass_per_kg = plane.inverse_mass_per_kg;
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) body.inverse_inertia_world(r, c) = plane.inverse_inertia_world[3 * r + c];
+      }
+      body.com_frame_m = to_eigen(plane.com_m);
+      body.velocity_mps = to_eigen(plane.velocity_mps);
+      body.angular_velocity_radps = to_eigen(plane.angular_velocity_radps);
+      body.contact_count = std::min(plane.local_contact_count, kMaxLocalContacts);
+      for (std::uint32_t c = 0; c < body.contact_count; ++c) {
+        body.contact_normal[c] = to_eigen(plane.local_contacts[c].normal);
+        body.contact_friction[c] = plane.local_contacts[c].friction;
+      }
+      body.touched = was_touched(plane.object_id);
+    }
+    body_of_plane_[k] = index;
+  }
+
+  // Blend from the plane the finger was feeling (C) to the world's (P), see the header.
+  for (std::uint32_t k = 0; k < plane_count_; ++k) {
+    const Plane& plane = frame_.planes[k];
+    const Eigen::Vector3d point = to_eigen(plane.point_m);
+    const Eigen::Vector3d normal = to_eigen(plane.normal);
+    PlaneBlend& blend = blends_[k];
+    blend = PlaneBlend{point, normal, 0.0, false};
+    const int match = displayed ? find_in_set(*displayed, plane.object_id, occurrence_in_frame(frame_, k)) : -1;
+    if (match < 0) continue;  // a new plane starts at the world's value
+    const ContactPlane& before = displayed->planes[static_cast<std::size_t>(match)];
+    blend.from_point_m = before.point_m;
+    blend.from_normal = before.normal;
+    blend.hold_normal = body_of_plane_[k] >= 0 && (before.point_m - point).dot(normal) < 0.0;
+    if (body_of_plane_[k] >= 0 && was_touched(plane.object_id)) {
+      const double error_m = std::fabs(normal.dot(proxy_m - point) - before.normal.dot(proxy_m - before.point_m));
+      last_model_error_m_ = std::max(last_model_error_m_, error_m);
+    }
+  }
+}
+
+void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
+  Eigen::Vector3d& v = body.velocity_mps;
+  v += gravity_mps2_ * h_s;
+  // Unilateral supports with Coulomb friction, impulses per unit mass (see the header). The other side is taken as
+  // immovable: against a movable neighbour the model under-predicts the motion, the passive error.
+  std::array<double, kMaxLocalContacts> normal_impulse{};
+  for (int pass = 0; pass < kContactPasses; ++pass) {
+    for (std::uint32_t c = 0; c < body.contact_count; ++c) {
+      const double approach = v.dot(body.contact_normal[c]);
+      if (approach < 0.0) {
+        v -= approach * body.contact_normal[c];
+        normal_impulse[c] -= approach;
+      }
+    }
+  }
+  for (std::uint32_t c = 0; c < body.contact_count; ++c) {
+    if (!(normal_impulse[c] > 0.0)) continue;
+    const Eigen::Vector3d& n = body.contact_normal[c];
+    const Eigen::Vector3d slip = v - v.dot(n) * n;
+    const double slip_mps = slip.norm();
+    if (slip_mps > 0.0) v -= std::min(slip_mps, body.contact_friction[c] * normal_impulse[c]) / slip_mps * slip;
+  }
+  // Rotation on supports: one support direction leaves only the spin about its normal (no tipping or rolling
+  // locally: that needs the world's full contact solve; leaving it out under-predicts the motion, the safe side).
+  if (body.contact_count > 0) {
+    const Eigen::Vector3d& n0 = body.contact_normal[0];
+    bool one_direction = true;
+    for (std::uint32_t c = 1; c < body.contact_count; ++c) {
+      one_direction = one_direction && body.contact_normal[c].dot(n0) > kParallelSupportCosine;
+    }
+    body.angular_velocity_radps =
+        one_direction ? Eigen::Vector3d(body.angular_velocity_radps.dot(n0) * n0) : Eigen::Vector3d::Zero();
+  }
+}
+
+void LocalDynamics::advance(double dt_s) {
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+  // Drift on the world's substep grid: ODE's substep k changes v at time k·h (its x then integrates the new v), so
+  // the drift of substep k is applied by the first tick that starts at or after k·h. Half a tick of slack absorbs
+  // rounding in elapsed time.
+  const double h_s = substep_s_ > 0.0 ? substep_s_ : dt_s;
+  int chunks = 0;
+  while (elapsed_s_ + 0.5 * dt_s > next_drift_s_ && chunks < kMaxDriftChunksPerTick) {
+    for (std::uint32_t b = 0; b < body_count_; ++b) apply_drift(bodies_[b], h_s);
+    next_drift_s_ += h_s;
+    ++chunks;
+  }
+  if (chunks == kMaxDriftChunksPerTick) next_drift_s_ = elapsed_s_ + h_s;  // a long gap: do not replay it
+  elapsed_s_ += dt_s;
+  for (std::uint32_t b = 0; b < body_count_; ++b) {
+    LocalBody& body = bodies_[b];
+    body.displacement_m += body.velocity_mps * dt_s;
+    const double angle_rad = body.angular_velocity_radps.norm() * dt_s;
+    if (angle_rad > 0.0) {
+      body.rotation =
+          Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, body.angular_velocity_radps.normalized())) * body.rotation;
+      body.rotation.normalize();
+    }
+  }
+}
+
+void LocalDynamics::apply_impulse(std::int32_t object_id, const Eigen::Vector3d& impulse_Ns,
+                                  const Eigen::Vector3d& angular_impulse_Nms) {
+  LocalBody* body = find_mutable(object_id);
+  if (!body || !impulse_Ns.allFinite() || !angular_impulse_Nms.allFinite()) return;
+  // Paper §3.5 at the haptic rate: Δv = J/m, Δω = I⁻¹·L.
+  body->velocity_mps += body->inverse_mass_per_kg * impulse_Ns;
+  body->angular_velocity_radps += body->inverse_inertia_world * angular_impulse_Nms;
+  body->pushed_Ns += impulse_Ns;
+  body->touched = true;
+}
+
+void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& out) {
+  w = std::isfinite(w) ? std::clamp(w, 0.0, 1.0) : 1.0;
+  out.count = plane_count_;
+  for (std::uint32_t k = 0; k < plane_count_; ++k) {
+    const Plane& now = frame_.planes[k];
+    ContactPlane& plane = out.planes[k];
+    plane = to_contact_plane(now);
+    PlaneBlend& blend = blends_[k];
+    const int b = body_of_plane_[k];
+    LocalBody* body = b >= 0 ? &bodies_[static_cast<std::size_t>(b)] : nullptr;
+
+    const Eigen::Vector3d target_point = to_eigen(now.point_m);
+    const Eigen::Vector3d target_normal = to_eigen(now.normal);
+    Eigen::Vector3d point = target_point;
+    Eigen::Vector3d normal = target_normal;
+    if (blend.from_normal.dot(target_normal) < kMinBlendCosine) {
+      if (w < kFlipSwitchWeight) {  // §3.2 rule: switch whole planes at the midpoint instead of blending through zero
+        point = blend.from_point_m;
+        normal = blend.from_normal;
+      }
+    } else {
+      const Eigen::Vector3d offset = blend.from_point_m - target_point;
+      const double offset_normal_m = offset.dot(target_normal);
+      const Eigen::Vector3d tangential = (1.0 - w) * (offset - offset_normal_m * target_normal);
+      double normal_weight = std::max(blend.normal_weight, w);
+      if (blend.hold_normal && body) {
+        // Passivity: the gap toward the finger (offset_normal_m < 0) closes no further than the last proxy, so the
+        // blend never pushes the finger out. Signed distance of the proxy to the plane as a function of w_n:
+        //     d(w_n) = d_P + (1 − w_n)·|offset_normal|,   d_P = its distance to the plane with the gap closed.
+        const double gap_m = -offset_normal_m;
+        const double d_closed_m = (body->rotation * target_normal)
+                                      .dot(proxy_m - body->carry_point(target_point + tangential));
+        if (d_closed_m < 0.0) normal_weight = std::min(normal_weight, std::max(blend.normal_weight, 1.0 + d_closed_m / gap_m));
+      }
+      blend.normal_weight = normal_weight;
+      point = target_point + tangential + (1.0 - normal_weight) * offset_normal_m * target_normal;
+      const Eigen::Vector3d blended = (1.0 - w) * blend.from_normal + w * target_normal;
+      normal = blended / blended.norm();  // ≥ 1/√2 for unit normals with dot ≥ 0
+    }
+
+    if (body) {
+      plane.point_m = body->carry_point(point);
+      plane.normal = body->rotation * normal;
+      plane.com_m = body->com_m();
+      plane.velocity_mps = body->velocity_mps;
+      plane.angular_velocity_radps = body->angular_velocity_radps;
+    } else {
+      plane.point_m = point;
+      plane.normal = normal;
+    }
+  }
+  for (std::uint32_t b = 0; b < body_count_; ++b) bodies_[b].touched = false;
+}
+
+}  // namespace impetus

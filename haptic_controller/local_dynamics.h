@@ -1,0 +1,128 @@
+#pragma once
+// Local dynamics: the haptic side moves the touched objects between world frames (paper §6.3, issue 9,
+// `--coupling local`).
+//
+// With impulse coupling (§2.2) the finger pushes on a plane that cannot move until the next world step, so the object
+// receives more momentum than it would at 1 kHz and overshoots. Here the haptic controller "calculates some part of
+// the motion of the solid object" (§6.3): every dynamic object in the frame is a rigid body of the frame's state
+// (centre of mass, velocity, angular velocity, inverse mass and world inverse inertia) with the contacts the world saw
+// (link_types.h LocalContact), integrated at the haptic rate from the impulse rendered so far:
+//
+//   at the start of each world substep h (frame.world_substep_s; every tick if unknown), the drift over h, on the
+//   same grid and with the same symplectic Euler as ODE, so a sliding object ends the period where the world puts it
+//   (friction applied every 1 ms instead of every 5 ms would differ by a·T_w·(h − Δt)/2 ≈ 0.06 mm per period):
+//     v ← v + g·h                                               drift: gravity ...
+//     for each contact n (unilateral, the other side immovable):  ... the supports ...
+//       P = max(0, −v·n);  v ← v + P·n                          (normal impulse per unit mass)
+//       v_t = v − (v·n)·n;  v ← v − min(|v_t|, μ·P)·v_t/|v_t|   ... and their Coulomb friction (cube on a floor:
+//                                                                μ·g·Δt of speed per tick, as in the world)
+//     ω restricted to spin about a single support's normal (no tipping or rolling locally; 0 with 2+ supports)
+//   each tick, before the planes are rendered:
+//     u ← u + v·Δt;  R ← exp(ω·Δt)·R                            pose since the frame: CoM displacement u, rotation R
+//   after the force of the tick (§3.4 share J, angular share L about the CoM):
+//     v ← v + J/m;  ω ← ω + I⁻¹·L
+//
+// A frame's state is the world's state *now* (the world integrates the impulses of the period just rendered, placed
+// at the times they were rendered, world.h), so the planes are rendered at the frame's plane moved rigidly with the
+// model's pose: x ↦ com + u + R·(x − com). Frame i's plane is therefore extrapolated with the model, not interpolated
+// from i−1 (which would lag a period behind the object the finger is pushing).
+//
+// Frame boundaries. When frame i arrives the plane the finger was feeling, C (frame i−1's plane moved by the old
+// model), and the world's new plane P normally agree to within the model error (floor friction per 1 ms tick vs per
+// 5 ms substep; features that change, e.g. the nearest point sliding over a sphere). Instead of jumping, the rendered
+// plane blends from C to P over the period like §3.2 (weight w), both carried by the new model's pose:
+//     point = P + (1 − w)·(C − P)_tangential + (1 − w_n)·((C − P)·n_P)·n_P,   normal = blend(n_C, n_P, w) (§3.2 rules)
+// Passivity: if P lies toward the finger from C (the world moved the object less than the model did: a wrong model,
+// e.g. an object stuck behind another the model did not know), closing that gap would push the finger out and add
+// energy. w_n therefore never moves the plane past the last proxy: the gap closes only as the finger withdraws (a
+// wrong model errs toward a softer object, never toward an active one). The model itself never pushes: the plane
+// moves with the world's motion and with the finger's own impulse, which moves it away from the finger.
+// The model is restarted from the world's state at every frame, so a local deviation does not outlive the contact.
+//
+// Allocation-free after construction; owned by the servo thread.
+
+#include "common/link_types.h"
+#include "haptic_controller/contact_plane.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+
+namespace impetus {
+
+struct LocalBody {
+  std::int32_t object_id = -1;
+  double inverse_mass_per_kg = 0.0;
+  Eigen::Matrix3d inverse_inertia_world = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d com_frame_m = Eigen::Vector3d::Zero();  // at the frame
+  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d displacement_m = Eigen::Vector3d::Zero();          // u, of the CoM since the frame
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();      // R, since the frame, about the CoM
+  std::array<Eigen::Vector3d, kMaxLocalContacts> contact_normal{};
+  std::array<double, kMaxLocalContacts> contact_friction{};
+  std::uint32_t contact_count = 0;
+  bool touched = false;       // the finger pushed it in the last tick
+  Eigen::Vector3d pushed_Ns = Eigen::Vector3d::Zero();  // Σ J since the frame (diagnostics, tests)
+
+  Eigen::Vector3d com_m() const { return com_frame_m + displacement_m; }
+  Eigen::Vector3d carry_point(const Eigen::Vector3d& x_m) const {
+    return com_frame_m + displacement_m + rotation * (x_m - com_frame_m);
+  }
+};
+
+class LocalDynamics {
+ public:
+  // A new world frame at the servo: restart every body from the frame's state and remember, per plane, the plane
+  // the finger was feeling (`displayed`: the last tick's planes, or nullptr) to blend from. `proxy_m` is the proxy of
+  // that tick, where last_model_error_m is measured.
+  void on_plane_frame(const PlaneFrame& frame, const PlaneSet* displayed, const Eigen::Vector3d& proxy_m);
+
+  // Advances every body by dt_s (drift, contacts, pose), before the planes of a tick are rendered.
+  void advance(double dt_s);
+
+  // The finger's share of this tick on `object_id` (reaction, N·s, and angular about the displayed CoM, N·m·s).
+  void apply_impulse(std::int32_t object_id, const Eigen::Vector3d& impulse_Ns,
+                     const Eigen::Vector3d& angular_impulse_Nms);
+
+  // The frame's planes at blend weight w, carried by the bodies' poses; velocities and centres of mass are the
+  // model's. `proxy_m` is the last tick's proxy (the passivity bound of the blend). Clears the bodies' touched flags
+  // (apply_impulse sets them again).
+  void render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& out);
+
+  const LocalBody* find(std::int32_t object_id) const;
+  std::uint32_t body_count() const { return body_count_; }
+
+  // At the last frame: the largest difference, at the finger's proxy, between the plane the finger was feeling and
+  // the world's new plane, over touched objects (m): how far the world and the model disagreed.
+  double last_model_error_m() const { return last_model_error_m_; }
+
+  void reset() { body_count_ = 0; plane_count_ = 0; }
+
+ private:
+  LocalBody* find_mutable(std::int32_t object_id);
+  void apply_drift(LocalBody& body, double h_s) const;
+
+  struct PlaneBlend {
+    Eigen::Vector3d from_point_m = Eigen::Vector3d::Zero();  // C
+    Eigen::Vector3d from_normal = Eigen::Vector3d::UnitZ();
+    double normal_weight = 0.0;  // w_n: how much of the normal offset has been closed (never decreases)
+    bool hold_normal = false;    // P is toward the finger from C: close no further than the proxy
+  };
+
+  PlaneFrame frame_{};  // the planes of the current frame (P)
+  std::uint32_t plane_count_ = 0;
+  std::array<PlaneBlend, kMaxPlanes> blends_{};
+  std::array<int, kMaxPlanes> body_of_plane_{};  // index into bodies_, −1 for static planes
+  std::array<LocalBody, kMaxPlanes> bodies_{};
+  std::uint32_t body_count_ = 0;
+  Eigen::Vector3d gravity_mps2_ = Eigen::Vector3d::Zero();
+  double substep_s_ = 0.0;       // the world's drift grid; 0: every tick
+  double elapsed_s_ = 0.0;       // model time since the frame
+  double next_drift_s_ = 0.0;    // start of the next substep whose drift is still to apply
+  double last_model_error_m_ = 0.0;
+};
+
+}  // namespace impetus

@@ -1,0 +1,191 @@
+// Local dynamics (haptic_controller/local_dynamics.h, paper §6.3, issue 9): the haptic side moves the touched object
+// between world frames. Physics-backed checks: a free body gives way by J/m per second, a sliding cube loses μ·g·h of
+// speed per world substep and never reverses, a support blocks, a wrong model never pushes the finger out, and the
+// impulse the model moved the object with is the impulse reported to the world.
+
+#include "haptic_controller/local_dynamics.h"
+#include "haptic_controller/servo.h"
+#include "haptic_controller/spidar_kinematics.h"
+#include "test_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+
+using namespace impetus;
+using impetus::test::make_frame;
+using impetus::test::wire_plane;
+using Eigen::Vector3d;
+
+namespace {
+
+constexpr double kTick_s = 1e-3;
+
+// A 1 kg cube (5 cm) whose −x face, at x = 0, faces a finger coming from −x.
+Plane cube_face(double inverse_mass_per_kg = 1.0) {
+  Plane plane = wire_plane(1, {0, 0, 0.05}, {-1, 0, 0});
+  plane.inverse_mass_per_kg = inverse_mass_per_kg;
+  const double inverse_inertia = 1.0 / (1.0 * 0.05 * 0.05 / 6.0);
+  plane.inverse_inertia_world = {inverse_inertia, 0, 0, 0, inverse_inertia, 0, 0, 0, inverse_inertia};
+  return plane;
+}
+
+PlaneFrame local_frame(std::initializer_list<Plane> planes, std::uint64_t index = 0) {
+  PlaneFrame frame = make_frame(planes, index);
+  frame.coupling = Coupling::local;
+  frame.stiffness_Npm = 2000.0;
+  frame.damping_Nspm = 0.0;
+  return frame;
+}
+
+void add_support(Plane& plane, const Vector3d& normal, double friction) {
+  plane.local_contacts[plane.local_contact_count++] = {to_vec3(normal.normalized()), friction};
+}
+
+DeviceState device_at(const SpidarKinematics& kinematics, const Vector3d& finger_m) {
+  DeviceState state;
+  state.encoder_counts = kinematics.encoder_counts(finger_m);
+  return state;
+}
+
+}  // namespace
+
+TEST_CASE("local dynamics: a free body pushed by J gives way by J/m per second, and its plane with it") {
+  LocalDynamics model;
+  model.on_plane_frame(local_frame({cube_face()}), nullptr, Vector3d::Zero());
+  PlaneSet planes;
+  model.advance(kTick_s);
+  model.render(kTick_s / 0.05, Vector3d(-0.01, 0, 0.05), planes);
+  REQUIRE(planes.planes[0].point_m.x() == Approx(0.0).margin(1e-15));
+  model.apply_impulse(1, Vector3d(0.01, 0, 0), Vector3d::Zero());  // 0.01 N·s on 1 kg: 1 cm/s
+  for (int tick = 2; tick <= 21; ++tick) {
+    model.advance(kTick_s);
+    model.render(tick * kTick_s / 0.05, Vector3d(-0.01, 0, 0.05), planes);
+  }
+  // 20 ticks at 1 cm/s after the push: 0.2 mm, exactly (symplectic Euler of a free body).
+  REQUIRE(planes.planes[0].point_m.x() == Approx(0.01 * 20 * kTick_s).epsilon(1e-12));
+  REQUIRE(planes.planes[0].velocity_mps.x() == Approx(0.01));
+  REQUIRE(model.find(1)->pushed_Ns.x() == Approx(0.01));
+}
+
+TEST_CASE("local dynamics: a cube sliding on the floor loses mu*g*h per world substep and stops without reversing") {
+  Plane face = cube_face();
+  face.velocity_mps = {0.1, 0, 0};
+  add_support(face, Vector3d::UnitZ(), 0.5);
+  PlaneFrame frame = local_frame({face});
+  frame.gravity_mps2 = {0, 0, -9.81};
+  frame.world_substep_s = 0.005;
+  LocalDynamics model;
+  model.on_plane_frame(frame, nullptr, Vector3d::Zero());
+  PlaneSet planes;
+  double last_x = 0.0;
+  for (int tick = 1; tick <= 10; ++tick) model.advance(kTick_s);
+  // Two substeps started (t = 0 and 5 ms): v = 0.1 − 2·μ·g·h.
+  REQUIRE(model.find(1)->velocity_mps.x() == Approx(0.1 - 2 * 0.5 * 9.81 * 0.005));
+  REQUIRE(model.find(1)->velocity_mps.z() == Approx(0.0).margin(1e-15));  // the floor holds it up
+  for (int tick = 11; tick <= 50; ++tick) {
+    model.advance(kTick_s);
+    model.render(tick / 50.0, Vector3d(-0.01, 0, 0.05), planes);
+    REQUIRE(planes.planes[0].point_m.x() >= last_x);  // friction never drives it backwards
+    last_x = planes.planes[0].point_m.x();
+  }
+  REQUIRE(model.find(1)->velocity_mps.x() == 0.0);
+  REQUIRE(last_x > 0.0);
+}
+
+TEST_CASE("local dynamics: a support blocks the push (a cube against a wall does not give way)") {
+  Plane face = cube_face();
+  add_support(face, -Vector3d::UnitX(), 0.2);  // a wall on the +x side pushes the cube toward −x
+  LocalDynamics model;
+  model.on_plane_frame(local_frame({face}), nullptr, Vector3d::Zero());
+  PlaneSet planes;
+  for (int tick = 1; tick <= 50; ++tick) {
+    model.advance(kTick_s);
+    model.render(tick / 50.0, Vector3d(-0.01, 0, 0.05), planes);
+    model.apply_impulse(1, Vector3d(0.002, 0, 0), Vector3d::Zero());
+  }
+  REQUIRE(planes.planes[0].point_m.x() == 0.0);
+}
+
+TEST_CASE("servo, local coupling: the pushed cube gives way between frames and the reported impulse is the one "
+          "that moved it") {
+  ServoOptions options;
+  HapticServo servo(options, 3);
+  const SpidarKinematics kinematics(options.geometry);
+  servo.on_plane_frame(local_frame({cube_face()}), 0.0);
+  const DeviceState outside = device_at(kinematics, Vector3d(-0.001, 0, 0.05));  // arrive from outside the face
+  servo.tick(&outside, 0.0, kTick_s);
+  const DeviceState state = device_at(kinematics, Vector3d(0.002, 0, 0.05));  // then 2 mm into it, held
+  for (int tick = 1; tick <= 40; ++tick) servo.tick(&state, tick * kTick_s, kTick_s);
+  const LocalBody* body = servo.local_dynamics().find(1);
+  REQUIRE(body != nullptr);
+  REQUIRE(servo.planes().planes[0].point_m.x() > 0.0);  // gave way under the finger
+  REQUIRE(servo.report().entry_count == 1);
+  // Conservation: what moved the local model is what the world will apply (the report's running total).
+  REQUIRE(body->pushed_Ns.x() == Approx(servo.report().entries[0].impulse_Ns[0]).epsilon(1e-12));
+  // The time moments are Σ J_k·t_k, so the world can place the impulse where it was rendered.
+  REQUIRE(servo.report().entries[0].impulse_moment_Nss[0] > 0.0);
+  REQUIRE(servo.report().entries[0].impulse_moment_Nss[0] <= body->pushed_Ns.x() * 40 * kTick_s);
+}
+
+TEST_CASE("servo, local coupling: a wrong model (the world says the object did not move) never pushes the finger "
+          "out") {
+  // The finger holds still 2 mm inside the face; the model lets the cube give way, but every world frame puts it back
+  // at x = 0 (stuck behind something the model was not told about). The plane may stay where the finger left it or
+  // recede; it must never move toward the finger while pushing on it, so the work the plane does on the finger is
+  // never positive. A 20 kg body, so the finger stays on it across frames (about 0.25 mm of give per frame).
+  ServoOptions options;
+  HapticServo servo(options, 3);
+  const SpidarKinematics kinematics(options.geometry);
+  const DeviceState outside = device_at(kinematics, Vector3d(-0.001, 0, 0.05));
+  const DeviceState state = device_at(kinematics, Vector3d(0.002, 0, 0.05));
+  servo.on_plane_frame(local_frame({cube_face(0.05)}), 0.0);
+  servo.tick(&outside, 0.0, kTick_s);  // arrive from outside the face
+  double work_on_finger_J = 0.0;
+  double toward_finger_m = 0.0;  // largest step of the plane toward the finger while the finger is on it
+  double last_plane_x = 0.0;
+  int tick = 0;
+  for (std::uint64_t frame = 0; frame < 10; ++frame) {
+    servo.on_plane_frame(local_frame({cube_face(0.05)}, frame), tick * kTick_s);
+    for (int j = 0; j < 50; ++j) {
+      ++tick;
+      const TickResult& r = servo.tick(&state, tick * kTick_s, kTick_s);
+      const double plane_x = servo.planes().planes[0].point_m.x();
+      // Plane displacement toward the finger is −x; the force on the finger is along −x: work = f_x·Δx.
+      work_on_finger_J += r.force_N[0] * (plane_x - last_plane_x);
+      if (r.active_planes > 0) toward_finger_m = std::max(toward_finger_m, last_plane_x - plane_x);
+      last_plane_x = plane_x;
+    }
+  }
+  REQUIRE(work_on_finger_J <= 1e-12);
+  REQUIRE(toward_finger_m <= 1e-12);
+  REQUIRE(servo.planes().planes[0].point_m.x() > 0.0);  // it did give way (softer, never active)
+  REQUIRE(servo.counters().local_model_error_max_m > 0.0);  // the disagreement is visible in the diagnostic
+}
+
+TEST_CASE("servo: the frame-boundary diagnostic sees a plane jump under the finger and ignores steady motion") {
+  ServoOptions options;
+  options.stiffness_Npm = 1000.0;
+  HapticServo servo(options, 3);
+  const SpidarKinematics kinematics(options.geometry);
+  const DeviceState above = device_at(kinematics, Vector3d(0, 0, 0.001));
+  const DeviceState state = device_at(kinematics, Vector3d(0, 0, -0.002));
+  // Impulse coupling, a static floor moving up steadily 1 mm per frame: interpolation is continuous, and at the
+  // boundaries the second difference is zero.
+  int tick = 0;
+  servo.on_plane_frame(make_frame({wire_plane(0, {0, 0, -0.001}, {0, 0, 1}, false)}, 0), 0.0);
+  servo.tick(&above, 0.0, 1e-3);  // arrive from above the floor
+  for (std::uint64_t frame = 0; frame < 4; ++frame) {
+    servo.on_plane_frame(make_frame({wire_plane(0, {0, 0, 0.001 * frame}, {0, 0, 1}, false)}, frame + 1),
+                         tick * 1e-3);
+    for (int j = 0; j < 50; ++j, ++tick) servo.tick(&state, (tick + 1) * 1e-3, 1e-3);
+  }
+  REQUIRE(servo.counters().contact_frame_boundaries >= 2);
+  REQUIRE(servo.counters().frame_jump_max_m == Approx(0.0).margin(1e-9));
+  // A frame that moves the plane by 0.5 mm at once while the finger is on it.
+  // (Steady motion of 0.02 mm per tick before it: the second difference is 0.5 − 0.02 mm.)
+  servo.on_plane_frame(make_frame({wire_plane(0, {0, 0, 0.0035}, {0, 0, 1}, false)}, 5), tick * 1e-3);
+  servo.on_plane_frame(make_frame({wire_plane(0, {0, 0, 0.0035}, {0, 0, 1}, false)}, 6), tick * 1e-3);
+  servo.tick(&state, (tick + 1) * 1e-3, 1e-3);
+  REQUIRE(servo.counters().frame_jump_max_m == Approx(0.00048).margin(1e-6));
+}

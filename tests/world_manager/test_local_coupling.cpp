@@ -1,0 +1,130 @@
+// The world's side of local coupling (world.h, paper §6.3, issue 9): impulses are applied at the time they were
+// rendered (from the report's first moments), so the world's next state is what the haptic side's local model showed;
+// the impulse applied is exactly the impulse reported; and the frame carries the response model (contacts, gravity,
+// substep).
+
+#include "world_test_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+using impetus::Coupling;
+using impetus::HapticReport;
+using impetus::ObjectImpulse;
+using impetus::World;
+using impetus::WorldOptions;
+using impetus::test::make_report;
+using impetus::test::make_world;
+using Eigen::Vector3d;
+using nlohmann::json;
+
+namespace {
+
+json free_cube() {
+  return json{{"name", "cube"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", true},
+              {"mass_kg", 2.0}, {"position_m", {0, 0, 0}}};
+}
+
+WorldOptions local_options() {
+  WorldOptions options;
+  options.coupling = Coupling::local;
+  options.world_rate_hz = 20.0;
+  return options;
+}
+
+// Adds impulse J rendered at haptic time t to a running entry (what ImpulseAccumulator does per tick).
+void render(ObjectImpulse& entry, const Vector3d& impulse_Ns, double t_s) {
+  for (int a = 0; a < 3; ++a) {
+    entry.impulse_Ns[a] += impulse_Ns[a];
+    entry.impulse_moment_Nss[a] += impulse_Ns[a] * t_s;
+  }
+}
+
+}  // namespace
+
+TEST_CASE("local coupling: impulses rendered at t_k move a free body by sum J_k (t_end - t_k)/m, as the haptic side "
+          "showed, and change its velocity by sum J_k/m") {
+  const impetus::Scene scene = impetus::parse_scene(impetus::test::free_body_document(free_cube()), "free.json");
+  auto world = make_world(scene, local_options());
+  HapticReport report = make_report(9, 50);
+  report.haptic_time_s = 0.05;  // first report: the window is the period before it, [0, 0.05]
+  report.entry_count = 1;
+  ObjectImpulse& entry = report.entries[0];
+  entry.object_id = 0;
+  entry.epoch = 1;
+  // Two pushes at awkward times (not on the 5 ms substep grid) and in different directions.
+  render(entry, Vector3d(0.10, 0.02, 0.0), 0.013);
+  render(entry, Vector3d(0.04, -0.03, 0.01), 0.041);
+  world->step(&report);
+  const double m = 2.0;
+  const Vector3d expected_x =
+      (Vector3d(0.10, 0.02, 0.0) * (0.05 - 0.013) + Vector3d(0.04, -0.03, 0.01) * (0.05 - 0.041)) / m;
+  INFO("x " << world->states()[0].pose.position_m.transpose() << " expected " << expected_x.transpose() << " substeps " << scene.physics.substeps);
+  CHECK((world->states()[0].pose.position_m - expected_x).norm() < 1e-12);
+  CHECK((world->states()[0].velocity_mps - Vector3d(0.14, -0.01, 0.01) / m).norm() < 1e-12);
+
+  // The next window starts at the previous report's time: a push in its very last tick changes the velocity only.
+  report.tick = 100;
+  report.haptic_time_s = 0.10;
+  render(entry, Vector3d(0.02, 0, 0), 0.10);
+  const Vector3d x_before = world->states()[0].pose.position_m;
+  const Vector3d v_before = world->states()[0].velocity_mps;
+  world->step(&report);
+  CHECK((world->states()[0].pose.position_m - (x_before + v_before * 0.05)).norm() < 1e-12);
+  CHECK(world->states()[0].velocity_mps.x() == Approx(v_before.x() + 0.01).epsilon(1e-12));
+}
+
+TEST_CASE("local coupling: the world applies exactly the impulse reported, whatever its timing") {
+  const impetus::Scene scene = impetus::parse_scene(impetus::test::free_body_document(free_cube()), "free.json");
+  auto world = make_world(scene, local_options());
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> push(-0.01, 0.02);
+  std::uniform_int_distribution<int> ticks(1, 120);  // reports arrive irregularly (real time)
+  HapticReport report = make_report(11, 0);
+  report.entry_count = 1;
+  report.entries[0].object_id = 0;
+  report.entries[0].epoch = 1;
+  std::uint64_t tick = 0;
+  for (int step = 0; step < 60; ++step) {
+    const int n = ticks(random);
+    for (int k = 0; k < n; ++k) {
+      ++tick;
+      render(report.entries[0], Vector3d(push(random), push(random), push(random)), tick * 1e-3);
+    }
+    report.tick = tick;
+    report.haptic_time_s = tick * 1e-3;
+    world->step(&report);
+  }
+  const Vector3d reported = impetus::to_eigen(report.entries[0].impulse_Ns);
+  CHECK((world->total_impulse_Ns(0) - reported).norm() <= 1e-12 * (1.0 + reported.norm()));
+  // And the free body's momentum is that impulse (no gravity, no contacts).
+  CHECK((2.0 * world->states()[0].velocity_mps - reported).norm() <= 1e-10);
+}
+
+TEST_CASE("local coupling: a cube resting on the floor sends its floor contact, gravity and substep with its plane") {
+  const impetus::Scene scene = impetus::load_scene(impetus::test::scene_path("tap.json"));
+  auto world = make_world(scene, local_options());
+  HapticReport report = make_report(3, 50, {-0.01, 0.0, 0.025}, true);
+  report.proxy_m = report.finger_m;
+  const impetus::PlaneFrame& frame = world->step(&report);
+  CHECK(frame.coupling == Coupling::local);
+  CHECK(frame.gravity_mps2[2] == Approx(-9.81));
+  CHECK(frame.world_substep_s == Approx(0.05 / scene.physics.substeps));
+  const impetus::Plane* cube = nullptr;
+  for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
+    if (frame.planes[k].object_id == 0) cube = &frame.planes[k];
+  }
+  REQUIRE(cube != nullptr);
+  REQUIRE(cube->local_contact_count == 1);  // the four corner contacts are one support
+  CHECK(impetus::to_eigen(cube->local_contacts[0].normal).dot(Vector3d::UnitZ()) > 0.999);  // pushes the cube up
+  CHECK(cube->local_contacts[0].friction == Approx(0.06));
+  CHECK(validate(frame) == impetus::FrameError::ok);
+
+  // Impulse coupling sends no contacts: the haptic side has no model to feed.
+  WorldOptions impulse = local_options();
+  impulse.coupling = Coupling::impulse;
+  auto other = make_world(scene, impulse);
+  const impetus::PlaneFrame& plain = other->step(&report);
+  for (std::uint32_t k = 0; k < plain.plane_count; ++k) CHECK(plain.planes[k].local_contact_count == 0);
+}
