@@ -6,10 +6,14 @@ cd "$(dirname "$0")/.."
 bash scripts/build.sh build >/dev/null
 mkdir -p docs
 # Fig. 5 of the paper: cube stop position against the world clock's phase, position vs impulse coupling.
-/usr/bin/python3 scripts/phase_experiment.py --phases 25 --out out/figures/phase
+/usr/bin/python3 scripts/phase_experiment.py --phases 25 --couplings position,impulse,local --out out/figures/phase
 cp out/figures/phase/phase_xt.png docs/phase_xt.png
 cp out/figures/phase/phase.md docs/phase.md
 # One tap trial, lockstep, impulse coupling: the cube face, the finger and the proxy.
 bash scripts/run.sh --scene scenes/tap.json --trajectory tap --out out/figures/tap --quiet
 /usr/bin/python3 scripts/plot_trial.py out/figures/tap --out docs/tap_trial.png
-echo "figures written to docs/"
+# Figs. 7/8 of the paper: a simulated subject learning the tap task with each coupling.
+/usr/bin/python3 scripts/tap_task.py --methods position,impulse,local --out out/figures/tap_task
+cp out/figures/tap_task/tap_task.png docs/tap_task.png
+cp out/figures/tap_task/tap_task.md docs/tap_task.md
+echo "figures written to docs/ (speed vs error: scripts/speed_vs_error.py --docs; hard cases: scripts/hard_cases.py)"

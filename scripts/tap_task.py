@@ -119,7 +119,8 @@ def main():
         left.set_title("stop position per trial (paper Fig. 7)")
         left.legend(fontsize=8)
         left.grid(alpha=0.3)
-        right.bar(methods, [1e3 * deviations[m] for m in methods], color=["tab:blue", "tab:orange"][:len(methods)])
+        right.bar(methods, [1e3 * deviations[m] for m in methods],
+                  color=["tab:blue", "tab:orange", "tab:green"][:len(methods)])
         right.set_ylabel(f"mean |error|, last {last} (mm)")
         right.set_title("accuracy (Fig. 8)")
         fig.tight_layout()
