@@ -167,7 +167,8 @@ Floor parse_floor(const Node& node) {
 }
 
 PhysicsParams parse_physics(const Node& node) {
-  node.expect_keys({"world_rate_hz", "substeps", "solver_iterations", "erp", "cfm", "auto_disable", "seed"});
+  node.expect_keys(
+      {"world_rate_hz", "substeps", "solver", "solver_iterations", "erp", "cfm", "auto_disable", "seed"});
   PhysicsParams physics;
   if (node.has("world_rate_hz")) {
     const Node rate = node.child("world_rate_hz");
@@ -176,6 +177,17 @@ PhysicsParams parse_physics(const Node& node) {
     if (!std::isfinite(physics.world_period_s())) rate.fail("too small: the world period 1/rate is not finite");
   }
   if (node.has("substeps")) physics.substeps = node.child("substeps").positive_int();
+  if (node.has("solver")) {
+    const Node solver = node.child("solver");
+    const std::string name = solver.string();
+    if (name == "quickstep") {
+      physics.solver = PhysicsParams::Solver::quickstep;
+    } else if (name == "direct") {
+      physics.solver = PhysicsParams::Solver::direct;
+    } else {
+      solver.fail("expected \"quickstep\" or \"direct\"");
+    }
+  }
   if (node.has("solver_iterations")) physics.solver_iterations = node.child("solver_iterations").positive_int();
   if (node.has("erp")) physics.erp = node.child("erp").in_unit_interval();
   if (node.has("cfm")) physics.cfm = node.child("cfm").non_negative();

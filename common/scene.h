@@ -13,6 +13,8 @@
 //     "physics": {                              optional, every key optional
 //       "world_rate_hz": 20,                    paper §4.2.1
 //       "substeps": 10,                         ODE steps inside one world period
+//       "solver": "quickstep",                  quickstep (iterative, O(n)) | direct (ODE's dWorldStep: exact
+//                                               LCP, O(n³), for stacks with large mass ratios QuickStep cannot hold)
 //       "solver_iterations": 20,                QuickStep iterations
 //       "erp": 0.2, "cfm": 1e-5,                ODE error reduction / constraint force mixing
 //       "auto_disable": false,                  let resting bodies sleep (off: "model only what a scene needs")
@@ -125,6 +127,10 @@ struct PhysicsParams {
   // 50 ms is too coarse for ODE's contacts: a body falls g·T² ≈ 2.5 cm into the floor in one step, half a 5 cm cube.
   // Ten 5 ms substeps keep that under 0.25 mm for the cost of ten cheap steps.
   int substeps = 10;
+  // QuickStep is ODE's fast iterative solver; it converges badly when a light body carries a much heavier one
+  // (a 1000:1 stack collapses at any iteration count), where the direct solver is exact but cubic in the contacts.
+  enum class Solver { quickstep, direct };
+  Solver solver = Solver::quickstep;
   int solver_iterations = 20;  // ODE's own default for QuickStep; enough for stacks of a few boxes
   double erp = 0.2;            // ODE's default: corrects 20 % of a penetration per step
   // A little compliance (ODE default is 1e-10 in double) lets QuickStep settle stacks without jitter.

@@ -44,6 +44,12 @@ def main():
                         help="--check: largest allowed impulse spread / position spread (the paper's claim: 0.5)")
     parser.add_argument("--reference-tolerance", type=float, default=1e-4,
                         help="--check: largest allowed phase spread of the 1 kHz reference, m")
+    parser.add_argument("--local-max-spread-ratio", type=float, default=0.05,
+                        help="--check, when local coupling ran: largest allowed local spread / position spread "
+                             "(issue 9's goal: 5 %%)")
+    parser.add_argument("--local-max-bias", type=float, default=0.05,
+                        help="--check, when local coupling ran: largest allowed |bias| as a fraction of the reference "
+                             "travel (issue 9's goal: 5 %%)")
     parser.add_argument("--expect-overshoot", action="store_true",
                         help="--check: also require impulse coupling to stop beyond the reference (the haptic side "
                              "pushes on a plane that cannot move until the next world step, so the object receives "
@@ -140,6 +146,13 @@ def main():
             failures.append(f"impulse spread / position spread = {ratio:.3f} > {args.max_ratio}")
         if stats["reference"]["spread_m"] > args.reference_tolerance:
             failures.append(f"reference spread {stats['reference']['spread_m']:.2e} m > {args.reference_tolerance}")
+        if "local" in stats:
+            local_ratio = stats["local"]["spread_m"] / stats["position"]["spread_m"]
+            if local_ratio > args.local_max_spread_ratio:
+                failures.append(f"local spread / position spread = {local_ratio:.3f} > {args.local_max_spread_ratio}")
+            if abs(stats["local"]["bias_pct_of_travel"]) > 100 * args.local_max_bias:
+                failures.append(f"local bias {stats['local']['bias_pct_of_travel']:+.1f} % of travel exceeds "
+                                f"{100 * args.local_max_bias:.0f} %")
         if args.expect_overshoot and stats["impulse"]["bias_m"] <= 0:
             failures.append(f"impulse coupling did not overshoot the reference (bias {stats['impulse']['bias_m']:+.4f} m)")
         if failures:

@@ -473,7 +473,11 @@ void World::advance_ode() {
     if (ode.record_contacts) std::fill(ode.local_contact_counts.begin(), ode.local_contact_counts.end(), 0u);
     dSpaceCollide(ode.space, &ode, &OdeHandles::near_callback);
     ode.record_contacts = false;
-    dWorldQuickStep(ode.world, ode.substep_s);
+    if (scene_.physics.solver == PhysicsParams::Solver::direct) {
+      dWorldStep(ode.world, ode.substep_s);
+    } else {
+      dWorldQuickStep(ode.world, ode.substep_s);
+    }
     dJointGroupEmpty(ode.contacts);
   }
   if (options_.coupling == Coupling::local) apply_local_schedule(scene_.physics.substeps);

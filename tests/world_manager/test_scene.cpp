@@ -181,6 +181,15 @@ TEST_CASE("scene error: bad physics settings") {
   require_error(json{{"objects", json::array()}, {"physics", {{"substeps", 2.5}}}}, "/physics/substeps", "integer");
   require_error(json{{"objects", json::array()}, {"haptic", {{"stiffness_Npm", -1}}}}, "/haptic/stiffness_Npm",
                 "positive");
+  require_error(json{{"objects", json::array()}, {"physics", {{"solver", "magic"}}}}, "/physics/solver",
+                "\"quickstep\" or \"direct\"");
+}
+
+TEST_CASE("the direct solver is chosen by the scene and QuickStep is the default") {
+  const json document{{"objects", json::array()}, {"physics", {{"solver", "direct"}}}};
+  CHECK(impetus::parse_scene(document, "test.json").physics.solver == impetus::PhysicsParams::Solver::direct);
+  CHECK(impetus::parse_scene(json{{"objects", json::array()}}, "test.json").physics.solver ==
+        impetus::PhysicsParams::Solver::quickstep);
 }
 
 TEST_CASE("scene error: the message echoes the offending value") {
