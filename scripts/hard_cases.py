@@ -42,11 +42,14 @@ HAPTIC_PERIOD_S = 1e-3
 # Running trials
 
 
+COUPLING = "impulse"  # set from --coupling: every case runs with it
+
+
 def run_trial(out_dir, scene, trajectory, rate=None, haptic_flags=()):
     """One lockstep trial through scripts/run.sh into out_dir; returns out_dir or raises RuntimeError."""
     out_dir.mkdir(parents=True, exist_ok=True)
     command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), "--trajectory", str(trajectory),
-               "--clock", "lockstep", "--out", str(out_dir), "--quiet"]
+               "--clock", "lockstep", "--coupling", COUPLING, "--out", str(out_dir), "--quiet"]
     if rate is not None:
         command += ["--rate", str(rate)]
     if haptic_flags:
@@ -650,7 +653,11 @@ def main():
     parser.add_argument("--check", action="store_true", help="exit 1 if any case fails")
     parser.add_argument("--fine", action="store_true", help="stiffness sweep in 5 %% steps (default 25 %%)")
     parser.add_argument("--cases", default="", help="comma-separated case ids (default: all)")
+    parser.add_argument("--coupling", default="impulse", choices=["impulse", "position", "local"],
+                        help="coupling every case runs with (default impulse, the paper's method)")
     args = parser.parse_args()
+    global COUPLING
+    COUPLING = args.coupling
     wanted = set(args.cases.split(",")) if args.cases else None
     cases = [c for c in CASES if wanted is None or c[0] in wanted]
     args.out.mkdir(parents=True, exist_ok=True)
