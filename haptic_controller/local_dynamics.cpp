@@ -168,16 +168,9 @@ void LocalDynamics::advance(double dt_s) {
   }
   if (chunks == kMaxDriftChunksPerTick) next_drift_s_ = elapsed_s_ + h_s;  // a long gap: do not replay it
   elapsed_s_ += dt_s;
-  for (std::uint32_t b = 0; b < body_count_; ++b) {
-    LocalBody& body = bodies_[b];
-    body.displacement_m += body.velocity_mps * dt_s;
-    const double angle_rad = body.angular_velocity_radps.norm() * dt_s;
-    if (angle_rad > 0.0) {
-      body.rotation =
-          Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, body.angular_velocity_radps.normalized())) * body.rotation;
-      body.rotation.normalize();
-    }
-  }
+  // Planes are carried by the CoM's displacement only (local_dynamics.h "Planes translate"); ω is kept for the
+  // surface velocity that friction sees and is reconciled by the next frame.
+  for (std::uint32_t b = 0; b < body_count_; ++b) bodies_[b].displacement_m += bodies_[b].velocity_mps * dt_s;
 }
 
 void LocalDynamics::apply_impulse(std::int32_t object_id, const Eigen::Vector3d& impulse_Ns,
@@ -221,8 +214,7 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
         // blend never pushes the finger out. Signed distance of the proxy to the plane as a function of w_n:
         //     d(w_n) = d_P + (1 − w_n)·|offset_normal|,   d_P = its distance to the plane with the gap closed.
         const double gap_m = -offset_normal_m;
-        const double d_closed_m = (body->rotation * target_normal)
-                                      .dot(proxy_m - body->carry_point(target_point + tangential));
+        const double d_closed_m = target_normal.dot(proxy_m - body->carry_point(target_point + tangential));
         if (d_closed_m < 0.0) normal_weight = std::min(normal_weight, std::max(blend.normal_weight, 1.0 + d_closed_m / gap_m));
       }
       blend.normal_weight = normal_weight;
@@ -233,7 +225,7 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
 
     if (body) {
       plane.point_m = body->carry_point(point);
-      plane.normal = body->rotation * normal;
+      plane.normal = normal;  // translated, not rotated: see the header
       plane.com_m = body->com_m();
       plane.velocity_mps = body->velocity_mps;
       plane.angular_velocity_radps = body->angular_velocity_radps;

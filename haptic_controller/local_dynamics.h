@@ -18,14 +18,26 @@
 //                                                                μ·g·Δt of speed per tick, as in the world)
 //     ω restricted to spin about a single support's normal (no tipping or rolling locally; 0 with 2+ supports)
 //   each tick, before the planes are rendered:
-//     u ← u + v·Δt;  R ← exp(ω·Δt)·R                            pose since the frame: CoM displacement u, rotation R
+//     u ← u + v·Δt                                              CoM displacement since the frame
 //   after the force of the tick (§3.4 share J, angular share L about the CoM):
-//     v ← v + J/m;  ω ← ω + I⁻¹·L
+//     v ← v + J/m;  ω ← ω + I⁻¹·L                               (ω: the surface velocity friction sees, §6.2)
 //
 // A frame's state is the world's state *now* (the world integrates the impulses of the period just rendered, placed
-// at the times they were rendered, world.h), so the planes are rendered at the frame's plane moved rigidly with the
-// model's pose: x ↦ com + u + R·(x − com). Frame i's plane is therefore extrapolated with the model, not interpolated
-// from i−1 (which would lag a period behind the object the finger is pushing).
+// at the times they were rendered, world.h), so the planes are rendered at the frame's plane moved with the model:
+// x ↦ x + u, normal unchanged. Frame i's plane is therefore extrapolated with the model, not interpolated from i−1
+// (which would lag a period behind the object the finger is pushing).
+//
+// Planes translate, they do not rotate. A plane is §3.1's first-order picture of the surface at the nearest point p
+// to the finger; it holds near p only. Carrying it rigidly about the CoM (x ↦ com + u + R·(x − com), n ↦ R·n) is
+// right for a flat face but not for a curved surface: a sphere's surface does not move when it spins, yet its
+// rotated tangent plane sweeps the finger's position at ω·L, L = the finger's distance from p along the plane (up to
+// the finger's travel in a period, 25 mm at 10 Hz). With small, fast-spinning bodies this is an active wall: 3 g balls
+// (I = 1.2e-7 kg·m²) roll at ~20 rad/s in the world, and a friction share at L = 1 cm adds ~200 rad/s per 10 N·ms, so
+// the swept plane strikes the finger, the reaction at lever L spins the ball faster, and the swept planes pinch the
+// proxy into infeasible sets (hard case 10 gained 2.4e10 J, tests/haptic_controller/test_local_dynamics.cpp). The
+// rotation within a period is not lost: the world integrates the angular impulses, and its next frame brings the
+// rotated face, blended in like §3.2's interpolation (the lag impulse coupling has for every plane). A rotationally
+// stiffer model errs toward impulse coupling's behaviour (more momentum, never energy from the plane's own motion).
 //
 // Frame boundaries. When frame i arrives the plane the finger was feeling, C (frame i−1's plane moved by the old
 // model), and the world's new plane P normally agree to within the model error (floor friction per 1 ms tick vs per
@@ -60,7 +72,6 @@ struct LocalBody {
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();
   Eigen::Vector3d displacement_m = Eigen::Vector3d::Zero();          // u, of the CoM since the frame
-  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();      // R, since the frame, about the CoM
   std::array<Eigen::Vector3d, kMaxLocalContacts> contact_normal{};
   std::array<double, kMaxLocalContacts> contact_friction{};
   std::uint32_t contact_count = 0;
@@ -68,9 +79,8 @@ struct LocalBody {
   Eigen::Vector3d pushed_Ns = Eigen::Vector3d::Zero();  // Σ J since the frame (diagnostics, tests)
 
   Eigen::Vector3d com_m() const { return com_frame_m + displacement_m; }
-  Eigen::Vector3d carry_point(const Eigen::Vector3d& x_m) const {
-    return com_frame_m + displacement_m + rotation * (x_m - com_frame_m);
-  }
+  // Where the model has carried a point of the frame's planes: translated with the CoM (header, "Planes translate").
+  Eigen::Vector3d carry_point(const Eigen::Vector3d& x_m) const { return x_m + displacement_m; }
 };
 
 class LocalDynamics {

@@ -189,3 +189,42 @@ TEST_CASE("servo: the frame-boundary diagnostic sees a plane jump under the fing
   servo.tick(&state, (tick + 1) * 1e-3, 1e-3);
   REQUIRE(servo.counters().frame_jump_max_m == Approx(0.00048).margin(1e-6));
 }
+
+namespace {
+
+// A 3 g wooden ball (r = 1 cm, hard case 10) centred at `centre`, its nearest point to a finger on the −x side, spinning
+// at `spin` (rolling on the floor at 0.2 m/s is 20 rad/s). No contacts: nothing stops it turning.
+Plane spinning_ball(const Vector3d& centre, const Vector3d& spin_radps) {
+  const double radius_m = 0.01;
+  const double mass_kg = 700.0 * 4.0 / 3.0 * 3.14159265358979 * radius_m * radius_m * radius_m;
+  Plane plane = wire_plane(5, centre - Vector3d(radius_m, 0, 0), {-1, 0, 0});
+  plane.com_m = to_vec3(centre);
+  plane.angular_velocity_radps = to_vec3(spin_radps);
+  plane.inverse_mass_per_kg = 1.0 / mass_kg;
+  const double inverse_inertia = 1.0 / (0.4 * mass_kg * radius_m * radius_m);
+  plane.inverse_inertia_world = {inverse_inertia, 0, 0, 0, inverse_inertia, 0, 0, 0, inverse_inertia};
+  return plane;
+}
+
+}  // namespace
+
+TEST_CASE("local dynamics: a spinning ball's plane does not sweep into a finger beside its tangent point (hard case "
+          "10)") {
+  // The finger is 0.2 mm outside the tangent plane but 2 cm along it (where it gets within a 10 Hz period): 12 mm from
+  // the ball itself. A sphere's surface does not move when it spins, so nothing may push the finger. Rotating the
+  // infinite plane with the ball about its centre swept it through the finger at ω·L = 20 rad/s · 2 cm = 0.4 m/s
+  // within half a tick's angle (0.01 rad); that active wall, fed by the reaction at lever L, blew case 10 up.
+  const Vector3d centre(0.0, 0.0, 0.01);
+  const Vector3d finger(-0.0102, 0.02, 0.01);
+  LocalDynamics model;
+  model.on_plane_frame(local_frame({spinning_ball(centre, Vector3d(0, 0, 20))}), nullptr, finger);
+  PlaneSet planes;
+  double closest_m = 1.0;
+  for (int tick = 1; tick <= 100; ++tick) {
+    model.advance(kTick_s);
+    model.render(tick / 100.0, finger, planes);
+    const ContactPlane& plane = planes.planes[0];
+    closest_m = std::min(closest_m, plane.normal.dot(finger - plane.point_m));
+  }
+  REQUIRE(closest_m == Approx(0.0002).margin(1e-9));
+}
