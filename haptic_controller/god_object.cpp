@@ -3,6 +3,10 @@
 namespace impetus {
 namespace {
 
+// An object whose surface moves toward the finger faster than this is arriving, not resting: ODE's resting contacts
+// jitter by micrometres per second, anything moving a millimetre per second is being driven into the finger.
+constexpr double kRestingSpeed_mps = 1e-3;
+
 // Signed distance of the finger in front of a plane (negative: behind it, inside the object).
 double clearance_m(const ContactPlane& plane, const Eigen::Vector3d& finger_m) {
   return plane.normal.dot(finger_m - plane.point_m);
@@ -14,7 +18,12 @@ const PlaneSet& GodObject::armed_planes(const PlaneSet& planes, const Eigen::Vec
   if (session_starting_ && planes.count > 0) {
     session_starting_ = false;
     for (std::uint32_t k = 0; k < planes.count && disarmed_count_ < static_cast<int>(kMaxPlanes); ++k) {
-      if (clearance_m(planes.planes[k], finger_m) < 0.0) disarmed_ids_[disarmed_count_++] = planes.planes[k].object_id;
+      // Only a resting object is disarmed: one that moves onto the finger pushes it out like any moving plane.
+      const ContactPlane& plane = planes.planes[k];
+      const double approach_mps = plane.surface_velocity_mps(plane.point_m).dot(plane.normal);
+      if (clearance_m(plane, finger_m) < 0.0 && approach_mps <= kRestingSpeed_mps) {
+        disarmed_ids_[disarmed_count_++] = plane.object_id;
+      }
     }
   }
   if (disarmed_count_ == 0) return planes;

@@ -9,10 +9,11 @@
 //
 // A finger that starts inside an object (the device attaches, or the finger reappears, with the fingertip already
 // behind a surface) is not kicked out to the nearest face: that would render a force of k·depth — the device maximum
-// for a centimetre — for energy nobody put in. Instead, at the start of a finger session the planes the finger is
-// already behind are disarmed: they do not constrain the proxy until the finger has come out of them (or the object
-// has left the frame), after which they act normally. Planes the finger is in front of at the start, and every plane
-// that appears later, act at once — so a plane that moves onto the finger still pushes it out.
+// for a centimetre — for energy nobody put in. Instead, at the start of a finger session the planes of resting objects
+// the finger is already behind are disarmed: they do not constrain the proxy until the finger has come out of them
+// (or the object has left the frame), after which they act normally. Planes the finger is in front of at the start,
+// planes of objects moving onto the finger, and every plane that appears later act at once — so an object that
+// arrives onto the finger still pushes it out (hard case 5, the pinch).
 
 #include "haptic_controller/contact_plane.h"
 #include "haptic_controller/friction.h"
