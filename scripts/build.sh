@@ -1,10 +1,16 @@
 #!/usr/bin/env bash
 # Installs what is missing and builds Impetus.
-#   scripts/build.sh [BUILD_DIR [extra cmake -D options...]]     default BUILD_DIR: build (Release)
+#   scripts/build.sh [--daemons] [BUILD_DIR [extra cmake -D options...]]     default BUILD_DIR: build (Release)
+#   --daemons   build only world_manager, haptic_controller and spidar_sim (what the demo needs), not the tests
 set -euo pipefail
 cd "$(dirname "$0")/.."
+targets=()
+if [ "${1:-}" = "--daemons" ]; then
+  targets=(--target world_manager haptic_controller spidar_sim)
+  shift
+fi
 build_dir="${1:-build}"
 shift || true
 bash scripts/deps.sh
 cmake -S . -B "$build_dir" "$@" >/dev/null
-cmake --build "$build_dir" -j"$(nproc)"
+cmake --build "$build_dir" -j"$(nproc)" "${targets[@]}"

@@ -5,7 +5,7 @@
 #   scripts/demo.sh [extra scripts/run.sh arguments, e.g. --coupling position]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh build
+bash scripts/build.sh --daemons build
 out=out/demo
 rm -rf "$out"
 bash scripts/run.sh --scene scenes/tap.json --trajectory tap --clock realtime --coupling impulse --out "$out" "$@"
