@@ -21,7 +21,8 @@ const PlaneSet& GodObject::armed_planes(const PlaneSet& planes, const Eigen::Vec
       // Only a resting object is disarmed: one that moves onto the finger pushes it out like any moving plane.
       const ContactPlane& plane = planes.planes[k];
       const double approach_mps = plane.surface_velocity_mps(plane.point_m).dot(plane.normal);
-      if (clearance_m(plane, finger_m) < 0.0 && approach_mps <= kRestingSpeed_mps) {
+      if (clearance_m(plane, finger_m) < 0.0 && clearance_m(plane, session_start_finger_m_) < 0.0 &&
+          approach_mps <= kRestingSpeed_mps) {
         disarmed_ids_[disarmed_count_++] = plane.object_id;
       }
     }
@@ -75,9 +76,10 @@ void GodObject::reset() {
   session_starting_ = false;
 }
 
-void GodObject::begin_finger_session() {
+void GodObject::begin_finger_session(const Eigen::Vector3d& finger_m) {
   reset();
   session_starting_ = true;
+  session_start_finger_m_ = finger_m;
 }
 
 }  // namespace impetus

@@ -36,9 +36,10 @@ class GodObject {
   // No contact memory (device detached, session restart).
   void reset();
 
-  // The finger has just become known (first valid device reading after none): the next solve that sees planes
-  // disarms those the finger is behind.
-  void begin_finger_session();
+  // The finger has just become known at `finger_m` (first valid device reading after none): the next solve that sees
+  // planes disarms those of resting objects that both this starting position and the current finger are behind —
+  // the finger was inside from the start, not driven in while the first world frame was on its way.
+  void begin_finger_session(const Eigen::Vector3d& finger_m);
 
   // Planes currently disarmed because the finger started behind them.
   int disarmed_count() const { return disarmed_count_; }
@@ -53,6 +54,7 @@ class GodObject {
   FrictionAnchor anchor_;
   GodObjectResult result_;
   bool session_starting_ = false;
+  Eigen::Vector3d session_start_finger_m_ = Eigen::Vector3d::Zero();
   std::array<std::int32_t, kMaxPlanes> disarmed_ids_{};
   int disarmed_count_ = 0;
   PlaneSet armed_;

@@ -133,7 +133,7 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
   }
   const Eigen::Vector3d finger_velocity_mps =
       finger_known_ && dt_s > 0.0 ? Eigen::Vector3d((finger_m - finger_m_) / dt_s) : Eigen::Vector3d::Zero();
-  if (!finger_known_) god_object_.begin_finger_session();  // a finger that appears inside an object is not kicked
+  if (!finger_known_) god_object_.begin_finger_session(finger_m);  // a finger that appears inside an object is not kicked
   finger_m_ = finger_m;
   finger_known_ = true;
   result_.finger_m = to_vec3(finger_m);

@@ -128,6 +128,17 @@ TEST_CASE("servo: a finger that appears inside an object is not kicked out until
   REQUIRE(back_in.active_planes == 1);
   REQUIRE(back_in.force_N[2] > 0.0);
 
+  // A finger that starts outside and is inside when the first planes arrive was driven in: it is pushed out.
+  {
+    HapticServo late(options, 6);
+    const DeviceState approaching = device_at(kinematics, Vector3d(0.0, 0.0, 0.08));
+    late.tick(&approaching, 0.001, 1e-3);  // no world frame yet
+    late.on_plane_frame(cube_on_floor(0), 0.002);
+    const TickResult& pushed = late.tick(&inside, 0.003, 1e-3);
+    REQUIRE(pushed.active_planes == 1);
+    REQUIRE(pushed.force_N[2] > 0.0);
+  }
+
   // The device goes away and comes back with the finger inside: disarmed again, no kick.
   servo.tick(nullptr, 0.023, 1e-3);
   const TickResult& reattached = servo.tick(&inside, 0.024, 1e-3);
