@@ -41,7 +41,8 @@ Segment<Layout> open_when_ready(const std::string& name, double timeout_s) {
                                  message.find("too small for a header") != std::string::npos;
       if (!not_there_yet || std::chrono::steady_clock::now() > give_up || g_stop_requested.load()) throw;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    // 2 ms: a trial's processes start together, and the polls are what a short lockstep trial waits on.
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
 }
 

@@ -1,6 +1,7 @@
 // haptic_controller: the 1 kHz servo (DESIGN.md §1 "One haptic tick"). Creates the device port, opens the world link,
 // and runs HapticServo on the real-time clock or as the lockstep master.
 
+#include "common/csv_line.h"
 #include "common/daemon.h"
 #include "common/device_port.h"
 #include "common/link_names.h"
@@ -71,18 +72,11 @@ constexpr const char* kLogHeader =
     "weight,lateness_ns,active_planes,flags";
 
 void format_row(std::ostream& out, const HapticLogRow& row) {
-  char line[640];
-  // %.17g: every double round-trips exactly, so logs of two lockstep runs compare byte for byte and impulse totals
-  // can be checked for exact conservation.
-  std::snprintf(line, sizeof line,
-                "%.17g,%llu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
-                "%.17g,%.17g,%lld,%d,%u\n",
-                row.time_s, static_cast<unsigned long long>(row.tick), row.finger_m[0], row.finger_m[1],
-                row.finger_m[2], row.proxy_m[0], row.proxy_m[1], row.proxy_m[2], row.force_N[0], row.force_N[1],
-                row.force_N[2], row.object_impulse_Ns[0], row.object_impulse_Ns[1], row.object_impulse_Ns[2],
-                row.static_impulse_Ns[0], row.static_impulse_Ns[1], row.static_impulse_Ns[2],
-                row.interpolation_weight, static_cast<long long>(row.lateness_ns), row.active_planes, row.flags);
-  out << line;
+  CsvLine line(out);
+  line.number(row.time_s).integer(static_cast<std::int64_t>(row.tick));
+  line.numbers(row.finger_m).numbers(row.proxy_m).numbers(row.force_N);
+  line.numbers(row.object_impulse_Ns).numbers(row.static_impulse_Ns);
+  line.number(row.interpolation_weight).integer(row.lateness_ns).integer(row.active_planes).integer(row.flags);
 }
 
 std::uint64_t make_session() {

@@ -1,5 +1,7 @@
 #include "spidar_sim/device_sim.h"
 
+#include "common/csv_line.h"
+
 #include <cmath>
 #include <iomanip>
 #include <stdexcept>
@@ -8,12 +10,6 @@
 
 namespace impetus {
 
-namespace {
-
-// Log precision: 1e-9 m resolves a fraction of an encoder count (1.7e-5 m) and a nanonewton of force.
-constexpr int kLogSignificantDigits = 10;
-
-}  // namespace
 
 DeviceSim::DeviceSim(const SpidarGeometry& geometry, HardwareParams hardware, FingerParams finger,
                      Trajectory trajectory)
@@ -49,17 +45,10 @@ void DeviceSim::write_log_header(std::ostream& out) {
 }
 
 void DeviceSim::write_log_row(std::ostream& out) const {
-  const auto old_precision = out.precision(kLogSignificantDigits);
-  const auto write3 = [&out](const Vec3& v) { out << ',' << v[0] << ',' << v[1] << ',' << v[2]; };
-  out << time_s_;
-  write3(target_m());
-  write3(finger_m());
-  write3(finger_velocity_mps());
-  write3(device_force_N());
-  for (const double t : tensions_N()) out << ',' << t;
-  for (const std::int64_t c : encoder_counts()) out << ',' << c;
-  out << '\n';
-  out.precision(old_precision);
+  CsvLine line(out);
+  line.number(time_s_).numbers(target_m()).numbers(finger_m()).numbers(finger_velocity_mps()).numbers(device_force_N());
+  for (const double t : tensions_N()) line.number(t);
+  for (const std::int64_t c : encoder_counts()) line.integer(c);
 }
 
 }  // namespace impetus
