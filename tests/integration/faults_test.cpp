@@ -48,6 +48,14 @@ Daemons make_daemons(const std::string& name) {
   return daemons;
 }
 
+// Ends a trial as run.sh and a user do: SIGTERM to the haptic controller, then to the world; both must exit 0.
+void stop_like_a_user(pid_t haptic, pid_t world) {
+  kill(haptic, SIGTERM);
+  CHECK(test::wait_for(haptic, 10.0) == 0);
+  kill(world, SIGTERM);
+  CHECK(test::wait_for(world, 10.0) == 0);
+}
+
 void sleep_s(double seconds) { std::this_thread::sleep_for(std::chrono::duration<double>(seconds)); }
 
 // Pressing down on the cube's top face (z = 0.05) 1 cm deep: the finger stays in contact for the whole hold.
@@ -66,10 +74,7 @@ TEST_CASE("killing the world manager mid-contact: the haptic controller keeps th
   sleep_s(0.5);  // ten world periods without a world: the servo must call its planes stale and keep them
   world = daemons.world("2");
   CHECK(test::wait_for(device, 30.0) == 0);
-  kill(haptic, SIGTERM);
-  CHECK(test::wait_for(haptic, 10.0) == 0);
-  kill(world, SIGTERM);
-  CHECK(test::wait_for(world, 10.0) == 0);
+  stop_like_a_user(haptic, world);
   INFO(test::read_text(daemons.dir / "haptic.out"));
 
   const auto summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
@@ -98,10 +103,7 @@ TEST_CASE("killing the haptic controller: the world keeps stepping and a restart
   haptic = daemons.haptic("2");
   const pid_t device2 = daemons.device("2", kPress + "1");
   CHECK(test::wait_for(device2, 30.0) == 0);
-  kill(haptic, SIGTERM);
-  CHECK(test::wait_for(haptic, 10.0) == 0);
-  kill(world, SIGTERM);
-  CHECK(test::wait_for(world, 10.0) == 0);
+  stop_like_a_user(haptic, world);
 
   // If the restarted counter were subtracted from the old baseline, the cube would be launched upward by several
   // N·s; pressed down onto the floor it must instead never rise above its resting height (plus ODE's contact slack).
@@ -128,10 +130,7 @@ TEST_CASE("killing spidar_sim: minimum tension is commanded and a new device att
   const pid_t device2 = daemons.device("2", kPress + "0.5");
   CHECK(test::wait_for(device2, 30.0) == 0);
   CHECK_THAT(test::read_text(daemons.dir / "device2.out"), Catch::Contains("attached"));
-  kill(haptic, SIGTERM);
-  CHECK(test::wait_for(haptic, 10.0) == 0);
-  kill(world, SIGTERM);
-  CHECK(test::wait_for(world, 10.0) == 0);
+  stop_like_a_user(haptic, world);
   const auto summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
   CHECK(summary["no_device_ticks"].get<int>() > 0);  // the gap between the two devices: no device, no force
   CHECK(summary["faults"] == 0);
@@ -161,10 +160,7 @@ TEST_CASE("random bytes written into a live world link are rejected and counted 
     }
   }
   CHECK(test::wait_for(device, 30.0) == 0);
-  kill(haptic, SIGTERM);
-  CHECK(test::wait_for(haptic, 10.0) == 0);
-  kill(world, SIGTERM);
-  CHECK(test::wait_for(world, 10.0) == 0);
+  stop_like_a_user(haptic, world);
   const auto haptic_summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
   const auto world_summary = test::read_json(daemons.dir / "world.json")["world"];
   CHECK(haptic_summary["rejected_frames"].get<int>() + world_summary["rejected_reports"].get<int>() > 0);
