@@ -42,6 +42,7 @@ const char* to_string(FrameError error) {
     case FrameError::bad_period: return "world period is not positive";
     case FrameError::bad_coupling: return "unknown coupling";
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
+    case FrameError::bad_reach: return "reach radius is negative";
   }
   return "unknown frame error";
 }
@@ -55,11 +56,12 @@ FrameError validate(const PlaneFrame& frame) {
   if (frame.checksum != frame_checksum(frame)) return FrameError::checksum;
   if (frame.plane_count > kMaxPlanes) return FrameError::count_out_of_range;
   if (!finite(frame.world_time_s) || !finite(frame.stiffness_Npm) || !finite(frame.damping_Nspm) ||
-      !all_finite(frame.gravity_mps2) || !finite(frame.world_substep_s)) {
+      !all_finite(frame.gravity_mps2) || !finite(frame.world_substep_s) || !finite(frame.reach_radius_m)) {
     return FrameError::not_finite;
   }
   if (!(frame.world_period_s > 0.0) || !finite(frame.world_period_s)) return FrameError::bad_period;
   if (frame.world_substep_s < 0.0) return FrameError::bad_period;
+  if (frame.reach_radius_m < 0.0) return FrameError::bad_reach;
   if (static_cast<std::uint32_t>(frame.coupling) > static_cast<std::uint32_t>(Coupling::local)) {
     return FrameError::bad_coupling;
   }

@@ -75,6 +75,10 @@ struct PlaneFrame {
   // haptic side's local model integrates the drift (gravity, supports, friction) on the same grid as the world.
   Vec3 gravity_mps2{};
   double world_substep_s = 0.0;  // 0: unknown (the model then applies the drift every tick)
+  // The scene's base reach radius: the world sent every object within it of the proxy, and nothing says what lies
+  // beyond, so the planes describe the world only that far (the god-object's bound on a meaningful solution).
+  // 0: unknown, no bound.
+  double reach_radius_m = 0.0;
   std::array<Plane, kMaxPlanes> planes{};
   std::uint64_t checksum = 0;  // frame_checksum() of everything above; set by the writer
 };
@@ -148,6 +152,7 @@ enum class FrameError : std::uint32_t {
   bad_period,
   bad_coupling,
   bad_friction,
+  bad_reach,
 };
 const char* to_string(FrameError error);
 

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 
 namespace impetus {
 
@@ -36,6 +37,9 @@ struct ContactPlane {
 struct PlaneSet {
   std::array<ContactPlane, kMaxPlanes> planes{};
   std::uint32_t count = 0;
+  // How far from the finger the planes describe the world (the frame's reach radius): the world sent every object
+  // within it, so a proxy the planes place farther away may lie inside an object nobody sent (proxy_projection.h).
+  double valid_within_m = std::numeric_limits<double>::infinity();
 };
 
 // Conversion of one world plane, unchanged.

@@ -43,6 +43,7 @@ const PlaneSet& GodObject::armed_planes(const PlaneSet& planes, const Eigen::Vec
   if (disarmed_count_ == 0) return planes;
 
   armed_.count = 0;
+  armed_.valid_within_m = planes.valid_within_m;
   for (std::uint32_t k = 0; k < planes.count; ++k) {
     bool disarmed = false;
     for (int d = 0; d < disarmed_count_; ++d) disarmed = disarmed || planes.planes[k].object_id == disarmed_ids_[d];

@@ -119,6 +119,14 @@ ProxySolution project_outside_planes(const PlaneSet& planes, const Eigen::Vector
         return s;
       }
       const double t = std::min(t_dual, t_primal);
+      const bool adds = independent && t_primal <= t_dual;
+      if (adds && s.active_count > 0 && (s.proxy_m + t * z - goal_m).norm() > planes.valid_within_m) {
+        // The point where p meets the active planes lies beyond the planes' validity: nearly opposed faces that
+        // overlap (a pinch) cross only far along their wedge, δ/sin θ away (0.1 mm at 3e-5 rad is 5 m). Sliding the
+        // proxy there would spring the finger sideways at the device's limit for energy nobody put in.
+        settle_infeasible(planes, goal_m, p, s);
+        return s;
+      }
       if (independent) s.proxy_m += t * z;
       for (int j = 0; j < s.active_count; ++j) s.active[j].multiplier_m -= t * r[j];
       up += t;

@@ -22,6 +22,9 @@
 //    two overlapping opposite planes). `infeasible` is set; the conflicting plane is listed as a fourth (or further)
 //    active constraint, and multipliers become the depth of the goal behind each listed plane, so the reaction still
 //    goes to the objects that pinch. Always finite for finite input.
+//  * Locally infeasible sets: nearly opposed planes that overlap do meet, but δ/sin θ along their wedge. A plane whose
+//    meeting point with the active ones lies farther than planes.valid_within_m from the goal (beyond what the world
+//    looked at) conflicts with them exactly as an opposite parallel plane does: same compromise, same flag.
 
 #include "haptic_controller/contact_plane.h"
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace impetus {
 namespace {
@@ -162,6 +163,8 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
   result_.interpolation_weight = w;
 
   // 3. Proxy D_j (god-object with friction).
+  planes_.valid_within_m =
+      current_frame_.reach_radius_m > 0.0 ? current_frame_.reach_radius_m : std::numeric_limits<double>::infinity();
   const GodObjectResult& contact = god_object_.solve(planes_, finger_m, dt_s);
   if (!contact.contact.proxy_m.allFinite()) {  // only a non-finite plane could do this; frames are validated upstream
     ++counters_.faults;

@@ -235,6 +235,7 @@ World::World(const Scene& scene, const WorldOptions& options)
   frame_.coupling = options_.coupling;
   frame_.gravity_mps2 = scene_.gravity_mps2;
   frame_.world_substep_s = ode.substep_s;
+  frame_.reach_radius_m = scene_.haptic.reach_radius_m;
 }
 
 World::~World() = default;

@@ -171,6 +171,72 @@ TEST_CASE("pinched between two objects whose planes overlap: midpoint, flagged, 
   REQUIRE(s.active[1].multiplier_m > 0.0);
 }
 
+TEST_CASE("nearly opposed planes that overlap meet far away: beyond the planes' reach it is a pinch") {
+  // Hard case 5 in numbers: a static face at x = -5 mm facing +x, a slider's face 0.14 mm past it facing −x, turned
+  // by 3e-5 rad about z. The half-spaces do meet, δ/sin θ ≈ 4.7 m away along y.
+  const double angle = 3e-5;
+  PlaneSet planes = make_set({make_plane({-0.005, 0, 0}, {1, 0, 0}, 1),
+                              make_plane({-0.00514, 0, 0}, {-std::cos(angle), std::sin(angle), 0}, 2)});
+  const Vector3d finger(-0.0045, 0.0, 0.0);
+
+  const ProxySolution unbounded = project_outside_planes(planes, finger);
+  REQUIRE(!unbounded.infeasible);
+  require_kkt(planes, finger, unbounded);
+  REQUIRE((unbounded.proxy_m - finger).norm() > 1.0);
+
+  planes.valid_within_m = 0.05;
+  const ProxySolution s = project_outside_planes(planes, finger);
+  REQUIRE(s.infeasible);
+  REQUIRE(s.proxy_m.x() == Approx(-0.00507).margin(1e-7));  // the midpoint of the overlap
+  REQUIRE(std::abs(s.proxy_m.y()) < 1e-7);
+  // Both faces are listed; the finger is behind the slider's only, by 0.64 mm, so the slider takes the reaction.
+  REQUIRE(s.active_count == 2);
+  for (int j = 0; j < 2; ++j) {
+    const ActiveConstraint& c = s.active[j];
+    REQUIRE(c.multiplier_m == Approx(planes.planes[c.plane].object_id == 2 ? 0.00064 : 0.0).margin(1e-9));
+  }
+}
+
+TEST_CASE("a wedge whose crossing is within the planes' reach is solved exactly, bound or not") {
+  // A 90° groove: the finger pressed 10 mm into it ends at the groove's edge line, 10 mm away.
+  PlaneSet planes = make_set({make_plane({0, 0, 0}, Vector3d(1, 0, 1).normalized(), 1),
+                              make_plane({0, 0, 0}, Vector3d(-1, 0, 1).normalized(), 2)});
+  const Vector3d finger(0.001, 0.0, -0.01);
+  planes.valid_within_m = 0.05;
+  const ProxySolution s = project_outside_planes(planes, finger);
+  REQUIRE(!s.infeasible);
+  REQUIRE(s.active_count == 2);
+  REQUIRE(s.proxy_m.norm() < 1e-12);
+  require_kkt(planes, finger, s);
+}
+
+TEST_CASE("random plane sets under a reach bound: the exact projection, or a pinch whose projection is out of reach") {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> gauss;
+  std::uniform_real_distribution<double> uniform(-0.02, 0.02);
+  int pinched = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    PlaneSet planes;
+    const int n = 2 + trial % 4;
+    for (int k = 0; k < n; ++k) {
+      planes.planes[planes.count++] = make_plane(Vector3d(uniform(rng), uniform(rng), uniform(rng)),
+                                                 Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized(), k);
+    }
+    const Vector3d finger(uniform(rng), uniform(rng), uniform(rng));
+    const ProxySolution unbounded = project_outside_planes(planes, finger);
+    planes.valid_within_m = 0.03;
+    const ProxySolution bounded = project_outside_planes(planes, finger);
+    REQUIRE(bounded.proxy_m.allFinite());
+    if (bounded.infeasible && !unbounded.infeasible) {
+      ++pinched;
+      REQUIRE((unbounded.proxy_m - finger).norm() > planes.valid_within_m);
+    } else if (!unbounded.infeasible) {
+      REQUIRE((bounded.proxy_m - unbounded.proxy_m).norm() < 1e-12);
+    }
+  }
+  REQUIRE(pinched > 0);  // the sample reaches the case it is about
+}
+
 TEST_CASE("four inward-facing planes enclose nothing: defined, finite proxy") {
   // Faces of a tetrahedron with normals pointing inward: the intersection of the half-spaces is empty.
   const Vector3d corners[4] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
