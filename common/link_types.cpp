@@ -42,7 +42,7 @@ const char* to_string(FrameError error) {
     case FrameError::bad_period: return "world period is not positive";
     case FrameError::bad_coupling: return "unknown coupling";
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
-    case FrameError::bad_reach: return "reach radius is negative";
+    case FrameError::bad_reach: return "reach radius or plane extent is negative";
   }
   return "unknown frame error";
 }
@@ -69,9 +69,11 @@ FrameError validate(const PlaneFrame& frame) {
     const Plane& plane = frame.planes[k];
     if (!all_finite(plane.point_m) || !all_finite(plane.normal) || !all_finite(plane.com_m) ||
         !all_finite(plane.velocity_mps) || !all_finite(plane.angular_velocity_radps) ||
-        !finite(plane.static_friction) || !finite(plane.dynamic_friction) || !finite(plane.inverse_mass_per_kg)) {
+        !finite(plane.static_friction) || !finite(plane.dynamic_friction) || !finite(plane.inverse_mass_per_kg) ||
+        !finite(plane.extent_m)) {
       return FrameError::not_finite;
     }
+    if (plane.extent_m < 0.0) return FrameError::bad_reach;
     for (double value : plane.inverse_inertia_world) {
       if (!finite(value)) return FrameError::not_finite;
     }

@@ -25,13 +25,23 @@ inline constexpr std::uint32_t kMaxLocalContacts = 4;
 
 // Plane flags.
 inline constexpr std::uint32_t kPlaneDynamic = 1u << 0;  // the object moves; impulses on it are applied by the world
+// A sphere's tangent plane: the centre is point_m − extent_m·normal and the radius extent_m. The haptic side takes the
+// tangent plane again at its proxy every tick (haptic_controller/sphere_planes.h), as the world does every step.
+inline constexpr std::uint32_t kPlaneSphere = 1u << 1;
+
+// LocalContact flags.
+// The other side holds a push along −normal: static geometry, or a body joined to static geometry by a chain of
+// contacts that each take the push within their friction cone (world_manager/contact_graph.h). Without it the
+// contact carries the object's weight in the local model but gives way to the finger's push.
+inline constexpr std::uint32_t kContactHolds = 1u << 0;
 
 // One contact of a dynamic object with the rest of the world, as the world saw it in its last substep: a unilateral
-// constraint for the haptic side's local model (haptic_controller/local_dynamics.h). Contacts with a movable body are
-// treated as immovable there: the model then under-predicts the motion, which is the safe (passive) error.
+// constraint for the haptic side's local model (haptic_controller/local_dynamics.h).
 struct LocalContact {
   Vec3 normal{};          // unit; the direction the contact pushes the object (out of the other body)
   double friction = 0.0;  // Coulomb coefficient of the pair, dimensionless, >= 0
+  std::uint32_t flags = 0;     // kContactHolds
+  std::uint32_t reserved = 0;  // keeps the layout in whole 64-bit words (checksum)
 };
 
 // One plane of paper §3.1: the nearest surface point of an object to the finger and the outward normal there, plus
@@ -46,6 +56,9 @@ struct Plane {
   Vec3 angular_velocity_radps{};  // angular velocity, world frame
   double static_friction = 0.0;   // coefficient, dimensionless
   double dynamic_friction = 0.0;  // coefficient, dimensionless, <= static_friction
+  // How far from point_m the plane still describes the object (world_manager/body_geometry.h plane_extent_m): a
+  // sphere's radius, a box's diagonal. 0: unbounded (the floor).
+  double extent_m = 0.0;
   // Local response model for the coming world period (issue 9, paper §6.3). Zero means "not provided": the haptic
   // side must then treat the object as immovable between world steps.
   double inverse_mass_per_kg = 0.0;

@@ -44,6 +44,7 @@ void check_accepted(const PlaneFrame& frame) {
     FUZZ_CHECK(all_finite(plane.point_m) && all_finite(plane.normal) && all_finite(plane.com_m) &&
                all_finite(plane.velocity_mps) && all_finite(plane.angular_velocity_radps));
     FUZZ_CHECK(std::isfinite(plane.inverse_mass_per_kg));
+    FUZZ_CHECK(std::isfinite(plane.extent_m) && plane.extent_m >= 0.0);
     for (double value : plane.inverse_inertia_world) FUZZ_CHECK(std::isfinite(value));
     const double norm = std::hypot(plane.normal[0], plane.normal[1], plane.normal[2]);
     FUZZ_CHECK(std::fabs(norm - 1.0) < kUnitSlack);

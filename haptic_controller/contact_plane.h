@@ -25,12 +25,25 @@ struct ContactPlane {
   Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();
   double static_friction = 0.0;
   double dynamic_friction = 0.0;
+  double extent_m = 0.0;  // how far from point_m the plane describes its object; 0: unbounded (link_types.h)
 
   // Velocity of the object's material point at `x` (rigid body: v + ω × (x − com)).
   Eigen::Vector3d surface_velocity_mps(const Eigen::Vector3d& x_m) const {
     return velocity_mps + angular_velocity_radps.cross(x_m - com_m);
   }
   bool dynamic() const { return (flags & kPlaneDynamic) != 0; }
+  bool sphere() const { return (flags & kPlaneSphere) != 0 && extent_m > 0.0; }
+
+  // Angular impulse about the CoM of `impulse_Ns` applied by a finger at `proxy_m`. On a flat face the push acts at
+  // the proxy. On a sphere its normal part acts through the centre, so only the part along the surface (friction)
+  // turns the ball, wherever on the tangent plane the proxy sits (an edge with another plane can hold it off the
+  // tangent point, and a lever there would spin a ball pushed straight).
+  Eigen::Vector3d angular_impulse_Nms(const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& impulse_Ns) const {
+    if (!sphere()) return (proxy_m - com_m).cross(impulse_Ns);
+    const Eigen::Vector3d normal_part = impulse_Ns.dot(normal) * normal;
+    const Eigen::Vector3d centre_m = point_m - extent_m * normal;
+    return (centre_m - com_m).cross(normal_part) + (proxy_m - com_m).cross(impulse_Ns - normal_part);
+  }
 };
 
 // Fixed-capacity set, filled in place each tick.

@@ -20,6 +20,18 @@ RenderedForce ForceRenderer::render(const Eigen::Vector3d& proxy_m, const Eigen:
   }
   previous_displacement_m_ = displacement_m;
   has_previous_ = true;
+  // A contact pushes, it never pulls: the damper may brake the finger's approach and its sliding, but the force's
+  // part along the spring (D − C, the way the surface pushes) is never negative. Without this a surface that lets go
+  // of the finger (a face turning away at an edge, an object moving off) drags it along by k_d times the release
+  // speed (hard case 6: 0.5 N into a box the finger had slid off).
+  const double depth_m = displacement_m.norm();
+  if (depth_m > 0.0) {
+    const Eigen::Vector3d push = displacement_m / depth_m;
+    const double along_N = force_N.dot(push);
+    if (along_N < 0.0) force_N -= along_N * push;
+  } else {
+    force_N.setZero();
+  }
 
   const double magnitude_N = force_N.norm();
   if (magnitude_N > max_force_N_) {

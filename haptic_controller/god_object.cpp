@@ -62,7 +62,7 @@ const GodObjectResult& GodObject::solve(const PlaneSet& planes, const Eigen::Vec
   result_.sticking = friction.sticking;
   if (&armed != &planes) {
     // The caller shares the reaction by indices into its own PlaneSet.
-    for (int j = 0; j < result_.contact.active_count + (result_.contact.infeasible ? 1 : 0); ++j) {
+    for (int j = 0; j < result_.contact.active_count; ++j) {  // a pinch's conflicting plane is counted
       int& index = result_.contact.active[j].plane;
       if (index >= 0) index = armed_index_[index];
     }

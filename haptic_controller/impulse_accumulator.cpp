@@ -1,13 +1,78 @@
 #include "haptic_controller/impulse_accumulator.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace impetus {
 namespace {
+
+// √3 plus rounding: the largest Σ|c_k|/|J| of a split over pairwise perpendicular normals (split_by_normals).
+constexpr double kMaxSplitRatio = 1.7320508075688772 * (1.0 + 1e-9);
 
 void add_to(Vec3& total, const Eigen::Vector3d& delta) {
   for (int a = 0; a < 3; ++a) total[a] += delta[a];
 }
 
+// The reaction's part along each listed plane's normal (see add()).
+std::array<Eigen::Vector3d, kMaxActiveConstraints + 1> split_by_normals(const PlaneSet& planes,
+                                                                         const ProxySolution& contact,
+                                                                         const Eigen::Vector3d& reaction_Ns) {
+  std::array<Eigen::Vector3d, kMaxActiveConstraints + 1> parts{};
+  for (Eigen::Vector3d& part : parts) part.setZero();
+  // The normal components, over the independent active planes (a pinch's conflicting plane, listed last, depends on
+  // them and takes no normal part), by least squares with c_k ≥ 0: a plane pushes, it never pulls.
+  const int independent = std::min(contact.active_count - (contact.infeasible ? 1 : 0), kMaxActiveConstraints);
+  std::array<bool, kMaxActiveConstraints> used{};
+  for (int j = 0; j < independent; ++j) used[static_cast<std::size_t>(j)] = true;
+  for (int round = 0; round < kMaxActiveConstraints; ++round) {
+    Eigen::Matrix3d normals = Eigen::Matrix3d::Zero();
+    std::array<int, kMaxActiveConstraints> column_of{};
+    int columns = 0;
+    for (int j = 0; j < independent; ++j) {
+      if (!used[static_cast<std::size_t>(j)]) continue;
+      column_of[static_cast<std::size_t>(columns)] = j;
+      normals.col(columns++) = planes.planes[static_cast<std::size_t>(contact.active[j].plane)].normal;
+    }
+    for (Eigen::Vector3d& part : parts) part.setZero();
+    if (columns == 0) break;
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    const Eigen::Matrix3d gram = normals.transpose() * normals;
+    if (columns == 1) {
+      c[0] = normals.col(0).dot(reaction_Ns) / gram(0, 0);
+    } else if (columns == 2) {
+      c.head<2>() = gram.topLeftCorner<2, 2>().inverse() * (normals.leftCols<2>().transpose() * reaction_Ns);
+    } else {
+      c = gram.inverse() * (normals.transpose() * reaction_Ns);
+    }
+    // The reaction pushes object k along −n_k: c_k ≤ 0 is a push, c_k > 0 would be a pull.
+    bool all_push = true;
+    for (int q = 0; q < columns; ++q) {
+      if (c[q] > 0.0 || !std::isfinite(c[q])) {
+        used[static_cast<std::size_t>(column_of[static_cast<std::size_t>(q)])] = false;
+        all_push = false;
+      }
+    }
+    if (!all_push) continue;
+    // Normals at most 90° apart (a box's corner, a wall on the floor) split any reaction with Σ|c_k| ≤ √3·|J|. More
+    // than that means planes facing each other, and the excess is a squeeze: pushes that cancel on the finger and
+    // only drive the objects apart, by an amount the ill-conditioned split makes up (two nearly opposed balls' planes
+    // gave 0.06 N·s each for a 3 mN·s reaction). No split then: the multipliers share the reaction as it is.
+    double total = 0.0;
+    for (int q = 0; q < columns; ++q) total -= c[q];
+    if (!(total <= kMaxSplitRatio * reaction_Ns.norm())) {
+      for (Eigen::Vector3d& part : parts) part.setZero();
+      break;
+    }
+    for (int q = 0; q < columns; ++q) {
+      parts[static_cast<std::size_t>(column_of[static_cast<std::size_t>(q)])] = c[q] * normals.col(q);
+    }
+    break;
+  }
+  return parts;
+}
+
 }  // namespace
+
 
 ImpulseAccumulator::ImpulseAccumulator(std::uint64_t haptic_session) { report_.haptic_session = haptic_session; }
 
@@ -38,6 +103,7 @@ ObjectImpulse* ImpulseAccumulator::entry_for(std::int32_t object_id) {
   return slot;
 }
 
+
 void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contact,
                              const Eigen::Vector3d& force_on_finger_N, double dt_s, std::uint64_t tick) {
   const Eigen::Vector3d reaction_Ns = -force_on_finger_N * dt_s;  // paper §3.4: the user's push on the world
@@ -45,19 +111,26 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
   last_share_count_ = 0;
   if (reaction_Ns.isZero(0.0)) return;  // nothing to share (and no multiplier is trusted when the force was zeroed)
 
-  double weight_sum = 0.0;
-  for (int j = 0; j < contact.active_count; ++j) weight_sum += contact.active[j].multiplier_m;
-  if (contact.active_count == 0) {
+  const int listed = std::min(contact.active_count, kMaxActiveConstraints + 1);  // with a pinch's conflicting plane
+  if (listed <= 0) {
     dropped_Ns_ += reaction_Ns;
     ++dropped_shares_;
     return;
   }
-  for (int j = 0; j < contact.active_count; ++j) {
-    // Multipliers share the load; if all are zero (touching with no load) share equally.
-    const double share = weight_sum > 0.0 ? contact.active[j].multiplier_m / weight_sum : 1.0 / contact.active_count;
-    const Eigen::Vector3d impulse_Ns = share * reaction_Ns;
+  // Each object is pushed along its own normal by its part of the reaction; what lies in no normal (friction along
+  // the surface) is shared by the multipliers (header).
+  const std::array<Eigen::Vector3d, kMaxActiveConstraints + 1> normal_parts =
+      split_by_normals(planes, contact, reaction_Ns);
+  Eigen::Vector3d remainder_Ns = reaction_Ns;
+  for (int j = 0; j < listed; ++j) remainder_Ns -= normal_parts[static_cast<std::size_t>(j)];
+  double weight_sum = 0.0;
+  for (int j = 0; j < listed; ++j) weight_sum += contact.active[j].multiplier_m;
+  for (int j = 0; j < listed; ++j) {
+    // Multipliers share the remainder; if all are zero (touching with no load) share equally.
+    const double share = weight_sum > 0.0 ? contact.active[j].multiplier_m / weight_sum : 1.0 / listed;
+    const Eigen::Vector3d impulse_Ns = normal_parts[static_cast<std::size_t>(j)] + share * remainder_Ns;
     const ContactPlane& plane = planes.planes[contact.active[j].plane];
-    const Eigen::Vector3d angular_Nms = (contact.proxy_m - plane.com_m).cross(impulse_Ns);
+    const Eigen::Vector3d angular_Nms = plane.angular_impulse_Nms(contact.proxy_m, impulse_Ns);
     last_shares_[static_cast<std::size_t>(last_share_count_++)] = {plane.object_id, plane.dynamic(), impulse_Ns,
                                                                    angular_Nms};
     if (!plane.dynamic()) {

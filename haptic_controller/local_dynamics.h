@@ -12,11 +12,13 @@
 //   same grid and with the same symplectic Euler as ODE, so a sliding object ends the period where the world puts it
 //   (friction applied every 1 ms instead of every 5 ms would differ by a·T_w·(h − Δt)/2 ≈ 0.06 mm per period):
 //     v ← v + g·h                                               drift: gravity ...
-//     for each contact n (unilateral, the other side immovable):  ... the supports ...
+//     for each contact n (unilateral):                          ... the supports ...
 //       P = max(0, −v·n);  v ← v + P·n                          (normal impulse per unit mass)
+//       a loose contact (no kContactHolds: a neighbour that can give way, world_manager/contact_graph.h) takes at
+//       most the weight it carries, P ≤ max(0, −g·n)·h: it holds the body up but yields to the finger's push
 //       v_t = v − (v·n)·n;  v ← v − min(|v_t|, μ·P)·v_t/|v_t|   ... and their Coulomb friction (cube on a floor:
 //                                                                μ·g·Δt of speed per tick, as in the world)
-//     ω restricted to spin about a single support's normal (no tipping or rolling locally; 0 with 2+ supports)
+//     ω free (supports act on v only: a rolling ball keeps its spin; a box's tipping is over-predicted, passively)
 //   each tick, before the planes are rendered:
 //     u ← u + v·Δt                                              CoM displacement since the frame
 //   after the force of the tick (§3.4 share J, angular share L about the CoM):
@@ -55,6 +57,7 @@
 
 #include "common/link_types.h"
 #include "haptic_controller/contact_plane.h"
+#include "haptic_controller/proxy_projection.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -74,6 +77,7 @@ struct LocalBody {
   Eigen::Vector3d displacement_m = Eigen::Vector3d::Zero();          // u, of the CoM since the frame
   std::array<Eigen::Vector3d, kMaxLocalContacts> contact_normal{};
   std::array<double, kMaxLocalContacts> contact_friction{};
+  std::array<bool, kMaxLocalContacts> contact_holds{};  // kContactHolds: the other side holds the finger's push
   std::uint32_t contact_count = 0;
   bool touched = false;       // the finger pushed it in the last tick
   Eigen::Vector3d pushed_Ns = Eigen::Vector3d::Zero();  // Σ J since the frame (diagnostics, tests)
@@ -101,6 +105,18 @@ class LocalDynamics {
   // model's. `proxy_m` is the last tick's proxy (the passivity bound of the blend). Clears the bodies' touched flags
   // (apply_impulse sets them again).
   void render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& out);
+
+  // The share of the explicit contact force the touched bodies can take within one tick (implicit contact, ≤ 1).
+  // The force k·d + b·ḋ assumes the objects stand still during the tick, but a body of mass m gives way by f·Δt²/m
+  // within it, and the model applies the reaction only after the tick. The error e of the finger–body contact then
+  // follows e_{j+1} = (1 − a − c)·e_j + c·e_{j−1}, a = kΔt²/m, c = bΔt/m, which has a root below −1 once m is under
+  // about bΔt + kΔt²/2 (6 g at 2 kN/m, 5 N·s/m, 1 kHz): the force flips sign every tick and pumps energy into the
+  // object (hard case 10's 3 g balls). Solving the tick implicitly, f = (k·d + b·ḋ)/(1 + a + c), keeps both roots
+  // inside the unit circle for any mass; on a 1 kg body it lowers the force by 0.7 %. 1/m is the contact's effective
+  // inverse mass along `force_N` at the proxy (translation and rotation), the touched bodies' weighted by their shares
+  // of the reaction (static planes: 0).
+  double yield_scale(const PlaneSet& planes, const ProxySolution& contact, const Eigen::Vector3d& force_N,
+                     double stiffness_Npm, double damping_Nspm, double dt_s) const;
 
   const LocalBody* find(std::int32_t object_id) const;
   std::uint32_t body_count() const { return body_count_; }

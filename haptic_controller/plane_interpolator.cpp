@@ -37,6 +37,7 @@ ContactPlane to_contact_plane(const Plane& plane) {
   out.angular_velocity_radps = to_eigen(plane.angular_velocity_radps);
   out.static_friction = plane.static_friction;
   out.dynamic_friction = plane.dynamic_friction;
+  out.extent_m = plane.extent_m;
   return out;
 }
 
@@ -46,7 +47,8 @@ double interpolation_weight(double now_s, double frame_arrival_s, double world_p
   return std::clamp(w, 0.0, 1.0);
 }
 
-void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, double w, PlaneSet& out) {
+void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, double w,
+                        const Eigen::Vector3d& pivot_m, PlaneSet& out) {
   w = std::isfinite(w) ? std::clamp(w, 0.0, 1.0) : 1.0;
   const std::uint32_t count = std::min(current.plane_count, kMaxPlanes);
   out.count = count;
@@ -69,10 +71,23 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, d
       }
       continue;
     }
-    plane.point_m = lerp(before.point_m, now.point_m, w);
     plane.com_m = lerp(before.com_m, now.com_m, w);
     const Eigen::Vector3d normal = lerp(before.normal, now.normal, w);
     plane.normal = normal / normal.norm();  // |normal| ≥ 1/√2 for unit inputs with dot ≥ 0
+    if (plane.sphere()) {
+      // A sphere: its centre moves between the frames, its tangent plane is taken again at the proxy (sphere_planes.h).
+      const double radius_m = plane.extent_m;
+      const Eigen::Vector3d centre_before = to_eigen(before.point_m) - radius_m * to_eigen(before.normal);
+      const Eigen::Vector3d centre_now = to_eigen(now.point_m) - radius_m * to_eigen(now.normal);
+      plane.point_m = (1.0 - w) * centre_before + w * centre_now + radius_m * plane.normal;
+      continue;
+    }
+    // The plane's offset at the pivot moves linearly from frame i−1's to frame i's (header).
+    const Eigen::Vector3d point = lerp(before.point_m, now.point_m, w);
+    const double offset_before = to_eigen(before.normal).dot(pivot_m - to_eigen(before.point_m));
+    const double offset_now = to_eigen(now.normal).dot(pivot_m - to_eigen(now.point_m));
+    const double offset = (1.0 - w) * offset_before + w * offset_now;
+    plane.point_m = point + (plane.normal.dot(pivot_m - point) - offset) * plane.normal;
   }
 }
 

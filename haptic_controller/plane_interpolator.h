@@ -13,6 +13,13 @@
 //    i−1's to frame i's at the midpoint, w ≥ ½. For dot ≥ 0 the blended normal has length ≥ 1/√2, never near zero.
 //  * The centre of mass is interpolated like the point; velocities, friction and flags are frame i's (the newest
 //    state the world has sent, §6.2).
+//  * Where the normal turns, the plane turns about the pivot (the last proxy), not about its point: its signed
+//    distance from the pivot moves linearly, d(w) = (1 − w)·d_{i−1} + w·d_i, and the point slides along the new normal
+//    to match (keeping its place along the surface). Turning about a point 15 mm from the finger (a box's top face
+//    whose next frame is the edge the finger slid past) drops the plane 0.3 mm at the finger in one tick, and the
+//    damper turns that into a pull on the finger (hard case 6). For planes that do not turn this is the paper's rule.
+//  * A sphere's plane (kPlaneSphere) interpolates the centre instead; the servo then takes the tangent plane at the
+//    proxy (sphere_planes.h).
 
 #include "common/link_types.h"
 #include "haptic_controller/contact_plane.h"
@@ -22,8 +29,9 @@ namespace impetus {
 // w = (now − arrival of frame i) / T_w, clamped to [0, 1]; 1 if the period is not positive or anything is NaN.
 double interpolation_weight(double now_s, double frame_arrival_s, double world_period_s);
 
-// Fills `out` with frame i's planes interpolated at weight w from frame i−1. `previous` may be the same object as
-// `current` (first frame of a session). Allocation-free.
-void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, double w, PlaneSet& out);
+// Fills `out` with frame i's planes interpolated at weight w from frame i−1, turning about `pivot_m` (the last proxy).
+// `previous` may be the same object as `current` (first frame of a session). Allocation-free.
+void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, double w, const Eigen::Vector3d& pivot_m,
+                        PlaneSet& out);
 
 }  // namespace impetus

@@ -58,6 +58,30 @@ void drop(ProxySolution& s, int j) {
   --s.active_count;
 }
 
+// Whether the plane describes its object at the goal: the goal's offset along the plane from the plane's point is
+// within the plane's extent (none: unbounded). Beyond it the object is not there at all (no point of a sphere of
+// radius R lies more than R from its tangent point along the tangent plane), and the finger passes beside it.
+bool beside_or_on(const ContactPlane& plane, const Eigen::Vector3d& goal) {
+  if (!(plane.extent_m > 0.0)) return true;
+  const Eigen::Vector3d offset = goal - plane.point_m;
+  return (offset - offset.dot(plane.normal) * plane.normal).norm() <= plane.extent_m;
+}
+
+// Whether `x` is where the planes in play (the active ones and p) still describe their objects: within each plane's
+// extent of its point, and within the world's reach of the goal (header, "Locally infeasible sets").
+bool within_validity(const PlaneSet& planes, const ProxySolution& s, int p, const Eigen::Vector3d& x,
+                     const Eigen::Vector3d& goal) {
+  if ((x - goal).norm() > planes.valid_within_m) return false;
+  auto covers = [&](int k) {
+    const ContactPlane& plane = planes.planes[static_cast<std::size_t>(k)];
+    return !(plane.extent_m > 0.0) || (x - plane.point_m).norm() <= plane.extent_m;
+  };
+  for (int j = 0; j < s.active_count; ++j) {
+    if (!covers(s.active[j].plane)) return false;
+  }
+  return covers(p);
+}
+
 // The defined compromise for a conflicting plane (see header).
 void settle_infeasible(const PlaneSet& planes, const Eigen::Vector3d& goal, int conflict, ProxySolution& s) {
   const ContactPlane& plane = planes.planes[conflict];
@@ -83,7 +107,7 @@ ProxySolution project_outside_planes(const PlaneSet& planes, const Eigen::Vector
     double worst = -kFeasibilityTolerance_m;
     for (int k = 0; k < count; ++k) {
       const double sk = slack(planes.planes[k], s.proxy_m);
-      if (sk < worst) {
+      if (sk < worst && beside_or_on(planes.planes[k], goal_m)) {
         bool is_active = false;
         for (int j = 0; j < s.active_count; ++j) is_active = is_active || s.active[j].plane == k;
         if (!is_active) {
@@ -119,11 +143,11 @@ ProxySolution project_outside_planes(const PlaneSet& planes, const Eigen::Vector
         return s;
       }
       const double t = std::min(t_dual, t_primal);
-      const bool adds = independent && t_primal <= t_dual;
-      if (adds && s.active_count > 0 && (s.proxy_m + t * z - goal_m).norm() > planes.valid_within_m) {
-        // The point where p meets the active planes lies beyond the planes' validity: nearly opposed faces that
-        // overlap (a pinch) cross only far along their wedge, δ/sin θ away (0.1 mm at 3e-5 rad is 5 m). Sliding the
-        // proxy there would spring the finger sideways at the device's limit for energy nobody put in.
+      if (independent && s.active_count > 0 && !within_validity(planes, s, p, s.proxy_m + t * z, goal_m)) {
+        // The proxy would slide along the active planes to where they (or p) no longer describe their objects:
+        // nearly opposed faces that overlap (a pinch) cross only δ/sin θ away (0.1 mm at 3e-5 rad is 5 m), and the
+        // tangent planes of balls packed around the finger close a pocket whose far corner lies beside the balls,
+        // not on them. Sliding there would spring the finger sideways for energy nobody put in.
         settle_infeasible(planes, goal_m, p, s);
         return s;
       }

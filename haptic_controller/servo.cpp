@@ -1,6 +1,7 @@
 #include "haptic_controller/servo.h"
 
 #include "haptic_controller/plane_interpolator.h"
+#include "haptic_controller/sphere_planes.h"
 #include "haptic_controller/tension_distribution.h"
 
 #include <algorithm>
@@ -155,12 +156,15 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
       if (!result_.world_stale) local_.advance(dt_s);
       local_.render(w, to_eigen(result_.proxy_m), planes_);
     } else {
-      interpolate_planes(previous_frame_, current_frame_, w, planes_);
+      interpolate_planes(previous_frame_, current_frame_, w, to_eigen(result_.proxy_m), planes_);
     }
   } else {
     planes_.count = 0;
   }
   result_.interpolation_weight = w;
+
+  // Spheres' tangent planes taken again at the last proxy (sphere_planes.h).
+  retake_sphere_planes(planes_, to_eigen(result_.proxy_m));
 
   // 3. Proxy D_j (god-object with friction).
   planes_.valid_within_m =
@@ -190,6 +194,10 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
   const RenderedForce rendered =
       renderer_.render(contact.contact.proxy_m, finger_m, stiffness_Npm, damping_Nspm, dt_s);
   Eigen::Vector3d force_N = contact.contact.active_count > 0 ? rendered.force_N : Eigen::Vector3d::Zero();
+  if (have_frame_ && current_frame_.coupling == Coupling::local && contact.contact.active_count > 0) {
+    // The local model moves the touched objects: the tick is solved implicitly (local_dynamics.h yield_scale).
+    force_N *= local_.yield_scale(planes_, contact.contact, force_N, stiffness_Npm, damping_Nspm, dt_s);
+  }
   result_.fault = rendered.fault;
   if (rendered.fault) ++counters_.faults;
   if (rendered.clamped && contact.contact.active_count > 0) ++counters_.force_clamps;

@@ -91,6 +91,18 @@ SurfacePoint nearest_surface_point(const Shape& shape, const BodyPose& pose, con
   return {pose.orientation * body.point_m + pose.position_m, pose.orientation * body.normal, body.signed_distance_m};
 }
 
+double plane_extent_m(const Shape& shape) {
+  switch (shape.kind) {
+    case ShapeKind::box:
+      return to_eigen(shape.box_size_m).norm();
+    case ShapeKind::sphere:
+    case ShapeKind::capsule:
+    case ShapeKind::cylinder:
+      return shape.radius_m;
+  }
+  return 0.0;
+}
+
 Eigen::AlignedBox3d world_bounds(const Shape& shape, const BodyPose& pose) {
   const Eigen::Matrix3d rotation = pose.orientation.toRotationMatrix();
   Eigen::Vector3d half_m = Eigen::Vector3d::Zero();

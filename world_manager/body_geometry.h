@@ -33,6 +33,11 @@ SurfacePoint nearest_surface_point_body(const Shape& shape, const Eigen::Vector3
 // The same for a body in the world: query, result point and normal in the world frame.
 SurfacePoint nearest_surface_point(const Shape& shape, const BodyPose& pose, const Eigen::Vector3d& query_m);
 
+// How far from its point a plane of the shape still describes it (link_types.h Plane::extent_m): the radius of a
+// sphere, capsule or cylinder (a tangent plane one radius from its point is beside the body, no longer on it), the
+// space diagonal of a box (no two points of the box are farther apart, so a face has ended by then).
+double plane_extent_m(const Shape& shape);
+
 // Tight world-frame axis-aligned bounding box of the shape at `pose`.
 Eigen::AlignedBox3d world_bounds(const Shape& shape, const BodyPose& pose);
 

@@ -1,5 +1,7 @@
 #include "world_manager/world.h"
 
+#include "world_manager/contact_graph.h"
+
 #include <ode/ode.h>
 
 #include <algorithm>
@@ -20,9 +22,6 @@ constexpr int kMaxContactsPerPair = 8;
 // Below this approach speed a contact does not bounce: resting and sliding objects would otherwise chatter on every
 // substep's tiny penetration-correction velocity (ERP pushes at a few mm/s).
 constexpr double kBounceThreshold_mps = 0.05;
-// Two contact normals of one object closer than this (cosine) are one constraint for the local model: the four
-// corner contacts of a box resting on the floor are one support.
-constexpr double kSameContactCosine = 0.999;
 
 void* id_to_data(std::size_t id) { return reinterpret_cast<void*>(static_cast<std::uintptr_t>(id)); }
 std::size_t data_to_id(void* data) { return static_cast<std::size_t>(reinterpret_cast<std::uintptr_t>(data)); }
@@ -46,23 +45,9 @@ struct World::OdeHandles {
   std::vector<dGeomID> geoms;     // per object
   std::vector<Material> materials;  // per id, the floor last
   double substep_s = 0.0;
-  // Local coupling: contacts of each object seen in the last substep of a step (link_types.h LocalContact).
+  // Local coupling: the contacts seen in the last substep of a step (contact_graph.h).
   bool record_contacts = false;
-  std::vector<std::array<LocalContact, kMaxLocalContacts>> local_contacts;  // per object id
-  std::vector<std::uint32_t> local_contact_counts;
-
-  void record_contact(std::size_t id, const Eigen::Vector3d& normal, double friction) {
-    if (id >= local_contact_counts.size()) return;
-    std::uint32_t& count = local_contact_counts[id];
-    for (std::uint32_t c = 0; c < count; ++c) {
-      LocalContact& known = local_contacts[id][c];
-      if (to_eigen(known.normal).dot(normal) > kSameContactCosine) {
-        known.friction = std::max(known.friction, friction);
-        return;
-      }
-    }
-    if (count < kMaxLocalContacts) local_contacts[id][count++] = {to_vec3(normal), friction};
-  }
+  ContactGraph contact_graph;
 
   ~OdeHandles() {
     if (contacts != nullptr) dJointGroupDestroy(contacts);
@@ -101,8 +86,14 @@ struct World::OdeHandles {
         const dReal* n = contacts[i].geom.normal;
         const Eigen::Vector3d normal(n[0], n[1], n[2]);
         if (!(normal.squaredNorm() > 0.0) || !normal.allFinite()) continue;
-        if (body_a != nullptr) self->record_contact(data_to_id(dGeomGetData(a)), normal.normalized(), surface.mu);
-        if (body_b != nullptr) self->record_contact(data_to_id(dGeomGetData(b)), -normal.normalized(), surface.mu);
+        const auto id_a = static_cast<std::int32_t>(data_to_id(dGeomGetData(a)));
+        const auto id_b = static_cast<std::int32_t>(data_to_id(dGeomGetData(b)));
+        if (body_a != nullptr) {
+          self->contact_graph.add(id_a, body_b != nullptr ? id_b : ContactGraph::kStatic, normal, surface.mu);
+        }
+        if (body_b != nullptr) {
+          self->contact_graph.add(id_b, body_a != nullptr ? id_a : ContactGraph::kStatic, -normal, surface.mu);
+        }
       }
     }
   }
@@ -165,8 +156,7 @@ World::World(const Scene& scene, const WorldOptions& options)
   dWorldSetAutoDisableFlag(ode.world, scene_.physics.auto_disable ? 1 : 0);
 
   ode.bodies.assign(scene_.objects.size(), nullptr);
-  ode.local_contacts.assign(scene_.objects.size(), {});
-  ode.local_contact_counts.assign(scene_.objects.size(), 0);
+  ode.contact_graph.reset(scene_.objects.size());
   ode.geoms.assign(scene_.objects.size(), nullptr);
   for (std::size_t id = 0; id < scene_.objects.size(); ++id) {
     const SceneObject& object = scene_.objects[id];
@@ -347,8 +337,9 @@ void World::schedule_local_impulse(std::size_t id, const ImpulseDelta& delta, co
   // Σ J_k·(t_end − t_k)/m by putting each axis's impulse at its centroid time
   //     c = (Σ J_k·t_k − t_start·Σ J_k) / Σ J_k      (from the report's first moments, link_types.h)
   // split between the two substeps around c: (1 − α) at ⌊c/h⌋ and α at ⌊c/h⌋ + 1, α = frac(c/h). Slot `substeps` is
-  // after the last substep: a velocity change with no displacement (an impulse in the very last tick). The world's
-  // next state then agrees with what the finger felt exactly for a free body; with contacts, up to how friction
+  // the end of the window (an impulse in the very last tick); it is applied in the last substep (apply_local_schedule).
+  // The world's next state then agrees with what the finger felt exactly for a free body (up to h·J/m for an impulse
+  // at the very end); with contacts, up to how friction
   // sees the impulse compressed to its centroid (it only acts while the object slides: ≈ 0.3 mm at the start of a
   // tap, while the contact itself is blended, local_dynamics.h).
   const int substeps = scene_.physics.substeps;
@@ -389,12 +380,24 @@ void World::schedule_local_impulse(std::size_t id, const ImpulseDelta& delta, co
 
 void World::apply_local_schedule(int slot) {
   // Substep slots: the scheduled impulse as a force held for one substep (ODE clears forces after every step).
-  // Slot `substeps`: what is left after the last substep, as an instantaneous velocity change.
+  // Slot `substeps` (an impulse at the very end of the window): for a free body, a velocity change after the last
+  // substep (exact: no displacement). For a body that touched something at the last frame it goes into the last
+  // substep instead, where the contacts see it: as a bare velocity change it would skip them for a whole step, and a
+  // 3 g ball pushed into the floor in the last tick entered it at 1.5 m/s, 5 mm deep, before ODE pushed it back out
+  // (hard case 10). The price there is h·J/m of displacement, blended in at the next frame (local_dynamics.h).
   const int substeps = scene_.physics.substeps;
   const double h = period_s_ / substeps;
   for (std::size_t id = 0; id < local_impulse_schedule_Ns_.size(); ++id) {
     Eigen::Vector3d& impulse_Ns = local_impulse_schedule_Ns_[id][static_cast<std::size_t>(slot)];
     Eigen::Vector3d& angular_Nms = local_angular_schedule_Nms_[id][static_cast<std::size_t>(slot)];
+    if (slot + 1 == substeps && ode_->contact_graph.touching(static_cast<std::int32_t>(id))) {
+      Eigen::Vector3d& end_Ns = local_impulse_schedule_Ns_[id][static_cast<std::size_t>(substeps)];
+      Eigen::Vector3d& end_Nms = local_angular_schedule_Nms_[id][static_cast<std::size_t>(substeps)];
+      impulse_Ns += end_Ns;
+      angular_Nms += end_Nms;
+      end_Ns.setZero();
+      end_Nms.setZero();
+    }
     if (impulse_Ns.isZero(0.0) && angular_Nms.isZero(0.0)) continue;
     dBodyID body = ode_->bodies[id];
     if (slot < substeps) {
@@ -422,9 +425,7 @@ void World::attach_local_contacts() {
     plane.local_contact_count = 0;
     if ((plane.flags & kPlaneDynamic) == 0 || plane.object_id < 0) continue;
     const auto id = static_cast<std::size_t>(plane.object_id);
-    if (id >= ode_->local_contact_counts.size()) continue;
-    plane.local_contact_count = ode_->local_contact_counts[id];
-    plane.local_contacts = ode_->local_contacts[id];
+    plane.local_contact_count = ode_->contact_graph.local_contacts(static_cast<std::int32_t>(id), plane.local_contacts);
   }
 }
 
@@ -471,8 +472,9 @@ void World::advance_ode() {
     }
     if (options_.coupling == Coupling::local) apply_local_schedule(substep);
     ode.record_contacts = options_.coupling == Coupling::local && substep + 1 == scene_.physics.substeps;
-    if (ode.record_contacts) std::fill(ode.local_contact_counts.begin(), ode.local_contact_counts.end(), 0u);
+    if (ode.record_contacts) ode.contact_graph.reset(scene_.objects.size());
     dSpaceCollide(ode.space, &ode, &OdeHandles::near_callback);
+    if (ode.record_contacts) ode.contact_graph.finish();
     ode.record_contacts = false;
     if (scene_.physics.solver == PhysicsParams::Solver::direct) {
       dWorldStep(ode.world, ode.substep_s);

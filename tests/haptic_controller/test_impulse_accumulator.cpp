@@ -47,7 +47,7 @@ TEST_CASE("finger pressing down on a cube on the floor: the cube gets the whole 
   REQUIRE(report.entries[0].last_tick == 1);
 }
 
-TEST_CASE("finger in the corner between a cube's side and the floor: the reaction is shared by the multipliers") {
+TEST_CASE("finger in the corner between a cube's side and the floor: each is pushed along its own normal") {
   const PlaneSet planes =
       make_set({make_plane({0, 0, 0}, {0, 0, 1}, 0, false), make_plane({0, 0, 0}, {1, 0, 0}, 1, true)});
   GodObject god;
@@ -57,8 +57,36 @@ TEST_CASE("finger in the corner between a cube's side and the floor: the reactio
   const Vector3d force_N(1.0, 0.0, 3.0);
   ImpulseAccumulator accumulator(kSession);
   accumulator.add(planes, contact.contact, force_N, 1e-3, 1);
-  REQUIRE(to_eigen(accumulator.report().entries[0].impulse_Ns).isApprox(-0.25 * force_N * 1e-3));
-  REQUIRE(to_eigen(accumulator.report().static_impulse_Ns).isApprox(-0.75 * force_N * 1e-3));
+  // The cube's side takes the horizontal push, the floor the vertical one: the finger's press on the floor does not
+  // push the cube down (sharing the whole vector by multipliers, 1:3, would).
+  REQUIRE(to_eigen(accumulator.report().entries[0].impulse_Ns).isApprox(Vector3d(-1e-3, 0, 0)));
+  REQUIRE(to_eigen(accumulator.report().static_impulse_Ns).isApprox(Vector3d(0, 0, -3e-3)));
+}
+
+TEST_CASE("a force with a part along the surface: the normal parts by plane, the rest by the multipliers") {
+  // One plane: friction along x on a face with normal z. The object gets all of it, normal and tangential.
+  const PlaneSet one = make_set({make_plane({0, 0, 0}, {0, 0, 1}, 1, true)});
+  ProxySolution contact;
+  contact.active[contact.active_count++] = {0, 0.004};
+  ImpulseAccumulator single(kSession);
+  single.add(one, contact, Vector3d(0.5, 0.0, 2.0), 1e-3, 1);
+  REQUIRE(to_eigen(single.report().entries[0].impulse_Ns).isApprox(Vector3d(-0.5e-3, 0, -2e-3)));
+
+  // A pull along a normal is never rendered as a pull on that object: the force (−1, 0, 2) against the corner of
+  // the floor (z) and a cube's side (x) has a negative x part, which goes to the remainder and is shared by λ.
+  const PlaneSet corner =
+      make_set({make_plane({0, 0, 0}, {0, 0, 1}, 0, false), make_plane({0, 0, 0}, {1, 0, 0}, 1, true)});
+  ProxySolution both;
+  both.active[both.active_count++] = {0, 0.003};
+  both.active[both.active_count++] = {1, 0.001};
+  ImpulseAccumulator accumulator(kSession);
+  const Vector3d force_N(-1.0, 0.0, 2.0);
+  accumulator.add(corner, both, force_N, 1e-3, 1);
+  const Vector3d cube = to_eigen(accumulator.report().entries[0].impulse_Ns);
+  const Vector3d floor = to_eigen(accumulator.report().static_impulse_Ns);
+  REQUIRE((cube + floor).isApprox(-force_N * 1e-3));  // nothing lost
+  REQUIRE(floor.z() == Approx(-2e-3));                 // the floor takes the press
+  REQUIRE(cube.isApprox(0.25 * Vector3d(1e-3, 0, 0)));  // the cube a quarter of the sideways remainder
 }
 
 TEST_CASE("impulse is conserved across objects: entries + static + evicted + dropped == total rendered") {

@@ -38,8 +38,11 @@ PlaneFrame local_frame(std::initializer_list<Plane> planes, std::uint64_t index 
   return frame;
 }
 
-void add_support(Plane& plane, const Vector3d& normal, double friction) {
-  plane.local_contacts[plane.local_contact_count++] = {to_vec3(normal.normalized()), friction};
+// A contact of the plane's object; `holds`: the other side takes the finger's push (static geometry or a grounded
+// chain, kContactHolds), otherwise a loose neighbour.
+void add_support(Plane& plane, const Vector3d& normal, double friction, bool holds = true) {
+  plane.local_contacts[plane.local_contact_count++] = {to_vec3(normal.normalized()), friction,
+                                                       holds ? impetus::kContactHolds : 0u, 0u};
 }
 
 DeviceState device_at(const SpidarKinematics& kinematics, const Vector3d& finger_m) {
@@ -105,6 +108,31 @@ TEST_CASE("local dynamics: a support blocks the push (a cube against a wall does
     model.apply_impulse(1, Vector3d(0.002, 0, 0), Vector3d::Zero());
   }
   REQUIRE(planes.planes[0].point_m.x() == 0.0);
+}
+
+TEST_CASE("local dynamics: a loose neighbour gives way to the push but carries the weight") {
+  // The cube rests on a neighbour below and touches one on its +x side; neither is held (a pile of loose balls).
+  Plane face = cube_face();
+  add_support(face, Vector3d::UnitZ(), 0.05, false);
+  add_support(face, -Vector3d::UnitX(), 0.05, false);
+  PlaneFrame frame = local_frame({face});
+  frame.gravity_mps2 = {0, 0, -9.81};
+  frame.world_substep_s = 0.005;
+  LocalDynamics model;
+  model.on_plane_frame(frame, nullptr, Vector3d::Zero());
+  PlaneSet planes;
+  for (int tick = 1; tick <= 50; ++tick) {
+    model.advance(kTick_s);
+    model.render(tick / 50.0, Vector3d(-0.01, 0, 0.05), planes);
+    model.apply_impulse(1, Vector3d(0.002, 0, 0), Vector3d::Zero());
+  }
+  // Held up: the neighbour below takes g·h per substep, exactly what gravity adds.
+  REQUIRE(std::abs(model.find(1)->velocity_mps.z()) < 1e-12);
+  // Pushed into the side neighbour: it gives way, so the cube moves as a free one would (0.1 N·s on 1 kg), less the
+  // friction of the weight-carrying contact below, μ·g·h = 2.5 mm/s per substep over at most 10 substeps.
+  REQUIRE(planes.planes[0].point_m.x() > 0.0);
+  REQUIRE(model.find(1)->velocity_mps.x() <= 0.1);
+  REQUIRE(model.find(1)->velocity_mps.x() >= 0.1 - 10 * 0.05 * 9.81 * 0.005);
 }
 
 TEST_CASE("servo, local coupling: the pushed cube gives way between frames and the reported impulse is the one "

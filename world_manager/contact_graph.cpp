@@ -1,0 +1,95 @@
+#include "world_manager/contact_graph.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace impetus {
+namespace {
+
+// Two contact normals of one object closer than this (cosine) are one constraint for the local model: the four
+// corner contacts of a box resting on the floor are one support.
+constexpr double kSameContactCosine = 0.999;
+// Rounding slack of the friction-cone test: ODE's box–box normals are axis-aligned to ~1e-16, and a push exactly along
+// a frictionless contact's normal must count as held.
+constexpr double kConeSlack = 1e-9;
+
+}  // namespace
+
+void ContactGraph::reset(std::size_t body_count) {
+  body_count_ = body_count;
+  pending_.clear();
+  edges_.clear();
+  first_edge_.assign(body_count + 1, 0);
+  if (visited_.size() != body_count) visited_.assign(body_count, 0);
+}
+
+void ContactGraph::add(std::int32_t body, std::int32_t other, const Eigen::Vector3d& normal, double friction) {
+  if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return;
+  if (other != kStatic && (other < 0 || static_cast<std::size_t>(other) >= body_count_)) return;
+  if (!(normal.squaredNorm() > 0.0) || !normal.allFinite() || !std::isfinite(friction)) return;
+  pending_.push_back({body, {other, normal.normalized(), std::max(0.0, friction)}});
+}
+
+void ContactGraph::finish() {
+  // Counting sort by body: edges_ grouped, first_edge_ the offsets.
+  std::fill(first_edge_.begin(), first_edge_.end(), 0);
+  for (const PendingEdge& p : pending_) ++first_edge_[static_cast<std::size_t>(p.body) + 1];
+  for (std::size_t b = 0; b < body_count_; ++b) first_edge_[b + 1] += first_edge_[b];
+  edges_.resize(pending_.size());
+  std::vector<std::size_t> cursor(first_edge_.begin(), first_edge_.end() - 1);
+  for (const PendingEdge& p : pending_) edges_[cursor[static_cast<std::size_t>(p.body)]++] = p.edge;
+}
+
+bool ContactGraph::holds(std::int32_t body, const Eigen::Vector3d& direction) {
+  if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return false;
+  if (++generation_ == 0) {  // wrapped: clear the marks once every 2^32 queries
+    std::fill(visited_.begin(), visited_.end(), 0u);
+    generation_ = 1;
+  }
+  stack_.clear();
+  stack_.push_back(body);
+  visited_[static_cast<std::size_t>(body)] = generation_;
+  while (!stack_.empty()) {
+    const auto b = static_cast<std::size_t>(stack_.back());
+    stack_.pop_back();
+    for (std::size_t e = first_edge_[b]; e < first_edge_[b + 1]; ++e) {
+      const Edge& edge = edges_[e];
+      // The contact takes a push along `direction` without sliding iff the push is within its friction cone about
+      // −n: cos(angle) ≥ cos(atan μ) = 1/√(1 + μ²).
+      const double opposing = -edge.normal.dot(direction);
+      if (opposing < 1.0 / std::sqrt(1.0 + edge.friction * edge.friction) - kConeSlack) continue;
+      if (edge.other == kStatic) return true;
+      const auto next = static_cast<std::size_t>(edge.other);
+      if (visited_[next] == generation_) continue;
+      visited_[next] = generation_;
+      stack_.push_back(edge.other);
+    }
+  }
+  return false;
+}
+
+std::uint32_t ContactGraph::local_contacts(std::int32_t body, std::array<LocalContact, kMaxLocalContacts>& out) {
+  if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return 0;
+  const auto b = static_cast<std::size_t>(body);
+  std::uint32_t count = 0;
+  for (std::size_t e = first_edge_[b]; e < first_edge_[b + 1]; ++e) {
+    const Edge& edge = edges_[e];
+    // This body pushes the other side along −n.
+    const bool held = edge.other == kStatic || holds(edge.other, -edge.normal);
+    bool merged = false;
+    for (std::uint32_t c = 0; c < count && !merged; ++c) {
+      LocalContact& known = out[c];
+      if (to_eigen(known.normal).dot(edge.normal) > kSameContactCosine) {
+        known.friction = std::max(known.friction, edge.friction);
+        if (held) known.flags |= kContactHolds;
+        merged = true;
+      }
+    }
+    if (!merged && count < kMaxLocalContacts) {
+      out[count++] = {to_vec3(edge.normal), edge.friction, held ? kContactHolds : 0u, 0u};
+    }
+  }
+  return count;
+}
+
+}  // namespace impetus
