@@ -25,6 +25,23 @@ TEST_CASE("force is the spring-damper of paper 3.3 with the real elapsed dt") {
   REQUIRE(renderer.faults() == 0);
 }
 
+TEST_CASE("a contact never pulls: a surface letting go of the finger fast does not drag it along") {
+  ForceRenderer renderer(100.0);
+  const double k = 2000.0, b = 5.0;
+  // 0.5 mm deep, then the surface recedes 0.3 mm in one tick: the damper alone would give 1 − 1.5 = −0.5 N (a pull).
+  renderer.render({0, 0, 0}, {0, 0, -0.0005}, k, b, 1e-3);
+  RenderedForce f = renderer.render({0, 0, -0.0003}, {0, 0, -0.0005}, k, b, 1e-3);
+  REQUIRE(f.force_N.z() == 0.0);
+  // Sliding along the surface the damper still brakes sideways, and the push stays: only the pull is removed.
+  renderer.render({0, 0, 0}, {0, 0, -0.001}, k, b, 1e-3);
+  f = renderer.render({0.0002, 0, 0}, {0, 0, -0.001}, k, b, 1e-3);
+  REQUIRE(f.force_N.z() == Approx(2.0));
+  REQUIRE(f.force_N.x() == Approx(2000.0 * 0.0002 + 5.0 * 0.2));
+  // The finger exactly on the surface: no push direction, no force.
+  f = renderer.render({0.01, 0, 0}, {0.01, 0, 0}, k, b, 1e-3);
+  REQUIRE(f.force_N == Vector3d::Zero());
+}
+
 TEST_CASE("force is clamped to the device maximum, direction kept, and counted") {
   ForceRenderer renderer(10.0);
   const RenderedForce f = renderer.render({0, 0, 0}, {-0.03, 0, -0.04}, 2000.0, 0.0, 1e-3);

@@ -237,6 +237,42 @@ TEST_CASE("random plane sets under a reach bound: the exact projection, or a pin
   REQUIRE(pinched > 0);  // the sample reaches the case it is about
 }
 
+TEST_CASE("a plane reaches only its extent: a finger beside a small ball is not held by its tangent plane") {
+  ContactPlane ball = make_plane({0, 0, 0.01}, {0, 0, 1}, 3, true);
+  ball.extent_m = 0.01;  // a 1 cm ball's tangent plane at its top
+  PlaneSet planes = make_set({ball});
+  // Under the plane but 2.5 cm to the side: beside the ball, not in it.
+  ProxySolution s = project_outside_planes(planes, Vector3d(0.025, 0.0, 0.005));
+  REQUIRE(s.active_count == 0);
+  REQUIRE(s.proxy_m == Vector3d(0.025, 0.0, 0.005));
+  // Over the ball (5 mm off its top point): held, however deep.
+  s = project_outside_planes(planes, Vector3d(0.005, 0.0, -0.003));
+  REQUIRE(s.active_count == 1);
+  REQUIRE(s.proxy_m.z() == Approx(0.01));
+  // No extent (the floor): unbounded.
+  planes.planes[0].extent_m = 0.0;
+  s = project_outside_planes(planes, Vector3d(0.025, 0.0, 0.005));
+  REQUIRE(s.active_count == 1);
+}
+
+TEST_CASE("a pocket of tangent planes whose corner lies beside the balls is a pinch, not a far corner") {
+  // The finger between two 1 cm balls that have closed on it: their tangent planes face each other, 2° above the
+  // horizontal, and overlap by 1 mm at the finger. They do cross, 14 mm above it: beyond a radius from either
+  // tangent point, where neither plane is on its ball any more.
+  const double tilt = 2.0 * M_PI / 180.0;
+  ContactPlane left = make_plane({0.0005, 0, 0}, {std::cos(tilt), 0, std::sin(tilt)}, 1, true);
+  ContactPlane right = make_plane({-0.0005, 0, 0}, {-std::cos(tilt), 0, std::sin(tilt)}, 2, true);
+  PlaneSet planes = make_set({left, right});
+  const Vector3d finger(0, 0, 0);
+  const ProxySolution unbounded = project_outside_planes(planes, finger);
+  REQUIRE(!unbounded.infeasible);
+  REQUIRE(unbounded.proxy_m.z() == Approx(0.0005 / std::tan(tilt)).epsilon(1e-9));
+  planes.planes[0].extent_m = planes.planes[1].extent_m = 0.01;
+  const ProxySolution s = project_outside_planes(planes, finger);
+  REQUIRE(s.infeasible);
+  REQUIRE((s.proxy_m - finger).norm() < 0.001);
+}
+
 TEST_CASE("four inward-facing planes enclose nothing: defined, finite proxy") {
   // Faces of a tetrahedron with normals pointing inward: the intersection of the half-spaces is empty.
   const Vector3d corners[4] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};

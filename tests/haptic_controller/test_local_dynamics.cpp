@@ -156,6 +156,34 @@ TEST_CASE("servo, local coupling: the pushed cube gives way between frames and t
   REQUIRE(servo.report().entries[0].impulse_moment_Nss[0] <= body->pushed_Ns.x() * 40 * kTick_s);
 }
 
+TEST_CASE("servo, local coupling: a 3 g body under the finger takes no more energy than the spring held") {
+  // The finger starts 2 mm inside the face of a 3 g body and is held there. The contact spring holds ½·k·d² = 4 mJ;
+  // that bounds what the body can carry away (the hand is still, so it does no work). With the tick solved
+  // explicitly the loop gain (k·Δt² + b·Δt)/m = 2.4 makes the force flip sign every tick and grow.
+  const double mass_kg = 0.0029;
+  Plane face = cube_face(1.0 / mass_kg);
+  const double inverse_inertia = 1.0 / (0.4 * mass_kg * 0.01 * 0.01);
+  face.inverse_inertia_world = {inverse_inertia, 0, 0, 0, inverse_inertia, 0, 0, 0, inverse_inertia};
+  PlaneFrame frame = local_frame({face});
+  frame.damping_Nspm = 5.0;
+  ServoOptions options;
+  HapticServo servo(options, 3);
+  const SpidarKinematics kinematics(options.geometry);
+  servo.on_plane_frame(frame, 0.0);
+  const DeviceState outside = device_at(kinematics, Vector3d(-0.001, 0, 0.05));
+  servo.tick(&outside, 0.0, kTick_s);
+  const DeviceState inside = device_at(kinematics, Vector3d(0.002, 0, 0.05));
+  double largest_kinetic_J = 0.0;
+  for (int tick = 1; tick <= 40; ++tick) {
+    servo.tick(&inside, tick * kTick_s, kTick_s);
+    const LocalBody* body = servo.local_dynamics().find(1);
+    REQUIRE(body != nullptr);
+    largest_kinetic_J = std::max(largest_kinetic_J, 0.5 * mass_kg * body->velocity_mps.squaredNorm());
+  }
+  REQUIRE(largest_kinetic_J > 0.0);                            // it was pushed
+  REQUIRE(largest_kinetic_J <= 0.5 * 2000.0 * 0.002 * 0.002);  // by no more than the spring's energy
+}
+
 TEST_CASE("servo, local coupling: a wrong model (the world says the object did not move) never pushes the finger "
           "out") {
   // The finger holds still 2 mm inside the face; the model lets the cube give way, but every world frame puts it back
