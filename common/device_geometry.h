@@ -22,8 +22,10 @@ struct SpidarGeometry {
   double metres_per_count = 1.7e-5;   // string length per encoder count (pulley circumference / counts per turn)
   double tension_min_N = 0.5;         // strings must stay taut or the length reading is lost
   double tension_max_N = 20.0;        // motor torque limit over the pulley radius
-  // Largest force the driver will render. With the tetrahedral layout and tensions in [0.5, 20] N a force of this
-  // size is feasible in every direction near the centre; larger forces are clamped (and counted) before mapping.
+  // Largest force the driver will render; larger forces are clamped (and counted) before mapping. With the
+  // tetrahedral layout and tensions in [0.5, 20] N a force of this size is feasible in every direction at the centre;
+  // about 5 cm off centre some directions top out near 9.3 N, and the tension distribution renders the nearest
+  // feasible force and counts a saturation (the hard cases report saturations; none of them reach one).
   double max_force_N = 10.0;
 
   // Motor (string exit) positions in the world frame, derived from the fields above.

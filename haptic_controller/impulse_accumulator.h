@@ -1,11 +1,17 @@
 #pragma once
 // Impulse integration (paper §3.4, DESIGN.md §1 haptic tick step 5): the user's force on the world is the reaction
-// −f_j of the force rendered on the finger. Each tick it is shared among the active constraints in proportion to
-// their multipliers (the normal load each plane carries: a finger pressing a cube onto the floor loads only the cube's
-// plane, so the cube gets the push and passes it on to the floor in the world's own simulation), and accumulated per
-// object exactly, tick by tick:
-//     impulse_Ns          += −f_k·Δt
-//     angular_impulse_Nms += (contact − com) × (−f_k·Δt)      (contact = the proxy, com interpolated)
+// −f_j of the force rendered on the finger. Each tick it is shared among the active constraints: each plane takes
+// the part of the reaction along its own normal (least squares over the active normals, pushes only), and what lies
+// in no normal (friction along the surface) is shared in proportion to the multipliers (the normal load each plane
+// carries: a finger pressing a cube onto the floor loads only the cube's plane, so the cube gets the push and passes
+// it on to the floor in the world's own simulation). An object can only be pushed along its own normal: sharing the
+// whole vector by multipliers lifted a ball touched at its side by the finger's press on the floor beside it (hard
+// case 10). Where the planes face each other the split would be a squeeze (pushes that cancel on the finger and only
+// drive the objects apart, ill-conditioned as the planes turn opposite); then the multipliers share the whole vector.
+// Accumulated per object exactly, tick by tick:
+//     impulse_Ns          += J_k (the share of −f_k·Δt)
+//     angular_impulse_Nms += (contact − com) × J_k      (contact = the proxy, com interpolated; through the centre
+//                                                        for a sphere's normal part, contact_plane.h)
 // rather than the paper's single F_i at one point p_i. Planes without kPlaneDynamic (floor, fixed objects) feed
 // report.static_impulse_Ns.
 //
