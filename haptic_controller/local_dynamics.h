@@ -38,8 +38,16 @@
 // the swept plane strikes the finger, the reaction at lever L spins the ball faster, and the swept planes pinch the
 // proxy into infeasible sets (hard case 10 gained 2.4e10 J, tests/haptic_controller/test_local_dynamics.cpp). The
 // rotation within a period is not lost: the world integrates the angular impulses, and its next frame brings the
-// rotated face, blended in like §3.2's interpolation (the lag impulse coupling has for every plane). A rotationally
-// stiffer model errs toward impulse coupling's behaviour (more momentum, never energy from the plane's own motion).
+// rotated face, blended in like §3.2's interpolation (the lag impulse coupling has for every plane). ω is still
+// integrated: it gives the surface velocity friction sees (a sphere's plane is taken again at the proxy each tick
+// instead, sphere_planes.h).
+//
+// Which way a wrong model errs. A model that gives way *less* than the world (a neighbour taken as immovable, a turn
+// it stopped) has the finger press a plane that does not yield, and the world then hands the object momentum the
+// finger never felt: energy from nowhere, as impulse coupling does (hard case 10 gained 790 J this way). A model that
+// gives way *more* than the world only lets the finger in deeper, and the frame-boundary rule below then holds the
+// plane where the finger is: softer, never active. So every approximation here leans toward more give: loose
+// neighbours yield, rotation is free, the tick is solved implicitly.
 //
 // Frame boundaries. When frame i arrives the plane the finger was feeling, C (frame i−1's plane moved by the old
 // model), and the world's new plane P normally agree to within the model error (floor friction per 1 ms tick vs per
