@@ -2,10 +2,12 @@
 // scene with the haptic controller's impulses (or the sampled finger, for position coupling) and publishes planes.
 
 #include "common/daemon.h"
+#include "common/device_geometry.h"
 #include "common/link_names.h"
 #include "common/realtime_clock.h"
 #include "common/scene.h"
 #include "common/world_link.h"
+#include "world_manager/impulse_limits.h"
 #include "world_manager/ode_runtime.h"
 #include "world_manager/world.h"
 #include "world_manager/world_log.h"
@@ -114,6 +116,18 @@ class WorldDaemon {
     std::fprintf(stderr, "world_manager: '%s', %zu objects, %.1f Hz, %s coupling, %s clock, link '%s'\n",
                  options_.scene_path.c_str(), scene_.objects.size(), 1.0 / world_.world_period_s(),
                  to_string(options_.coupling), to_string(options_.clock), (*link_).name().c_str());
+    if (options_.coupling == Coupling::impulse) {
+      const LightObjects light =
+          light_for_impulse_coupling(scene_, world_.world_period_s(), SpidarGeometry{}.max_force_N);
+      if (light.count > 0) {
+        std::fprintf(stderr,
+                     "world_manager: warning: %zu object(s) are light for impulse coupling at %.1f Hz, the lightest "
+                     "'%s' (%.3g kg): the device's %.0f N held for one world period would give it %.3g m/s; a push can "
+                     "launch it (hard case 10). Use --coupling local or a faster --rate.\n",
+                     light.count, 1.0 / world_.world_period_s(), light.lightest_name.c_str(), light.lightest_mass_kg,
+                     SpidarGeometry{}.max_force_N, light.lightest_speed_mps);
+      }
+    }
     const std::uint64_t max_steps =
         options_.duration_s > 0.0 ? static_cast<std::uint64_t>(std::llround(options_.duration_s /
                                                                              world_.world_period_s()))
