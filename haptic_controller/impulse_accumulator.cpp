@@ -111,7 +111,7 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
   last_share_count_ = 0;
   if (reaction_Ns.isZero(0.0)) return;  // nothing to share (and no multiplier is trusted when the force was zeroed)
 
-  const int listed = std::min(contact.active_count, kMaxActiveConstraints + 1);  // with a pinch's conflicting plane
+  const int listed = listed_constraints(contact);
   if (listed <= 0) {
     dropped_Ns_ += reaction_Ns;
     ++dropped_shares_;
@@ -123,12 +123,8 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
       split_by_normals(planes, contact, reaction_Ns);
   Eigen::Vector3d remainder_Ns = reaction_Ns;
   for (int j = 0; j < listed; ++j) remainder_Ns -= normal_parts[static_cast<std::size_t>(j)];
-  double weight_sum = 0.0;
-  for (int j = 0; j < listed; ++j) weight_sum += contact.active[j].multiplier_m;
   for (int j = 0; j < listed; ++j) {
-    // Multipliers share the remainder; if all are zero (touching with no load) share equally.
-    const double share = weight_sum > 0.0 ? contact.active[j].multiplier_m / weight_sum : 1.0 / listed;
-    const Eigen::Vector3d impulse_Ns = normal_parts[static_cast<std::size_t>(j)] + share * remainder_Ns;
+    const Eigen::Vector3d impulse_Ns = normal_parts[static_cast<std::size_t>(j)] + load_share(contact, j) * remainder_Ns;
     const ContactPlane& plane = planes.planes[contact.active[j].plane];
     const Eigen::Vector3d angular_Nms = plane.angular_impulse_Nms(contact.proxy_m, impulse_Ns);
     last_shares_[static_cast<std::size_t>(last_share_count_++)] = {plane.object_id, plane.dynamic(), impulse_Ns,

@@ -49,19 +49,17 @@ const LocalBody* LocalDynamics::find(std::int32_t object_id) const {
 double LocalDynamics::yield_scale(const PlaneSet& planes, const ProxySolution& contact,
                                   const Eigen::Vector3d& force_N, double stiffness_Npm, double damping_Nspm,
                                   double dt_s) const {
-  const int listed = std::min(contact.active_count, kMaxActiveConstraints + 1);  // with a pinch's conflicting plane
+  const int listed = listed_constraints(contact);
   const double force_norm_N = force_N.norm();
   if (listed <= 0 || !(dt_s > 0.0) || !(force_norm_N > 0.0) || !std::isfinite(force_norm_N)) return 1.0;
   const Eigen::Vector3d direction = force_N / force_norm_N;
-  double weight_sum = 0.0;
-  for (int j = 0; j < listed; ++j) weight_sum += contact.active[j].multiplier_m;
   double inverse_mass_per_kg = 0.0;
   for (int j = 0; j < listed; ++j) {
     const int index = contact.active[j].plane;
     if (index < 0 || static_cast<std::uint32_t>(index) >= planes.count) continue;
     const LocalBody* body = find(planes.planes[static_cast<std::size_t>(index)].object_id);
     if (body == nullptr || !planes.planes[static_cast<std::size_t>(index)].dynamic()) continue;
-    const double share = weight_sum > 0.0 ? contact.active[j].multiplier_m / weight_sum : 1.0 / listed;
+    const double share = load_share(contact, j);
     // Along the force at the proxy: translation plus the turn about the CoM (r × d)ᵀ I⁻¹ (r × d), which the friction
     // anchor feels through the surface velocity (a 3 g ball pushed tangentially at its surface gives way 3.5× more
     // than pushed through its centre).

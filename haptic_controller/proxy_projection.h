@@ -39,6 +39,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 
 namespace impetus {
@@ -59,6 +60,20 @@ struct ProxySolution {
 
 // Allocation-free; bounded iterations.
 ProxySolution project_outside_planes(const PlaneSet& planes, const Eigen::Vector3d& goal_m);
+
+// Constraints listed in `solution` (active_count, a pinch's conflicting plane included), bounded by the array.
+inline int listed_constraints(const ProxySolution& solution) {
+  return solution.active_count < 0 ? 0 : std::min(solution.active_count, kMaxActiveConstraints + 1);
+}
+
+// The share of the load that listed constraint j carries: its multiplier over their sum, or an equal share when none
+// carries any (touching, not pressing). What the reaction and the objects' give are weighted by (§3.4).
+inline double load_share(const ProxySolution& solution, int j) {
+  const int listed = listed_constraints(solution);
+  double sum = 0.0;
+  for (int q = 0; q < listed; ++q) sum += solution.active[q].multiplier_m;
+  return sum > 0.0 ? solution.active[j].multiplier_m / sum : 1.0 / listed;
+}
 
 // Projection of `x` onto the intersection of the active planes' boundaries (a face, edge line or corner point).
 Eigen::Vector3d project_onto_active(const PlaneSet& planes, const ProxySolution& solution, const Eigen::Vector3d& x_m);

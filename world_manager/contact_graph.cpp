@@ -36,8 +36,8 @@ void ContactGraph::finish() {
   for (const PendingEdge& p : pending_) ++first_edge_[static_cast<std::size_t>(p.body) + 1];
   for (std::size_t b = 0; b < body_count_; ++b) first_edge_[b + 1] += first_edge_[b];
   edges_.resize(pending_.size());
-  std::vector<std::size_t> cursor(first_edge_.begin(), first_edge_.end() - 1);
-  for (const PendingEdge& p : pending_) edges_[cursor[static_cast<std::size_t>(p.body)]++] = p.edge;
+  cursor_.assign(first_edge_.begin(), first_edge_.end() - 1);
+  for (const PendingEdge& p : pending_) edges_[cursor_[static_cast<std::size_t>(p.body)]++] = p.edge;
 }
 
 bool ContactGraph::holds(std::int32_t body, const Eigen::Vector3d& direction) {

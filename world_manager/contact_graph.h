@@ -68,6 +68,7 @@ class ContactGraph {
   std::vector<PendingEdge> pending_;
   std::vector<Edge> edges_;             // grouped by body after finish()
   std::vector<std::size_t> first_edge_;  // body → index of its first edge in edges_; size body_count + 1
+  std::vector<std::size_t> cursor_;     // finish()'s fill position per body (kept to reuse its storage)
   std::vector<std::uint32_t> visited_;   // per body: the query generation that last visited it
   std::uint32_t generation_ = 0;
   std::vector<std::int32_t> stack_;

@@ -40,6 +40,14 @@ PlaneFrame local_frame(std::initializer_list<Plane> planes, std::uint64_t index 
 
 // A contact of the plane's object; `holds`: the other side takes the finger's push (static geometry or a grounded
 // chain, kContactHolds), otherwise a loose neighbour.
+// A local frame on Earth: gravity and the world's 5 ms substep, for models with supports.
+PlaneFrame grounded_frame(const Plane& plane) {
+  PlaneFrame frame = local_frame({plane});
+  frame.gravity_mps2 = {0, 0, -9.81};
+  frame.world_substep_s = 0.005;
+  return frame;
+}
+
 void add_support(Plane& plane, const Vector3d& normal, double friction, bool holds = true) {
   plane.local_contacts[plane.local_contact_count++] = {to_vec3(normal.normalized()), friction,
                                                        holds ? impetus::kContactHolds : 0u, 0u};
@@ -75,11 +83,8 @@ TEST_CASE("local dynamics: a cube sliding on the floor loses mu*g*h per world su
   Plane face = cube_face();
   face.velocity_mps = {0.1, 0, 0};
   add_support(face, Vector3d::UnitZ(), 0.5);
-  PlaneFrame frame = local_frame({face});
-  frame.gravity_mps2 = {0, 0, -9.81};
-  frame.world_substep_s = 0.005;
   LocalDynamics model;
-  model.on_plane_frame(frame, nullptr, Vector3d::Zero());
+  model.on_plane_frame(grounded_frame(face), nullptr, Vector3d::Zero());
   PlaneSet planes;
   double last_x = 0.0;
   for (int tick = 1; tick <= 10; ++tick) model.advance(kTick_s);
@@ -115,11 +120,8 @@ TEST_CASE("local dynamics: a loose neighbour gives way to the push but carries t
   Plane face = cube_face();
   add_support(face, Vector3d::UnitZ(), 0.05, false);
   add_support(face, -Vector3d::UnitX(), 0.05, false);
-  PlaneFrame frame = local_frame({face});
-  frame.gravity_mps2 = {0, 0, -9.81};
-  frame.world_substep_s = 0.005;
   LocalDynamics model;
-  model.on_plane_frame(frame, nullptr, Vector3d::Zero());
+  model.on_plane_frame(grounded_frame(face), nullptr, Vector3d::Zero());
   PlaneSet planes;
   for (int tick = 1; tick <= 50; ++tick) {
     model.advance(kTick_s);
