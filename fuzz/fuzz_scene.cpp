@@ -3,7 +3,7 @@
 // exception escapes and terminates: it is a bug, since a daemon's main would report it as an unknown error instead of
 // pointing at the field. An accepted scene must hold only numbers the world manager can use.
 
-#include "common/scene.h"
+#include "world_manager/scene.h"
 #include "fuzz/fuzz_check.h"
 
 #include <cmath>

@@ -2,7 +2,7 @@
 // Expected outcomes: a Trajectory or a TrajectoryError. An accepted trajectory must evaluate to finite positions and
 // velocities everywhere, since spidar_sim feeds them straight into the hand model at 1 kHz.
 
-#include "common/trajectory.h"
+#include "spidar_sim/trajectory.h"
 #include "fuzz/fuzz_check.h"
 #include "fuzz/trajectory_check.h"
 

@@ -1,7 +1,7 @@
 // Fuzz target: built-in trajectory specs (`NAME[:key=value,...]`) through make_builtin_trajectory. Expected outcomes:
 // a Trajectory or a TrajectoryError; an accepted trajectory must evaluate to finite positions and velocities.
 
-#include "common/trajectory.h"
+#include "spidar_sim/trajectory.h"
 #include "fuzz/fuzz_check.h"
 #include "fuzz/trajectory_check.h"
 

@@ -2,7 +2,7 @@
 // What trajectory.h promises about a trajectory that loaded: finite position and velocity at any time, including
 // before the start, at and around the segment joins we can reach cheaply, and after the end.
 
-#include "common/trajectory.h"
+#include "spidar_sim/trajectory.h"
 #include "fuzz/fuzz_check.h"
 
 #include <array>

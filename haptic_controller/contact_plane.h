@@ -4,7 +4,7 @@
 //
 // A plane is a half-space constraint: the proxy must satisfy normal·(x − point_m) ≥ 0. Owned by the servo thread.
 
-#include "common/link_types.h"
+#include "common/contract/frames.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross

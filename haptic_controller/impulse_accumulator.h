@@ -27,7 +27,7 @@
 //
 // Owned by the servo thread.
 
-#include "common/link_types.h"
+#include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
 #include "haptic_controller/proxy_projection.h"
 

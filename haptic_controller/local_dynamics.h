@@ -63,7 +63,7 @@
 //
 // Allocation-free after construction; owned by the servo thread.
 
-#include "common/link_types.h"
+#include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
 #include "haptic_controller/proxy_projection.h"
 

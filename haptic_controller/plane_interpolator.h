@@ -21,7 +21,7 @@
 //  * A sphere's plane (kPlaneSphere) interpolates the centre instead; the servo then takes the tangent plane at the
 //    proxy (sphere_planes.h).
 
-#include "common/link_types.h"
+#include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
 
 namespace impetus {

@@ -6,8 +6,8 @@
 // Threading: one servo thread owns the object; on_plane_frame, tick and report are called from that thread only.
 // Real time: the constructor preallocates everything; on_plane_frame and tick never allocate, lock, block or throw.
 
-#include "common/device_geometry.h"
-#include "common/link_types.h"
+#include "common/spidar/geometry.h"
+#include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
 #include "haptic_controller/force_renderer.h"
 #include "haptic_controller/god_object.h"

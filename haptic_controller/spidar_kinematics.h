@@ -5,8 +5,8 @@
 // the finger cap sits at the motor's string exit. The device (or spidar_sim) is calibrated that way at start-up; the
 // driver never needs an offset. Geometry (motors at alternate corners of the frame cube) is SpidarGeometry's.
 
-#include "common/device_geometry.h"
-#include "common/link_types.h"
+#include "common/spidar/geometry.h"
+#include "common/contract/frames.h"
 
 #include <Eigen/Core>
 

@@ -13,8 +13,8 @@
 // true optimum is its own face's unclamped solution and every clamped candidate is feasible. Fixed work, no
 // iteration that might not converge, no allocation.
 
-#include "common/device_geometry.h"
-#include "common/link_types.h"
+#include "common/spidar/geometry.h"
+#include "common/contract/frames.h"
 
 #include <Eigen/Core>
 

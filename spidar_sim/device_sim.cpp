@@ -1,6 +1,6 @@
 #include "spidar_sim/device_sim.h"
 
-#include "common/csv_line.h"
+#include "common/runtime/csv_line.h"
 
 #include <cmath>
 #include <iomanip>

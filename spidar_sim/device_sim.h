@@ -7,10 +7,10 @@
 // the returned state carries the encoder counts at the end of the tick. Time starts at 0 with the finger at rest on
 // the trajectory's start and the motors at the minimum tension. No allocation after construction.
 
-#include "common/device_geometry.h"
-#include "common/link_types.h"
-#include "common/trajectory.h"
-#include "common/vec3.h"
+#include "common/spidar/geometry.h"
+#include "common/contract/frames.h"
+#include "spidar_sim/trajectory.h"
+#include "common/contract/vec3.h"
 #include "spidar_sim/finger.h"
 #include "spidar_sim/spidar_hardware.h"
 

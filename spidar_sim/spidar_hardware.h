@@ -9,8 +9,8 @@
 //   a tension t_i ≥ 0 pulls the finger toward motor i: F = Σ t_i·u_i with u_i = (motor_i − finger)/|motor_i − finger|.
 // Not thread-safe; owned by one DeviceSim.
 
-#include "common/device_geometry.h"
-#include "common/link_types.h"
+#include "common/spidar/geometry.h"
+#include "common/contract/frames.h"
 
 #include <Eigen/Core>
 

@@ -4,7 +4,7 @@
 //
 // Shapes are centred on the body origin (the centre of mass) with their axis along body z (DESIGN.md §4).
 
-#include "common/scene.h"
+#include "world_manager/scene.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

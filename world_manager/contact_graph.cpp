@@ -86,7 +86,7 @@ std::uint32_t ContactGraph::local_contacts(std::int32_t body, std::array<LocalCo
       }
     }
     if (!merged && count < kMaxLocalContacts) {
-      out[count++] = {to_vec3(edge.normal), edge.friction, held ? kContactHolds : 0u, 0u};
+      out[count++] = {to_vec3(edge.normal), edge.friction, held ? kContactHolds : 0u};
     }
   }
   return count;

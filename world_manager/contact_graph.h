@@ -16,7 +16,7 @@
 // errs toward "does not hold", i.e. toward a model that gives way more than the world does, which is the passive
 // error (local_dynamics.h, frame boundaries).
 
-#include "common/link_types.h"
+#include "common/contract/frames.h"
 
 #include <Eigen/Core>
 

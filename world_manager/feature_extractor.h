@@ -9,8 +9,8 @@
 // The extractor keeps a SpatialGrid of every object's bounding box swept by its own speed·T_w; index() rebuilds it
 // once per world step and extract() then only tests the objects in the cells around the finger.
 
-#include "common/link_types.h"
-#include "common/scene.h"
+#include "common/contract/frames.h"
+#include "world_manager/scene.h"
 #include "world_manager/body_geometry.h"
 #include "world_manager/object_state.h"
 #include "world_manager/spatial_grid.h"

@@ -7,7 +7,7 @@
 // F_max·T_w/m. Where that exceeds what a hand gives an object (kHandSpeed_mps), a push can launch the body (3 g balls
 // at 10 Hz: 345 m/s), and local coupling (§6.3) is the coupling to use. The world manager warns at start-up.
 
-#include "common/scene.h"
+#include "world_manager/scene.h"
 
 #include <cstddef>
 #include <string>

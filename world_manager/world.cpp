@@ -5,13 +5,10 @@
 #include <ode/ode.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <random>
 #include <stdexcept>
 #include <string>
-#include <unistd.h>
 
 namespace impetus {
 
@@ -98,13 +95,6 @@ struct World::OdeHandles {
     }
   }
 };
-
-std::uint64_t make_world_session() {
-  std::random_device device;
-  const auto now = static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
-  std::uint64_t session = (std::uint64_t{device()} << 32) ^ now ^ (static_cast<std::uint64_t>(::getpid()) << 16);
-  return session == 0 ? 1 : session;
-}
 
 World::World(const Scene& scene, const WorldOptions& options)
     : scene_(scene),
@@ -282,6 +272,7 @@ void World::apply_report_impulses(const HapticReport& report) {
   last_report_session_ = report.haptic_session;
   last_report_time_s_ = report.haptic_time_s;
   const std::size_t floor_id = scene_.objects.size();
+  const CounterOwner owner{report.haptic_session, report.endpoint};
   const std::uint32_t count = std::min(report.entry_count, kMaxImpulseEntries);
   for (std::uint32_t i = 0; i < count; ++i) {
     const ObjectImpulse& entry = report.entries[i];
@@ -291,11 +282,11 @@ void World::apply_report_impulses(const HapticReport& report) {
       continue;
     }
     const auto id = static_cast<std::size_t>(entry.object_id);
-    const ImpulseDelta delta = ledger_.take(report.haptic_session, entry);
+    const ImpulseDelta delta = ledger_.take(owner, entry);
     ObjectImpulse moments = entry;  // the moments through the same ledger rules (session, epoch, baseline)
     moments.impulse_Ns = entry.impulse_moment_Nss;
     moments.angular_impulse_Nms = entry.angular_impulse_moment_Nmss;
-    const ImpulseDelta moment = moment_ledger_.take(report.haptic_session, moments);
+    const ImpulseDelta moment = moment_ledger_.take(owner, moments);
     if (id < floor_id && scene_.objects[id].dynamic) {
       if (local && all_finite(entry.impulse_moment_Nss) && all_finite(entry.angular_impulse_moment_Nmss)) {
         schedule_local_impulse(id, delta, moment, window_start_s, window_s);
@@ -307,7 +298,7 @@ void World::apply_report_impulses(const HapticReport& report) {
     }
   }
   if (all_finite(report.static_impulse_Ns)) {
-    total_static_impulse_Ns_ += ledger_.take_static(report.haptic_session, report.static_impulse_Ns);
+    total_static_impulse_Ns_ += ledger_.take_static(owner, report.static_impulse_Ns);
   }
 }
 
@@ -525,7 +516,6 @@ void World::publish(const HapticReport* report) {
   frame_.plane_count = finger_valid_ ? features_.extract(plane_query_, states_, period_s_, frame_.planes) : 0;
   if (!finger_valid_) frame_.planes.fill(Plane{});
   if (options_.coupling == Coupling::local) attach_local_contacts();
-  seal(frame_);
 }
 
 double World::mechanical_energy_J() const {

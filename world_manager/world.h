@@ -9,10 +9,10 @@
 //
 // Units SI, world frame right-handed with z up; object ids are scene indices, the floor is scene.floor_object_id().
 
-#include "common/link_types.h"
-#include "common/scene.h"
+#include "common/contract/frames.h"
+#include "world_manager/scene.h"
 #include "world_manager/feature_extractor.h"
-#include "common/impulse_ledger.h"
+#include "world_manager/impulse_ledger.h"
 #include "world_manager/object_state.h"
 
 #include <Eigen/Core>
@@ -32,13 +32,10 @@ struct WorldOptions {
   // see the same surface.
   std::optional<double> position_stiffness_Npm;
   std::optional<double> position_damping_Nspm;
-  // Published in every frame so the haptic side notices a restarted world; must be nonzero. Daemons pass
-  // make_world_session(), tests a constant.
+  // Published in every frame so the haptic side notices a restarted world; must be nonzero. Nodes pass
+  // new_session_id() (common/runtime/process.h), tests a constant.
   std::uint64_t world_session = 1;
 };
-
-// A nonzero session id that differs between process starts (pid, clock and random_device mixed).
-std::uint64_t make_world_session();
 
 class World {
  public:
@@ -51,7 +48,7 @@ class World {
 
   // One world step (DESIGN.md §1): read `report` (nullptr: none yet; the daemon has validated it), apply its impulses
   // (impulse/local coupling) or the finger's penalty force (position coupling), advance ODE by T_w in `substeps`
-  // steps, extract the planes around the finger and return the sealed frame. The reference stays valid until the
+  // steps, extract the planes around the finger and return the frame. The reference stays valid until the
   // next step.
   const PlaneFrame& step(const HapticReport* report);
 

@@ -1,6 +1,6 @@
 #include "world_manager/world_log.h"
 
-#include "common/csv_line.h"
+#include "common/runtime/csv_line.h"
 
 #include <string>
 

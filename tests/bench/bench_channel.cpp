@@ -4,10 +4,10 @@
 //
 //   bench_channel [SECONDS=5]
 
-#include "common/link_types.h"
-#include "common/loop_stats.h"
-#include "common/segment.h"
-#include "common/seqlock.h"
+#include "common/link/shm/wire_frames.h"
+#include "common/runtime/loop_stats.h"
+#include "common/link/shm/segment.h"
+#include "common/link/shm/seqlock.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -22,7 +22,7 @@ namespace {
 struct BenchLayout {
   static constexpr impetus::SegmentKind kKind = impetus::SegmentKind::world_link;
   impetus::SegmentHeader header;
-  impetus::SeqlockChannel<impetus::HapticReport> channel;
+  impetus::SeqlockChannel<impetus::wire::HapticReport> channel;
   std::atomic<std::uint32_t> stop{0};
   std::atomic<std::uint32_t> reader_ready{0};
 };
@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   const pid_t reader = fork();
   if (reader == 0) {
     LatencyHistogram latency;
-    HapticReport report{};
+    wire::HapticReport report{};
     std::uint64_t last = 0;
     segment->reader_ready.store(1);
     while (segment->stop.load(std::memory_order_relaxed) == 0) {
@@ -52,19 +52,19 @@ int main(int argc, char** argv) {
     }
     std::printf("channel publish->observe latency (HapticReport, %zu bytes, %llu samples): p50 %.2f us, "
                 "p99 %.2f us, p99.9 %.2f us, max %.1f us\n",
-                sizeof(HapticReport), static_cast<unsigned long long>(latency.count()),
+                sizeof(wire::HapticReport), static_cast<unsigned long long>(latency.count()),
                 latency.percentile_ns(0.5) / 1e3, latency.percentile_ns(0.99) / 1e3,
                 latency.percentile_ns(0.999) / 1e3, latency.max_ns() / 1e3);
     std::fflush(stdout);
     _exit(0);
   }
   while (segment->reader_ready.load() == 0) usleep(1000);
-  HapticReport report{};
+  wire::HapticReport report{};
   report.entry_count = 8;
   const std::int64_t end = monotonic_now_ns() + static_cast<std::int64_t>(seconds * 1e9);
   while (monotonic_now_ns() < end) {
     report.tick = static_cast<std::uint64_t>(monotonic_now_ns());  // the send time travels in the frame
-    seal(report);
+    report.checksum = frame_checksum(report);
     segment->channel.write(report);
     usleep(1000);
   }

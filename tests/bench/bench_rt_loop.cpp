@@ -4,7 +4,7 @@
 //
 //   bench_rt_loop [SECONDS=10] [RATE_HZ=1000]
 
-#include "common/realtime_clock.h"
+#include "common/runtime/realtime_clock.h"
 
 #include <sched.h>
 #include <sys/mman.h>

@@ -4,7 +4,7 @@
 //     cost what is near the finger, not the size of the world. index() (once per step, O(N log N)) is shown apart.
 // Uses world_manager symbols only.
 
-#include "common/scene.h"
+#include "world_manager/scene.h"
 #include "world_manager/feature_extractor.h"
 #include "world_manager/ode_runtime.h"
 #include "world_manager/world.h"

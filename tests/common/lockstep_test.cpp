@@ -1,5 +1,5 @@
-#include "common/lockstep.h"
-#include "common/segment.h"
+#include "common/runtime/lockstep.h"
+#include "common/link/shm/segment.h"
 #include "test_support.h"
 
 #include <catch2/catch.hpp>

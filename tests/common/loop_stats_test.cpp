@@ -1,5 +1,5 @@
-#include "common/loop_stats.h"
-#include "common/realtime_clock.h"
+#include "common/runtime/loop_stats.h"
+#include "common/runtime/realtime_clock.h"
 
 #include <catch2/catch.hpp>
 

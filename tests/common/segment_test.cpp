@@ -1,4 +1,4 @@
-#include "common/segment.h"
+#include "common/link/shm/segment.h"
 #include "test_support.h"
 
 #include <catch2/catch.hpp>

@@ -1,5 +1,5 @@
-#include "common/segment.h"
-#include "common/seqlock.h"
+#include "common/link/shm/segment.h"
+#include "common/link/shm/seqlock.h"
 #include "test_support.h"
 
 #include <catch2/catch.hpp>

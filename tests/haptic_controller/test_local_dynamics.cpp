@@ -50,7 +50,7 @@ PlaneFrame grounded_frame(const Plane& plane) {
 
 void add_support(Plane& plane, const Vector3d& normal, double friction, bool holds = true) {
   plane.local_contacts[plane.local_contact_count++] = {to_vec3(normal.normalized()), friction,
-                                                       holds ? impetus::kContactHolds : 0u, 0u};
+                                                       holds ? impetus::kContactHolds : 0u};
 }
 
 DeviceState device_at(const SpidarKinematics& kinematics, const Vector3d& finger_m) {

@@ -1,7 +1,7 @@
 #pragma once
 // Builders shared by the haptic_controller tests.
 
-#include "common/link_types.h"
+#include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
 
 #include <Eigen/Core>

@@ -2,9 +2,9 @@
 // live segment. No timing is asserted (this VM has host stalls); the tests check that the survivors keep running,
 // forces stay bounded, nothing bursts, and the restarted process re-attaches.
 
-#include "common/link_names.h"
-#include "common/segment.h"
-#include "common/world_link.h"
+#include "common/link/shm/names.h"
+#include "common/link/shm/segment.h"
+#include "common/link/shm/world_link_layout.h"
 #include "trial_support.h"
 
 #include <catch2/catch.hpp>

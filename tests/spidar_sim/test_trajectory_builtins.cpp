@@ -1,6 +1,6 @@
 // Built-in trajectories: each shape starts, peaks and ends where its parameters say, moves with continuous velocity,
 // and every parameter error names the key and the value.
-#include "common/trajectory.h"
+#include "spidar_sim/trajectory.h"
 
 #include <catch2/catch.hpp>
 

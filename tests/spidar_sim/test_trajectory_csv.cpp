@@ -1,5 +1,5 @@
 // CSV trajectories: interpolation, holding outside the time range, and error messages that point at line and column.
-#include "common/trajectory.h"
+#include "spidar_sim/trajectory.h"
 #include "trajectory_test_util.h"
 
 #include <catch2/catch.hpp>

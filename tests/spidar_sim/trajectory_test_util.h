@@ -1,7 +1,7 @@
 #pragma once
 // Helpers shared by the trajectory tests: write a CSV to a private temporary file, and sample a trajectory densely.
 
-#include "common/trajectory.h"
+#include "spidar_sim/trajectory.h"
 
 #include <filesystem>
 #include <fstream>

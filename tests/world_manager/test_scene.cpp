@@ -1,4 +1,4 @@
-#include "common/scene.h"
+#include "world_manager/scene.h"
 #include "world_test_support.h"
 
 #include <catch2/catch.hpp>

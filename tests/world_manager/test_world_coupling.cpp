@@ -174,5 +174,5 @@ TEST_CASE("no report, or a report without a finger, leaves the world to itself a
   CHECK(touched.frame_index == 2);
   CHECK(touched.report_tick_applied == 50);
   CHECK(touched.report_session_applied == 3);
-  CHECK(impetus::validate(touched) == impetus::FrameError::ok);
+  CHECK(impetus::test::transport_verdict(touched) == impetus::FrameError::ok);
 }

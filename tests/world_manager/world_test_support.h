@@ -2,7 +2,8 @@
 // Shared set-up for the world_manager tests: ODE is initialised once per process (as the daemon's main does), and
 // scenes are built from small JSON documents.
 
-#include "common/scene.h"
+#include "common/link/shm/wire_frames.h"
+#include "world_manager/scene.h"
 #include "world_manager/ode_runtime.h"
 #include "world_manager/world.h"
 
@@ -16,6 +17,14 @@ namespace impetus::test {
 inline std::unique_ptr<World> make_world(const Scene& scene, const WorldOptions& options = {}) {
   init_ode_once();
   return std::make_unique<World>(scene, options);
+}
+
+// Whether the shared-memory transport would deliver `frame` (it validates what it decodes).
+inline FrameError transport_verdict(const PlaneFrame& frame) {
+  static wire::PlaneFrame encoded;
+  static PlaneFrame decoded;
+  encode(frame, encoded);
+  return decode(encoded, decoded);
 }
 
 inline std::string scene_path(const std::string& file) { return std::string(IMPETUS_SOURCE_DIR) + "/scenes/" + file; }

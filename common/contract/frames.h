@@ -1,0 +1,161 @@
+#pragma once
+// What crosses the world link and the device port (DESIGN.md §1, §2), as the nodes and algorithms see it: plain data,
+// fixed capacity (the 1 kHz path never allocates), SI units, world frame (right-handed, z up).
+//
+// These are not the bytes on a wire. Each transport encodes them its own way (common/link/shm/wire_frames.h seals
+// them with a checksum in a fixed layout; the in-process link hands them over as they are) and validates what it
+// receives, so a frame an algorithm sees is always usable: counts within capacity, numbers finite, normals unit.
+
+#include "common/contract/vec3.h"
+
+#include <cstdint>
+#include <type_traits>
+
+namespace impetus {
+
+// One finger of a haptic session (DESIGN.md §1): a report and a plane frame name the endpoint they belong to, and the
+// world keys what it applies by (haptic session, endpoint, object).
+using EndpointId = std::uint32_t;
+
+inline constexpr std::uint32_t kMaxPlanes = 64;          // planes in one world → haptic frame
+inline constexpr std::uint32_t kMaxImpulseEntries = 64;  // objects with a running impulse total in one report
+
+enum class Coupling : std::uint32_t {
+  impulse = 0,   // paper §2.2: the haptic side integrates the force, the world applies the impulse
+  position = 1,  // the paper's "previous method": the world samples the finger and applies a penalty force
+  local = 2,     // paper §6.3: the haptic side also moves the touched object between world steps
+};
+const char* to_string(Coupling coupling);
+
+// Contacts of one object that the local response model respects (paper §6.3).
+inline constexpr std::uint32_t kMaxLocalContacts = 4;
+
+// Plane flags.
+inline constexpr std::uint32_t kPlaneDynamic = 1u << 0;  // the object moves; impulses on it are applied by the world
+// A sphere's tangent plane: the centre is point_m − extent_m·normal and the radius extent_m. The haptic side takes the
+// tangent plane again at its proxy every tick (haptic_controller/sphere_planes.h), as the world does every step.
+inline constexpr std::uint32_t kPlaneSphere = 1u << 1;
+
+// LocalContact flags.
+// The other side holds a push along −normal: static geometry, or a body joined to static geometry by a chain of
+// contacts that each take the push within their friction cone (world_manager/contact_graph.h). Without it the
+// contact carries the object's weight in the local model but gives way to the finger's push.
+inline constexpr std::uint32_t kContactHolds = 1u << 0;
+
+// One contact of a dynamic object with the rest of the world, as the world saw it in its last substep: a unilateral
+// constraint for the haptic side's local model (haptic_controller/local_dynamics.h).
+struct LocalContact {
+  Vec3 normal{};          // unit; the direction the contact pushes the object (out of the other body)
+  double friction = 0.0;  // Coulomb coefficient of the pair, dimensionless, >= 0
+  std::uint32_t flags = 0;  // kContactHolds
+};
+
+// One plane of paper §3.1: the nearest surface point of an object to the finger and the outward normal there, plus
+// what the haptic side needs for friction (§6.2) and for splitting the reaction among objects.
+struct Plane {
+  std::int32_t object_id = -1;  // index of the object in the scene; stable for the whole run
+  std::uint32_t flags = 0;
+  Vec3 point_m{};                 // nearest surface point to the finger
+  Vec3 normal{};                  // unit, pointing out of the object toward the finger side
+  Vec3 com_m{};                   // object's centre of mass
+  Vec3 velocity_mps{};            // linear velocity of the centre of mass
+  Vec3 angular_velocity_radps{};  // angular velocity, world frame
+  double static_friction = 0.0;   // coefficient, dimensionless
+  double dynamic_friction = 0.0;  // coefficient, dimensionless, <= static_friction
+  // How far from point_m the plane still describes the object (world_manager/body_geometry.h plane_extent_m): a
+  // sphere's radius, a box's diagonal. 0: unbounded (the floor).
+  double extent_m = 0.0;
+  // Local response model for the coming world period (paper §6.3). Zero means "not provided": the haptic
+  // side must then treat the object as immovable between world steps.
+  double inverse_mass_per_kg = 0.0;
+  std::array<double, 9> inverse_inertia_world{};  // row-major, 1/(kg·m²), about the centre of mass
+  // Local coupling only: the object's contacts (floor, walls, other objects) at the end of the step, so the local
+  // model cannot move it into them and applies their Coulomb friction (a cube sliding on the floor loses μ·g·Δt of
+  // speed per tick, as in the world). Other couplings leave them empty.
+  std::uint32_t local_contact_count = 0;
+  std::array<LocalContact, kMaxLocalContacts> local_contacts{};
+};
+
+// World → haptic, published once per world step i (DESIGN.md §1 step 5).
+struct PlaneFrame {
+  std::uint64_t frame_index = 0;       // i; 0 is the first frame of a world session
+  std::uint64_t world_session = 0;     // changes when the world manager restarts
+  EndpointId endpoint = 0;             // the finger these planes surround
+  std::uint64_t report_tick_applied = 0;  // tick of the last haptic report whose impulses the world applied
+  std::uint64_t report_session_applied = 0;  // haptic session of that report (0 if none yet)
+  double world_time_s = 0.0;           // simulated time at the end of this step
+  double world_period_s = 0.0;         // T_w
+  Coupling coupling = Coupling::impulse;
+  std::uint32_t plane_count = 0;
+  // Haptic parameters from the scene; the haptic controller's flags override them.
+  double stiffness_Npm = 0.0;
+  double damping_Nspm = 0.0;
+  // Local coupling: the scene's gravity and the world's integration step inside its period (T_w / substeps), so the
+  // haptic side's local model integrates the drift (gravity, supports, friction) on the same grid as the world.
+  Vec3 gravity_mps2{};
+  double world_substep_s = 0.0;  // 0: unknown (the model then applies the drift every tick)
+  // The scene's base reach radius: the world sent every object within it of the proxy, and nothing says what lies
+  // beyond, so the planes describe the world only that far (the god-object's bound on a meaningful solution).
+  // 0: unknown, no bound.
+  double reach_radius_m = 0.0;
+  std::array<Plane, kMaxPlanes> planes{};
+};
+
+// Running impulse on one object since the haptic session started (never reset while the session lives), so the world
+// applies `total - applied_so_far` whatever the timing and nothing is lost or counted twice (DESIGN.md §2).
+struct ObjectImpulse {
+  std::int32_t object_id = -1;
+  // Incremented by the haptic side each time it (re)allocates an entry for this object: a new epoch restarts the
+  // total from zero, so the world resets its baseline instead of seeing a negative or huge difference.
+  std::uint32_t epoch = 0;
+  Vec3 impulse_Ns{};              // ∑ −f_k·Δt over ticks, shared to this object (paper §3.4)
+  Vec3 angular_impulse_Nms{};     // ∑ (contact − CoM) × (−f_k·Δt), about the centre of mass
+  // First moments in time, ∑ impulse_k·t_k with t_k the haptic session time of tick k (N·s², N·m·s²). With the
+  // report's haptic_time_s they tell the world *when* within its period the impulse was rendered, so local coupling
+  // applies it at that time and the world's next state agrees with what the haptic side showed (world.h).
+  Vec3 impulse_moment_Nss{};
+  Vec3 angular_impulse_moment_Nmss{};
+  std::uint64_t last_tick = 0;    // last haptic tick that added to this entry
+};
+
+// Haptic → world, published every haptic tick (DESIGN.md §1 "One haptic tick").
+struct HapticReport {
+  std::uint64_t tick = 0;           // haptic tick j of this session
+  std::uint64_t haptic_session = 0; // nonzero; changes when the haptic controller restarts
+  EndpointId endpoint = 0;          // the finger this report is about
+  double haptic_time_s = 0.0;       // session time at this tick
+  Vec3 finger_m{};                  // C_j
+  Vec3 finger_velocity_mps{};
+  // D_j, the god-object proxy: always outside every plane, so the world extracts the next planes around it rather
+  // than around a finger that may have pushed deep into (or through) a thin object.
+  Vec3 proxy_m{};
+  std::uint32_t finger_valid = 0;   // 0 while no device is attached: position coupling must not use finger_m
+  std::uint32_t entry_count = 0;
+  Vec3 static_impulse_Ns{};         // share of the reaction that went into static geometry (floor, fixed objects)
+  std::array<ObjectImpulse, kMaxImpulseEntries> entries{};
+};
+
+inline constexpr int kStringCount = 4;
+
+// Haptic → device: the tensions to command (DESIGN.md §1 step 6).
+struct DeviceCommand {
+  std::uint64_t tick = 0;
+  std::uint64_t haptic_session = 0;
+  std::array<double, kStringCount> tension_N{};
+};
+
+// Device → haptic: the encoder readings.
+struct DeviceState {
+  std::uint64_t tick = 0;            // device tick; in lockstep equal to the haptic tick it answers
+  std::uint64_t device_session = 0;  // changes on each attach
+  std::array<std::int64_t, kStringCount> encoder_counts{};
+};
+
+static_assert(std::is_trivially_copyable_v<Plane>);
+static_assert(std::is_trivially_copyable_v<PlaneFrame>);
+static_assert(std::is_trivially_copyable_v<ObjectImpulse>);
+static_assert(std::is_trivially_copyable_v<HapticReport>);
+static_assert(std::is_trivially_copyable_v<DeviceCommand>);
+static_assert(std::is_trivially_copyable_v<DeviceState>);
+
+}  // namespace impetus

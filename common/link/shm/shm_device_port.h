@@ -1,0 +1,75 @@
+#pragma once
+// The device port over shared memory (DESIGN.md §2): one segment "<shm>.device" (device_port_layout.h), created by
+// the haptic node, opened by the device. A device claims the port by swapping device_pid from 0 to its pid; to leave
+// it sets `detaching` (in lockstep, inside its last turn); a dead device is noticed by the host (pid gone), which
+// resets the turn and frees the slot.
+
+#include "common/link/device_port.h"
+#include "common/link/shm/device_port_layout.h"
+
+#include <string>
+
+namespace impetus {
+
+class ShmDevicePortHost final : public DevicePortHost {
+ public:
+  // Creates "<shm>.device" for a host ticking every `haptic_period_s` (throws SegmentError if a live process owns
+  // it).
+  ShmDevicePortHost(const std::string& shm, ClockMode clock, double haptic_period_s);
+
+  const DeviceState* lockstep_turn(std::uint64_t tick) override;
+  const DeviceState* latest_state(double now_s) override;
+  void send_command(const DeviceCommand& command) override;
+  bool wait_for_device() override;
+  void end_session() override;
+  std::uint64_t rejected_states() const override { return rejected_; }
+
+  const std::string& name() const { return segment_.name(); }
+
+ private:
+  const DeviceState* read_state();
+  void release_device();
+
+  Segment<DevicePortLayout> segment_;
+  std::int32_t attached_pid_ = 0;
+  std::uint64_t last_sequence_ = 0;
+  wire::DeviceState state_wire_{};
+  wire::DeviceCommand command_wire_{};
+  DeviceState state_{};
+  bool have_state_ = false;
+  double fresh_s_ = 0.0;
+  std::uint64_t rejected_ = 0;
+};
+
+class ShmDevicePortClient final : public DevicePortClient {
+ public:
+  // Opens "<shm>.device" (waiting up to `timeout_s` for the haptic node to create it) and claims its slot (waiting
+  // up to `timeout_s` for a dead device's slot to be freed). Throws if the host runs another clock than `clock` or
+  // a live device holds the slot.
+  ShmDevicePortClient(const std::string& shm, ClockMode clock, double timeout_s);
+  ~ShmDevicePortClient() override;
+
+  ClockMode clock() const override { return segment_->clock; }
+  double haptic_period_s() const override { return segment_->haptic_period_s; }
+  bool latest_command(DeviceCommand& out) override;
+  void publish_state(const DeviceState& state) override;
+  void publish_stats(const LoopStats& stats) override;
+  TurnResult wait_turn() override;
+  void finish_turn() override;
+  void detach() override;
+  bool host_alive() const override { return segment_.creator_alive(); }
+  std::uint64_t rejected_commands() const override { return rejected_; }
+
+  const std::string& name() const { return segment_.name(); }
+
+ private:
+  Segment<DevicePortLayout> segment_;
+  wire::DeviceCommand command_wire_{};
+  wire::DeviceState state_wire_{};
+  DeviceCommand command_{};
+  bool have_command_ = false;
+  bool detached_ = false;
+  std::uint64_t rejected_ = 0;
+};
+
+}  // namespace impetus

@@ -1,0 +1,291 @@
+#include "common/link/shm/wire_frames.h"
+
+#include <algorithm>
+
+#include <cmath>
+#include <cstddef>
+#include <cstring>
+
+namespace impetus {
+namespace {
+
+// A normal is accepted as unit if | |n| − 1 | is below this. Writers normalise in double precision (error ~1e-16);
+// the slack admits normals that went through a float round trip or an interpolation, and rejects garbage.
+constexpr double kUnitNormalTolerance = 1e-6;
+
+// Mixes every 64-bit word before the checksum field. Not cryptographic: it only has to make a torn or scribbled frame
+// (random bytes, half of two frames) fail with overwhelming probability, cheaply enough for a 1 kHz writer.
+template <class Frame>
+std::uint64_t checksum_words(const Frame& frame) {
+  constexpr std::size_t covered = offsetof(Frame, checksum);
+  static_assert(covered % 8 == 0, "checksum must follow whole 64-bit words");
+  const auto* bytes = reinterpret_cast<const unsigned char*>(&frame);
+  std::uint64_t hash = 0x9E3779B97F4A7C15ull ^ covered;
+  for (std::size_t offset = 0; offset < covered; offset += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, bytes + offset, 8);
+    hash = (hash ^ word) * 0xBF58476D1CE4E5B9ull;
+    hash ^= hash >> 31;
+  }
+  return hash;
+}
+
+bool finite(double value) { return std::isfinite(value); }
+
+// Each struct's fields, listed once for both directions: visit(a, b, f) calls f(a.x, b.x) for every field x.
+template <class A, class B, class F>
+void visit_contact(A& a, B& b, F&& f) {
+  f(a.normal, b.normal);
+  f(a.friction, b.friction);
+  f(a.flags, b.flags);
+}
+
+template <class A, class B, class F>
+void visit_plane(A& a, B& b, F&& f) {
+  f(a.object_id, b.object_id);
+  f(a.flags, b.flags);
+  f(a.point_m, b.point_m);
+  f(a.normal, b.normal);
+  f(a.com_m, b.com_m);
+  f(a.velocity_mps, b.velocity_mps);
+  f(a.angular_velocity_radps, b.angular_velocity_radps);
+  f(a.static_friction, b.static_friction);
+  f(a.dynamic_friction, b.dynamic_friction);
+  f(a.extent_m, b.extent_m);
+  f(a.inverse_mass_per_kg, b.inverse_mass_per_kg);
+  f(a.inverse_inertia_world, b.inverse_inertia_world);
+  f(a.local_contact_count, b.local_contact_count);
+  for (std::size_t c = 0; c < kMaxLocalContacts; ++c) visit_contact(a.local_contacts[c], b.local_contacts[c], f);
+}
+
+template <class A, class B, class F>
+void visit_frame_header(A& a, B& b, F&& f) {
+  f(a.frame_index, b.frame_index);
+  f(a.world_session, b.world_session);
+  f(a.endpoint, b.endpoint);
+  f(a.report_tick_applied, b.report_tick_applied);
+  f(a.report_session_applied, b.report_session_applied);
+  f(a.world_time_s, b.world_time_s);
+  f(a.world_period_s, b.world_period_s);
+  f(a.coupling, b.coupling);
+  f(a.plane_count, b.plane_count);
+  f(a.stiffness_Npm, b.stiffness_Npm);
+  f(a.damping_Nspm, b.damping_Nspm);
+  f(a.gravity_mps2, b.gravity_mps2);
+  f(a.world_substep_s, b.world_substep_s);
+  f(a.reach_radius_m, b.reach_radius_m);
+}
+
+template <class A, class B, class F>
+void visit_entry(A& a, B& b, F&& f) {
+  f(a.object_id, b.object_id);
+  f(a.epoch, b.epoch);
+  f(a.impulse_Ns, b.impulse_Ns);
+  f(a.angular_impulse_Nms, b.angular_impulse_Nms);
+  f(a.impulse_moment_Nss, b.impulse_moment_Nss);
+  f(a.angular_impulse_moment_Nmss, b.angular_impulse_moment_Nmss);
+  f(a.last_tick, b.last_tick);
+}
+
+template <class A, class B, class F>
+void visit_report_header(A& a, B& b, F&& f) {
+  f(a.tick, b.tick);
+  f(a.haptic_session, b.haptic_session);
+  f(a.endpoint, b.endpoint);
+  f(a.haptic_time_s, b.haptic_time_s);
+  f(a.finger_m, b.finger_m);
+  f(a.finger_velocity_mps, b.finger_velocity_mps);
+  f(a.proxy_m, b.proxy_m);
+  f(a.finger_valid, b.finger_valid);
+  f(a.entry_count, b.entry_count);
+  f(a.static_impulse_Ns, b.static_impulse_Ns);
+}
+
+struct CopyInto {
+  template <class From, class To>
+  void operator()(const From& from, To& to) const {
+    to = from;
+  }
+};
+
+template <class Frame>
+void seal(Frame& frame) {
+  frame.checksum = frame_checksum(frame);
+}
+
+}  // namespace
+
+const char* to_string(FrameError error) {
+  switch (error) {
+    case FrameError::ok: return "ok";
+    case FrameError::checksum: return "checksum mismatch";
+    case FrameError::count_out_of_range: return "count out of range";
+    case FrameError::not_finite: return "non-finite number";
+    case FrameError::normal_not_unit: return "normal is not a unit vector";
+    case FrameError::bad_period: return "world period is not positive";
+    case FrameError::bad_coupling: return "unknown coupling";
+    case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
+    case FrameError::bad_reach: return "reach radius or plane extent is negative";
+  }
+  return "unknown frame error";
+}
+
+std::uint64_t frame_checksum(const wire::PlaneFrame& frame) { return checksum_words(frame); }
+std::uint64_t frame_checksum(const wire::HapticReport& report) { return checksum_words(report); }
+std::uint64_t frame_checksum(const wire::DeviceCommand& command) { return checksum_words(command); }
+std::uint64_t frame_checksum(const wire::DeviceState& state) { return checksum_words(state); }
+
+FrameError validate(const wire::PlaneFrame& frame) {
+  if (frame.checksum != frame_checksum(frame)) return FrameError::checksum;
+  if (frame.plane_count > kMaxPlanes) return FrameError::count_out_of_range;
+  if (!finite(frame.world_time_s) || !finite(frame.stiffness_Npm) || !finite(frame.damping_Nspm) ||
+      !all_finite(frame.gravity_mps2) || !finite(frame.world_substep_s) || !finite(frame.reach_radius_m)) {
+    return FrameError::not_finite;
+  }
+  if (!(frame.world_period_s > 0.0) || !finite(frame.world_period_s)) return FrameError::bad_period;
+  if (frame.world_substep_s < 0.0) return FrameError::bad_period;
+  if (frame.reach_radius_m < 0.0) return FrameError::bad_reach;
+  if (static_cast<std::uint32_t>(frame.coupling) > static_cast<std::uint32_t>(Coupling::local)) {
+    return FrameError::bad_coupling;
+  }
+  for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
+    const wire::Plane& plane = frame.planes[k];
+    if (!all_finite(plane.point_m) || !all_finite(plane.normal) || !all_finite(plane.com_m) ||
+        !all_finite(plane.velocity_mps) || !all_finite(plane.angular_velocity_radps) ||
+        !finite(plane.static_friction) || !finite(plane.dynamic_friction) || !finite(plane.inverse_mass_per_kg) ||
+        !finite(plane.extent_m)) {
+      return FrameError::not_finite;
+    }
+    if (plane.extent_m < 0.0) return FrameError::bad_reach;
+    for (double value : plane.inverse_inertia_world) {
+      if (!finite(value)) return FrameError::not_finite;
+    }
+    if (plane.local_contact_count > kMaxLocalContacts) return FrameError::count_out_of_range;
+    for (std::uint32_t c = 0; c < plane.local_contact_count; ++c) {
+      const wire::LocalContact& contact = plane.local_contacts[c];
+      if (!all_finite(contact.normal) || !finite(contact.friction)) return FrameError::not_finite;
+      const double length = std::sqrt(contact.normal[0] * contact.normal[0] + contact.normal[1] * contact.normal[1] +
+                                      contact.normal[2] * contact.normal[2]);
+      if (std::fabs(length - 1.0) > kUnitNormalTolerance) return FrameError::normal_not_unit;
+      if (contact.friction < 0.0) return FrameError::bad_friction;
+    }
+    const double norm = std::sqrt(plane.normal[0] * plane.normal[0] + plane.normal[1] * plane.normal[1] +
+                                  plane.normal[2] * plane.normal[2]);
+    if (std::fabs(norm - 1.0) > kUnitNormalTolerance) return FrameError::normal_not_unit;
+    if (plane.static_friction < 0.0 || plane.dynamic_friction < 0.0 ||
+        plane.dynamic_friction > plane.static_friction) {
+      return FrameError::bad_friction;
+    }
+  }
+  return FrameError::ok;
+}
+
+FrameError validate(const wire::HapticReport& report) {
+  if (report.checksum != frame_checksum(report)) return FrameError::checksum;
+  if (report.entry_count > kMaxImpulseEntries) return FrameError::count_out_of_range;
+  if (!finite(report.haptic_time_s) || !all_finite(report.finger_m) || !all_finite(report.finger_velocity_mps) ||
+      !all_finite(report.proxy_m) ||
+      !all_finite(report.static_impulse_Ns)) {
+    return FrameError::not_finite;
+  }
+  for (std::uint32_t k = 0; k < report.entry_count; ++k) {
+    const wire::ObjectImpulse& entry = report.entries[k];
+    if (!all_finite(entry.impulse_Ns) || !all_finite(entry.angular_impulse_Nms) ||
+        !all_finite(entry.impulse_moment_Nss) || !all_finite(entry.angular_impulse_moment_Nmss)) {
+      return FrameError::not_finite;
+    }
+  }
+  return FrameError::ok;
+}
+
+FrameError validate(const wire::DeviceCommand& command) {
+  if (command.checksum != frame_checksum(command)) return FrameError::checksum;
+  for (double tension : command.tension_N) {
+    if (!finite(tension)) return FrameError::not_finite;
+  }
+  return FrameError::ok;
+}
+
+FrameError validate(const wire::DeviceState& state) {
+  if (state.checksum != frame_checksum(state)) return FrameError::checksum;
+  return FrameError::ok;
+}
+
+// Encoding copies every slot of the fixed arrays, so the wire frame never keeps a stale entry from an earlier frame.
+void encode(const PlaneFrame& frame, wire::PlaneFrame& out) {
+  visit_frame_header(frame, out, CopyInto{});
+  for (std::size_t k = 0; k < kMaxPlanes; ++k) visit_plane(frame.planes[k], out.planes[k], CopyInto{});
+  seal(out);
+}
+
+void encode(const HapticReport& report, wire::HapticReport& out) {
+  visit_report_header(report, out, CopyInto{});
+  for (std::size_t k = 0; k < kMaxImpulseEntries; ++k) visit_entry(report.entries[k], out.entries[k], CopyInto{});
+  seal(out);
+}
+
+void encode(const DeviceCommand& command, wire::DeviceCommand& out) {
+  out.tick = command.tick;
+  out.haptic_session = command.haptic_session;
+  out.tension_N = command.tension_N;
+  seal(out);
+}
+
+void encode(const DeviceState& state, wire::DeviceState& out) {
+  out.tick = state.tick;
+  out.device_session = state.device_session;
+  out.encoder_counts = state.encoder_counts;
+  seal(out);
+}
+
+// Decoding copies the counted slots only; the rest of the contract frame is reset, so nothing unvalidated reaches it.
+FrameError decode(const wire::PlaneFrame& in, PlaneFrame& out) {
+  const FrameError error = validate(in);
+  if (error != FrameError::ok) return error;
+  visit_frame_header(in, out, CopyInto{});
+  for (std::size_t k = 0; k < kMaxPlanes; ++k) {
+    if (k < in.plane_count) {
+      visit_plane(in.planes[k], out.planes[k], CopyInto{});
+      for (std::size_t c = in.planes[k].local_contact_count; c < kMaxLocalContacts; ++c) {
+        out.planes[k].local_contacts[c] = LocalContact{};
+      }
+    } else {
+      out.planes[k] = Plane{};
+    }
+  }
+  return FrameError::ok;
+}
+
+FrameError decode(const wire::HapticReport& in, HapticReport& out) {
+  const FrameError error = validate(in);
+  if (error != FrameError::ok) return error;
+  visit_report_header(in, out, CopyInto{});
+  for (std::size_t k = 0; k < kMaxImpulseEntries; ++k) {
+    if (k < in.entry_count) {
+      visit_entry(in.entries[k], out.entries[k], CopyInto{});
+    } else {
+      out.entries[k] = ObjectImpulse{};
+    }
+  }
+  return FrameError::ok;
+}
+
+FrameError decode(const wire::DeviceCommand& in, DeviceCommand& out) {
+  const FrameError error = validate(in);
+  if (error != FrameError::ok) return error;
+  out.tick = in.tick;
+  out.haptic_session = in.haptic_session;
+  out.tension_N = in.tension_N;
+  return FrameError::ok;
+}
+
+FrameError decode(const wire::DeviceState& in, DeviceState& out) {
+  const FrameError error = validate(in);
+  if (error != FrameError::ok) return error;
+  out.tick = in.tick;
+  out.device_session = in.device_session;
+  out.encoder_counts = in.encoder_counts;
+  return FrameError::ok;
+}
+
+}  // namespace impetus

@@ -1,0 +1,150 @@
+#pragma once
+// The shared-memory transport's encoding of the contract frames (common/contract/frames.h): the same fields in a
+// fixed layout of whole 64-bit words, every frame sealed with a checksum of the words before it.
+//
+// Writers encode() a contract frame into its wire form (which seals it); readers decode(), which accepts a frame only
+// if its checksum matches and its content is usable (counts within capacity, numbers finite, normals unit, friction
+// ordered), and otherwise names the reason. Nothing outside the transport sees these types.
+//
+// Changing any struct here changes the shared-memory layout: bump kLayoutVersion in segment.h.
+
+#include "common/contract/frames.h"
+
+#include <array>
+#include <cstdint>
+#include <type_traits>
+
+namespace impetus {
+namespace wire {
+
+struct LocalContact {
+  Vec3 normal{};
+  double friction = 0.0;
+  std::uint32_t flags = 0;
+  std::uint32_t reserved = 0;  // keeps the layout in whole 64-bit words (checksum)
+};
+
+struct Plane {
+  std::int32_t object_id = -1;
+  std::uint32_t flags = 0;
+  Vec3 point_m{};
+  Vec3 normal{};
+  Vec3 com_m{};
+  Vec3 velocity_mps{};
+  Vec3 angular_velocity_radps{};
+  double static_friction = 0.0;
+  double dynamic_friction = 0.0;
+  double extent_m = 0.0;
+  double inverse_mass_per_kg = 0.0;
+  std::array<double, 9> inverse_inertia_world{};
+  std::uint32_t local_contact_count = 0;
+  std::uint32_t reserved = 0;
+  std::array<LocalContact, kMaxLocalContacts> local_contacts{};
+};
+
+struct PlaneFrame {
+  std::uint64_t frame_index = 0;
+  std::uint64_t world_session = 0;
+  EndpointId endpoint = 0;
+  std::uint32_t reserved = 0;
+  std::uint64_t report_tick_applied = 0;
+  std::uint64_t report_session_applied = 0;
+  double world_time_s = 0.0;
+  double world_period_s = 0.0;
+  Coupling coupling = Coupling::impulse;
+  std::uint32_t plane_count = 0;
+  double stiffness_Npm = 0.0;
+  double damping_Nspm = 0.0;
+  Vec3 gravity_mps2{};
+  double world_substep_s = 0.0;
+  double reach_radius_m = 0.0;
+  std::array<Plane, kMaxPlanes> planes{};
+  std::uint64_t checksum = 0;  // frame_checksum() of everything above; set by encode()
+};
+
+struct ObjectImpulse {
+  std::int32_t object_id = -1;
+  std::uint32_t epoch = 0;
+  Vec3 impulse_Ns{};
+  Vec3 angular_impulse_Nms{};
+  Vec3 impulse_moment_Nss{};
+  Vec3 angular_impulse_moment_Nmss{};
+  std::uint64_t last_tick = 0;
+};
+
+struct HapticReport {
+  std::uint64_t tick = 0;
+  std::uint64_t haptic_session = 0;
+  EndpointId endpoint = 0;
+  std::uint32_t reserved = 0;
+  double haptic_time_s = 0.0;
+  Vec3 finger_m{};
+  Vec3 finger_velocity_mps{};
+  Vec3 proxy_m{};
+  std::uint32_t finger_valid = 0;
+  std::uint32_t entry_count = 0;
+  Vec3 static_impulse_Ns{};
+  std::array<ObjectImpulse, kMaxImpulseEntries> entries{};
+  std::uint64_t checksum = 0;
+};
+
+struct DeviceCommand {
+  std::uint64_t tick = 0;
+  std::uint64_t haptic_session = 0;
+  std::array<double, kStringCount> tension_N{};
+  std::uint64_t checksum = 0;
+};
+
+struct DeviceState {
+  std::uint64_t tick = 0;
+  std::uint64_t device_session = 0;
+  std::array<std::int64_t, kStringCount> encoder_counts{};
+  std::uint64_t checksum = 0;
+};
+
+static_assert(std::is_trivially_copyable_v<PlaneFrame>);
+static_assert(std::is_trivially_copyable_v<HapticReport>);
+static_assert(std::is_trivially_copyable_v<DeviceCommand>);
+static_assert(std::is_trivially_copyable_v<DeviceState>);
+
+}  // namespace wire
+
+// Why a reader rejected a frame; ok means accepted.
+enum class FrameError : std::uint32_t {
+  ok = 0,
+  checksum,
+  count_out_of_range,
+  not_finite,
+  normal_not_unit,
+  bad_period,
+  bad_coupling,
+  bad_friction,
+  bad_reach,
+};
+const char* to_string(FrameError error);
+
+// Checksums cover every byte of the frame before the checksum field.
+std::uint64_t frame_checksum(const wire::PlaneFrame& frame);
+std::uint64_t frame_checksum(const wire::HapticReport& report);
+std::uint64_t frame_checksum(const wire::DeviceCommand& command);
+std::uint64_t frame_checksum(const wire::DeviceState& state);
+
+// Checksum and content checks of a received frame (what decode() runs first).
+FrameError validate(const wire::PlaneFrame& frame);
+FrameError validate(const wire::HapticReport& report);
+FrameError validate(const wire::DeviceCommand& command);
+FrameError validate(const wire::DeviceState& state);
+
+// Contract → wire, sealed. Entries beyond the frame's count are written as zeros. Allocation-free.
+void encode(const PlaneFrame& frame, wire::PlaneFrame& out);
+void encode(const HapticReport& report, wire::HapticReport& out);
+void encode(const DeviceCommand& command, wire::DeviceCommand& out);
+void encode(const DeviceState& state, wire::DeviceState& out);
+
+// Wire → contract: validate(), then copy. On error `out` is left unchanged. Allocation-free.
+FrameError decode(const wire::PlaneFrame& in, PlaneFrame& out);
+FrameError decode(const wire::HapticReport& in, HapticReport& out);
+FrameError decode(const wire::DeviceCommand& in, DeviceCommand& out);
+FrameError decode(const wire::DeviceState& in, DeviceState& out);
+
+}  // namespace impetus

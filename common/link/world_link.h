@@ -1,0 +1,70 @@
+#pragma once
+// The world link (DESIGN.md §1, §2): plane frames from the world to each endpoint, running impulse totals and the
+// finger back. Two ends, each an interface the nodes talk through; the transports (shared memory, in-process) encode,
+// seal and validate, so a node only ever sees contract frames that passed validation.
+//
+// Threading: each end is used by its node's loop thread, except WorldLinkClient::reattach(), which a real-time haptic
+// node calls from its supervisor thread while the servo thread keeps reading (implementations make that safe).
+
+#include "common/contract/frames.h"
+#include "common/runtime/lockstep.h"
+#include "common/runtime/loop_stats.h"
+
+#include <cstdint>
+
+namespace impetus {
+
+// What the world tells every haptic side once, at attach: its schedule and coupling.
+struct WorldLinkInfo {
+  double world_rate_hz = 0.0;
+  double world_period_s = 0.0;
+  std::uint64_t phase_ticks = 0;  // lockstep: world step i happens at haptic tick i·n + phase_ticks
+  ClockMode clock = ClockMode::realtime;
+  Coupling coupling = Coupling::impulse;
+};
+
+// The world node's end.
+class WorldLinkServer {
+ public:
+  virtual ~WorldLinkServer() = default;
+
+  // The newest valid report since the world started (whether or not it is new since the last call); false if none
+  // has arrived yet. Invalid reports are dropped and counted.
+  virtual bool latest_report(HapticReport& out) = 0;
+  virtual void publish_frame(const PlaneFrame& frame) = 0;
+  virtual void publish_stats(const LoopStats& stats) = 0;
+
+  // Lockstep follower: waits for the master's go for the next world step. ok: step now, then finish_turn();
+  // anything else ends the run (shutdown: the session ended; peer_gone: the master died or a stop was requested).
+  virtual TurnResult wait_turn() = 0;
+  virtual void finish_turn() = 0;
+
+  virtual std::uint64_t rejected_reports() const = 0;
+};
+
+// A haptic node's end.
+class WorldLinkClient {
+ public:
+  virtual ~WorldLinkClient() = default;
+
+  virtual const WorldLinkInfo& info() const = 0;
+  // The newest valid frame published since the last call; false if none. A restarted world's frames follow on
+  // (PlaneFrame::world_session tells them apart). Invalid frames are dropped and counted.
+  virtual bool receive_frame(PlaneFrame& out) = 0;
+  virtual void publish_report(const HapticReport& report) = 0;
+  virtual void publish_stats(const LoopStats& stats) = 0;
+
+  // Lockstep master: the world takes its step for haptic tick `tick`; false if the world is gone (its last frames
+  // stay in force until reattach() finds a new one).
+  virtual bool step_world(std::uint64_t tick) = 0;
+  // Lockstep master: ends the session; a waiting world returns from wait_turn() with `shutdown`.
+  virtual void end_session() = 0;
+
+  // Not real time: if the world died and a new one took its place, follow it. True if it switched.
+  virtual bool reattach() = 0;
+
+  virtual std::uint64_t rejected_frames() const = 0;
+  virtual std::uint64_t attaches() const = 0;  // 1 + re-attachments
+};
+
+}  // namespace impetus

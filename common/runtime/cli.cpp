@@ -1,0 +1,32 @@
+#include "common/runtime/cli.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+
+namespace impetus {
+
+std::string check_writable_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path parent = fs::absolute(fs::path(path)).parent_path();
+  std::error_code error;
+  if (!fs::is_directory(parent, error)) return "directory '" + parent.string() + "' does not exist";
+  if (access(parent.c_str(), W_OK) != 0) return "directory '" + parent.string() + "' is not writable";
+  if (fs::is_directory(fs::path(path), error)) return "'" + path + "' is a directory";
+  return "";
+}
+
+void add_clock_flag(CLI::App& app, ClockMode& clock) {
+  app.add_option("--clock", clock, "realtime or lockstep (all three processes must agree)")
+      ->transform(CLI::CheckedTransformer(kClockNames, CLI::ignore_case));
+}
+
+void add_shm_flag(CLI::App& app, std::string& shm) {
+  app.add_option("--shm", shm, "shared-memory name of the link (default impetus)");
+}
+
+void add_output_flag(CLI::App& app, const std::string& flag, std::string& path, const std::string& description) {
+  app.add_option(flag, path, description)->check(CLI::Validator(check_writable_path, "WRITABLE"));
+}
+
+}  // namespace impetus

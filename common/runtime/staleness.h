@@ -1,0 +1,31 @@
+#pragma once
+// When a peer counts as silent (DESIGN.md §2 "Staleness"): one policy, used by every node and transport.
+//
+//   a world silent for kWorldStalePeriods world periods  → the haptic side keeps its last planes, no extrapolation;
+//   a device silent for kDeviceStale_s                   → the driver commands minimum output;
+//   an endpoint silent for endpoint_stale_s(T_w)         → the world stops applying its finger.
+
+#include <algorithm>
+
+namespace impetus {
+
+// Three periods: one late frame is jitter, three in a row is a world that stopped.
+inline constexpr double kWorldStalePeriods = 3.0;
+
+// Several host stalls' worth of slack for the device's own 1 kHz loop, and short enough that a dead device does not
+// leave the strings pulling for a perceptible time.
+inline constexpr double kDeviceStale_s = 0.05;
+
+// Three world periods without a report, and at least 100 ms (several host stalls), is a haptic side gone.
+inline constexpr double kEndpointStaleMin_s = 0.1;
+inline double endpoint_stale_s(double world_period_s) {
+  return std::max(kWorldStalePeriods * world_period_s, kEndpointStaleMin_s);
+}
+
+inline bool world_stale(double frame_age_s, double world_period_s) {
+  return frame_age_s > kWorldStalePeriods * world_period_s;
+}
+
+inline bool device_stale(double state_age_s) { return state_age_s > kDeviceStale_s; }
+
+}  // namespace impetus

@@ -1,0 +1,83 @@
+#pragma once
+// The haptic node (DESIGN.md §1.3): the 1 kHz servo on its schedule. Each tick: the device's state from the device
+// port, the world's newest frame from the world link, HapticServo::tick, the command back to the device, the report to
+// the world, a log row into the real-time ring. Real time: its own clock, and a supervisor thread that does what the
+// servo loop must not (re-attaching to a restarted world). Lockstep: the master; the device advances once per tick
+// and the world steps at tick i·n + phase (common/runtime/lockstep_schedule.h).
+//
+// Owns the servo, its log and statistics; its summary is the haptic half of summary.json (DESIGN.md §4).
+
+#include "common/link/device_port.h"
+#include "common/link/world_link.h"
+#include "common/runtime/loop_stats.h"
+#include "common/runtime/rt_log.h"
+#include "haptic_controller/servo.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+
+namespace impetus {
+
+struct HapticNodeOptions {
+  double rate_hz = 1000.0;
+  double stiffness_Npm = std::numeric_limits<double>::quiet_NaN();  // NaN: the scene's (servo.h)
+  double damping_Nspm = std::numeric_limits<double>::quiet_NaN();
+  ClockMode clock = ClockMode::realtime;
+  double duration_s = 0.0;  // 0: until stopped (lockstep: until the device leaves, or stopped)
+  std::string log_path;     // "": no log
+  bool realtime_priority = true;
+  std::uint64_t haptic_session = 0;  // 0: a fresh new_session_id()
+};
+
+// One row of the haptic log (the ring holds these; formatted by the drain thread).
+struct HapticLogRow {
+  std::uint64_t tick;
+  double time_s;
+  Vec3 finger_m, proxy_m, force_N;
+  Vec3 object_impulse_Ns;  // sum of the cumulative totals over all objects
+  Vec3 static_impulse_Ns;  // cumulative share into static geometry
+  double interpolation_weight;
+  std::int64_t lateness_ns;
+  std::int32_t active_planes;
+  std::uint32_t flags;  // bit 0 finger valid, 1 saturated, 2 fault, 3 world stale, 4 sticking
+};
+
+class HapticNode {
+ public:
+  // Both links must outlive the node. Throws std::invalid_argument for a lockstep world period that is not a whole
+  // number of ticks, std::runtime_error if the log cannot be opened.
+  HapticNode(const HapticNodeOptions& options, WorldLinkClient& world, DevicePortHost& device);
+
+  // Runs until the duration, a stop request, or (lockstep) no device. Returns the exit status.
+  int run();
+
+  // The haptic half of summary.json.
+  nlohmann::json summary() const;
+  const HapticServo& servo() const { return servo_; }
+
+ private:
+  void tick(const DeviceState* device, std::uint64_t tick, double now_s, double dt_s, std::int64_t lateness_ns);
+  void receive_frame(double now_s);
+  void run_lockstep();
+  void run_realtime();
+  void publish_stats(const class RealtimeClock* clock);
+  std::uint64_t max_ticks() const;
+
+  HapticNodeOptions options_;
+  double period_s_;
+  WorldLinkClient& world_;
+  DevicePortHost& device_;
+  HapticServo servo_;
+  std::optional<RtLog<HapticLogRow>> log_;
+  PlaneFrame frame_buffer_{};
+  double max_force_N_ = 0.0;
+  LatencyHistogram clock_stats_;
+  LatencyHistogram tick_cpu_ns_;  // CPU time of HapticServo::tick, per tick
+  std::uint64_t skipped_periods_ = 0;
+};
+
+}  // namespace impetus

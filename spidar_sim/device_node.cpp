@@ -1,0 +1,96 @@
+#include "spidar_sim/device_node.h"
+
+#include "common/runtime/process.h"
+#include "common/runtime/realtime_clock.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <stdexcept>
+
+namespace impetus {
+namespace {
+
+// The device's own servo rate in real time; the finger sub-steps inside each tick (device_sim.h).
+constexpr double kDevicePeriod_s = 1e-3;
+// Statistics and (real time) the host's liveness, which reads /proc: every 100 ticks, ten times a second.
+constexpr std::uint64_t kCheckEveryTicks = 100;
+
+}  // namespace
+
+DeviceNode::DeviceNode(DeviceSim& sim, DevicePortClient& port, const std::string& log_path,
+                       std::uint64_t device_session)
+    : sim_(sim), port_(port), session_(device_session) {
+  if (!log_path.empty()) {
+    log_.emplace(log_path);
+    if (!*log_) throw std::runtime_error("cannot open log file '" + log_path + "' for writing");
+    DeviceSim::write_log_header(*log_);
+  }
+}
+
+void DeviceNode::tick(double dt_s) {
+  // Minimum tensions until a command arrives: what a haptic side that sends nothing means (the strings stay taut).
+  std::array<double, kStringCount> tensions{};
+  tensions.fill(sim_.hardware().geometry().tension_min_N);
+  DeviceCommand command;
+  if (port_.latest_command(command)) tensions = command.tension_N;
+  DeviceState state = sim_.tick(tensions, dt_s);
+  state.device_session = session_;
+  port_.publish_state(state);
+  if (log_) sim_.write_log_row(*log_);
+  ++ticks_;
+}
+
+bool DeviceNode::step_device() {
+  if (sim_.finished()) {
+    // The last turn carries no new state: the host sees the detach and frees the slot.
+    port_.detach();
+    return false;
+  }
+  tick(port_.haptic_period_s());
+  if (ticks_ % kCheckEveryTicks == 0) publish_stats(nullptr);
+  return true;
+}
+
+void DeviceNode::publish_stats(const RealtimeClock* clock) {
+  LoopStats stats = loop_stats_now(clock);
+  stats.ticks = ticks_;
+  stats.rejected_frames = port_.rejected_commands();
+  port_.publish_stats(stats);
+}
+
+int DeviceNode::run() {
+  if (port_.clock() == ClockMode::lockstep) {
+    for (;;) {
+      const TurnResult result = port_.wait_turn();
+      if (result == TurnResult::shutdown) {
+        std::fprintf(stderr, "spidar_sim: the haptic controller ended the session\n");
+        break;
+      }
+      if (result != TurnResult::ok) {
+        std::fprintf(stderr, "spidar_sim: %s\n",
+                     g_stop_requested.load() ? "stopped" : "the haptic controller went away");
+        break;
+      }
+      const bool ticked = step_device();
+      port_.finish_turn();
+      if (!ticked) break;
+    }
+    publish_stats(nullptr);
+  } else {
+    RealtimeClock clock(kDevicePeriod_s);
+    bool host_alive = true;
+    while (!g_stop_requested.load() && !sim_.finished() && host_alive) {
+      const TickTiming timing = clock.wait_next();
+      if (timing.index % kCheckEveryTicks == 0) host_alive = port_.host_alive();
+      // After a host stall the finger is advanced by the real elapsed time, capped so one tick stays a tick.
+      tick(std::min(timing.elapsed_s, DeviceSim::kMaxTick_s));
+      if (timing.index % kCheckEveryTicks == 0) publish_stats(&clock);
+    }
+    publish_stats(&clock);
+    port_.detach();
+  }
+  if (log_) log_->flush();
+  return 0;
+}
+
+}  // namespace impetus

@@ -1,0 +1,45 @@
+#pragma once
+// The device node (DESIGN.md §1.3): a simulated SPIDAR and finger (DeviceSim) on the device port. Each tick takes the
+// newest commanded tensions (minimum tension before the first command), advances the simulation and publishes the
+// encoder counts. Lockstep: one tick per turn the host gives (shared memory), or per in-process step_device() call;
+// when the trajectory ends the node detaches. Real time: its own 1 kHz clock until the trajectory ends.
+//
+// Owns the simulation's log and statistics.
+
+#include "common/link/device_port.h"
+#include "common/link/inproc/inproc_device_port.h"
+#include "spidar_sim/device_sim.h"
+
+#include <cstdint>
+#include <fstream>
+#include <optional>
+#include <string>
+
+namespace impetus {
+
+class DeviceNode final : public DeviceStepper {
+ public:
+  // `sim` and `port` must outlive the node. Throws std::runtime_error if the log cannot be opened.
+  DeviceNode(DeviceSim& sim, DevicePortClient& port, const std::string& log_path, std::uint64_t device_session);
+
+  // Runs until the trajectory ends, the host ends the session or dies, or a stop is requested. Returns the exit
+  // status.
+  int run();
+  // One lockstep tick (the in-process port's turn); false once the trajectory has ended and the node detached.
+  bool step_device() override;
+
+  std::uint64_t ticks() const { return ticks_; }
+  const DeviceSim& sim() const { return sim_; }
+
+ private:
+  void tick(double dt_s);
+  void publish_stats(const class RealtimeClock* clock);
+
+  DeviceSim& sim_;
+  DevicePortClient& port_;
+  std::uint64_t session_;
+  std::optional<std::ofstream> log_;
+  std::uint64_t ticks_ = 0;
+};
+
+}  // namespace impetus

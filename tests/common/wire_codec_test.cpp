@@ -1,0 +1,100 @@
+#include "common/link/shm/wire_frames.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+
+namespace impetus {
+namespace {
+
+PlaneFrame valid_frame() {
+  PlaneFrame frame{};
+  frame.frame_index = 3;
+  frame.world_period_s = 0.05;
+  frame.stiffness_Npm = 2000.0;
+  frame.plane_count = 2;
+  for (std::uint32_t k = 0; k < 2; ++k) {
+    frame.planes[k].object_id = static_cast<std::int32_t>(k);
+    frame.planes[k].normal = {0.0, 0.0, 1.0};
+    frame.planes[k].static_friction = 0.6;
+    frame.planes[k].dynamic_friction = 0.4;
+  }
+  return frame;
+}
+
+template <class Frame>
+wire::PlaneFrame encoded(const Frame& frame) {
+  wire::PlaneFrame out;
+  encode(frame, out);
+  return out;
+}
+
+FrameError decoded(const wire::PlaneFrame& in) {
+  static PlaneFrame out;  // static: a frame is large for the stack of a test
+  return decode(in, out);
+}
+
+}  // namespace
+
+TEST_CASE("an encoded valid frame decodes to the same frame") {
+  const PlaneFrame frame = valid_frame();
+  static PlaneFrame copy;
+  REQUIRE(decode(encoded(frame), copy) == FrameError::ok);
+  CHECK(std::memcmp(&copy, &frame, sizeof frame) == 0);
+  HapticReport report{};
+  report.entry_count = 1;
+  report.endpoint = 3;
+  report.entries[0].impulse_Ns = {0.25, -0.5, 1.0};
+  wire::HapticReport wire_report;
+  encode(report, wire_report);
+  static HapticReport report_copy;
+  REQUIRE(decode(wire_report, report_copy) == FrameError::ok);
+  CHECK(report_copy.endpoint == 3);
+  CHECK(report_copy.entries[0].impulse_Ns == report.entries[0].impulse_Ns);
+}
+
+TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {
+  auto rejected = [](auto mutate) {
+    PlaneFrame frame = valid_frame();
+    mutate(frame);
+    return decoded(encoded(frame));
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK(rejected([](PlaneFrame& f) { f.plane_count = kMaxPlanes + 1; }) == FrameError::count_out_of_range);
+  CHECK(rejected([&](PlaneFrame& f) { f.planes[1].point_m[2] = nan; }) == FrameError::not_finite);
+  CHECK(rejected([&](PlaneFrame& f) { f.planes[0].velocity_mps[0] = INFINITY; }) == FrameError::not_finite);
+  CHECK(rejected([](PlaneFrame& f) { f.planes[0].normal = {0.0, 0.0, 1.01}; }) == FrameError::normal_not_unit);
+  CHECK(rejected([](PlaneFrame& f) { f.world_period_s = 0.0; }) == FrameError::bad_period);
+  CHECK(rejected([](PlaneFrame& f) { f.coupling = static_cast<Coupling>(9); }) == FrameError::bad_coupling);
+  CHECK(rejected([](PlaneFrame& f) { f.planes[0].dynamic_friction = 0.9; }) == FrameError::bad_friction);
+  CHECK(rejected([](PlaneFrame& f) { f.reach_radius_m = -0.05; }) == FrameError::bad_reach);
+  CHECK(rejected([&](PlaneFrame& f) { f.reach_radius_m = nan; }) == FrameError::not_finite);
+  // Planes past the count are not looked at: garbage there is harmless.
+  CHECK(rejected([&](PlaneFrame& f) { f.planes[5].point_m[0] = nan; }) == FrameError::ok);
+
+  wire::PlaneFrame unsealed = encoded(valid_frame());
+  unsealed.planes[0].point_m[0] = 0.5;
+  CHECK(decoded(unsealed) == FrameError::checksum);
+}
+
+TEST_CASE("random bytes written over a frame are rejected") {
+  std::mt19937_64 random(4);
+  int accepted = 0;
+  for (int trial = 0; trial < 1000; ++trial) {
+    wire::PlaneFrame frame = encoded(valid_frame());
+    auto* bytes = reinterpret_cast<unsigned char*>(&frame);
+    const std::size_t start = random() % sizeof(frame);
+    const std::size_t length = 1 + random() % 64;
+    for (std::size_t k = start; k < std::min(sizeof(frame), start + length); ++k) bytes[k] = random() & 0xFF;
+    // Scribbles that happen to leave every byte unchanged are not corruption.
+    const wire::PlaneFrame original = encoded(valid_frame());
+    if (std::memcmp(&frame, &original, sizeof(frame)) == 0) continue;
+    if (decoded(frame) == FrameError::ok) ++accepted;
+  }
+  CHECK(accepted == 0);
+}
+
+}  // namespace impetus

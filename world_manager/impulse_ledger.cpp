@@ -1,0 +1,35 @@
+#include "world_manager/impulse_ledger.h"
+
+namespace impetus {
+
+ImpulseLedger::ImpulseLedger(std::size_t id_count) : id_count_(id_count) {}
+
+ImpulseLedger::OwnerBaselines& ImpulseLedger::baselines_of(const CounterOwner& owner) {
+  auto [it, inserted] = owners_.try_emplace(owner);
+  if (inserted) it->second.objects.resize(id_count_);
+  return it->second;
+}
+
+ImpulseDelta ImpulseLedger::take(const CounterOwner& owner, const ObjectImpulse& entry) {
+  Baseline& baseline = baselines_of(owner).objects[static_cast<std::size_t>(entry.object_id)];
+  if (!baseline.seen || baseline.epoch != entry.epoch) {
+    // A new counter starts at zero (contract/frames.h, ObjectImpulse::epoch).
+    baseline = Baseline{true, entry.epoch, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  }
+  const Eigen::Vector3d total_Ns = to_eigen(entry.impulse_Ns);
+  const Eigen::Vector3d total_angular_Nms = to_eigen(entry.angular_impulse_Nms);
+  ImpulseDelta delta{total_Ns - baseline.impulse_Ns, total_angular_Nms - baseline.angular_impulse_Nms};
+  baseline.impulse_Ns = total_Ns;
+  baseline.angular_impulse_Nms = total_angular_Nms;
+  return delta;
+}
+
+Eigen::Vector3d ImpulseLedger::take_static(const CounterOwner& owner, const Vec3& total_Ns) {
+  Eigen::Vector3d& baseline_Ns = baselines_of(owner).static_Ns;
+  const Eigen::Vector3d total = to_eigen(total_Ns);
+  const Eigen::Vector3d delta_Ns = total - baseline_Ns;
+  baseline_Ns = total;
+  return delta_Ns;
+}
+
+}  // namespace impetus

@@ -1,0 +1,395 @@
+#include "world_manager/scene.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <string_view>
+
+namespace impetus {
+
+namespace {
+
+using nlohmann::json;
+
+// A quaternion read from text with ~7 significant digits is still unit to ~1e-7; 1e-6 accepts those and rejects
+// anything a normalisation would noticeably change.
+constexpr double kUnitQuaternionTolerance = 1e-6;
+// Long values (a whole object echoed back) would drown the message; the start is enough to find it.
+constexpr std::size_t kMaxEchoedChars = 80;
+
+// JSON pointer escaping (RFC 6901) for keys that contain '/' or '~'.
+std::string escape_key(std::string_view key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') {
+      out += "~0";
+    } else if (c == '/') {
+      out += "~1";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+// A node of the document with its JSON pointer, so every error can name the field.
+class Node {
+ public:
+  Node(const json& value, std::string pointer, const std::string& source)
+      : value_(value), pointer_(std::move(pointer)), source_(source) {}
+
+  const json& value() const { return value_; }
+  const std::string& pointer() const { return pointer_; }
+
+  [[noreturn]] void fail(const std::string& reason) const {
+    std::string echoed = value_.dump();
+    if (echoed.size() > kMaxEchoedChars) echoed = echoed.substr(0, kMaxEchoedChars) + "...";
+    throw SceneError(source_ + ": " + where() + ": " + reason + " (got " + echoed + ")");
+  }
+  [[noreturn]] void fail_missing(std::string_view key, std::string_view hint = {}) const {
+    std::string message = source_ + ": " + pointer_ + "/" + escape_key(key) + ": missing required field";
+    if (!hint.empty()) message += std::string(" (") + std::string(hint) + ")";
+    throw SceneError(message);
+  }
+
+  bool has(std::string_view key) const { return value_.contains(key); }
+
+  Node child(std::string_view key) const {
+    return Node(value_.at(std::string(key)), pointer_ + "/" + escape_key(key), source_);
+  }
+  Node element(std::size_t index) const {
+    return Node(value_.at(index), pointer_ + "/" + std::to_string(index), source_);
+  }
+  Node required(std::string_view key) const {
+    if (!has(key)) fail_missing(key);
+    return child(key);
+  }
+
+  void expect_object() const {
+    if (!value_.is_object()) fail("expected an object");
+  }
+  // Unknown keys are errors: a misspelt optional key would otherwise silently fall back to its default.
+  void expect_keys(std::initializer_list<std::string_view> allowed) const {
+    expect_object();
+    for (const auto& item : value_.items()) {
+      bool known = false;
+      for (std::string_view name : allowed) known = known || item.key() == name;
+      if (!known) child(item.key()).fail("unknown key '" + item.key() + "'");
+    }
+  }
+
+  double number() const {
+    if (!value_.is_number()) fail("expected a number");
+    const double x = value_.get<double>();
+    if (!std::isfinite(x)) fail("expected a finite number");
+    return x;
+  }
+  double positive() const {
+    const double x = number();
+    if (!(x > 0.0)) fail("must be positive");
+    return x;
+  }
+  double non_negative() const {
+    const double x = number();
+    if (x < 0.0) fail("must not be negative");
+    return x;
+  }
+  double in_unit_interval() const {
+    const double x = number();
+    if (x < 0.0 || x > 1.0) fail("must be in [0, 1]");
+    return x;
+  }
+  std::int64_t integer() const {
+    if (!value_.is_number_integer()) fail("expected an integer");
+    return value_.get<std::int64_t>();
+  }
+  int positive_int() const {
+    const std::int64_t x = integer();
+    constexpr std::int64_t kLargestSensible = 1'000'000;  // far beyond any step count; guards int overflow
+    if (x <= 0 || x > kLargestSensible) fail("must be a positive integer no larger than 1000000");
+    return static_cast<int>(x);
+  }
+  bool boolean() const {
+    if (!value_.is_boolean()) fail("expected true or false");
+    return value_.get<bool>();
+  }
+  std::string string() const {
+    if (!value_.is_string()) fail("expected a string");
+    return value_.get<std::string>();
+  }
+  template <std::size_t N>
+  std::array<double, N> numbers() const {
+    if (!value_.is_array() || value_.size() != N) fail("expected an array of " + std::to_string(N) + " numbers");
+    std::array<double, N> out{};
+    for (std::size_t i = 0; i < N; ++i) out[i] = element(i).number();
+    return out;
+  }
+
+ private:
+  std::string where() const { return pointer_.empty() ? std::string("/") : pointer_; }
+
+  const json& value_;
+  std::string pointer_;
+  const std::string& source_;
+};
+
+Material parse_material(const Node& node, Material material) {
+  if (node.has("static_friction")) material.static_friction = node.child("static_friction").non_negative();
+  if (node.has("dynamic_friction")) {
+    material.dynamic_friction = node.child("dynamic_friction").non_negative();
+  } else if (node.has("static_friction")) {
+    material.dynamic_friction = material.static_friction;  // one coefficient given: no stick-slip difference
+  }
+  if (material.dynamic_friction > material.static_friction) {
+    const Node offending = node.has("dynamic_friction") ? node.child("dynamic_friction") : node;
+    offending.fail("dynamic_friction must not exceed static_friction (" + std::to_string(material.static_friction) +
+                   ")");
+  }
+  if (node.has("restitution")) material.restitution = node.child("restitution").in_unit_interval();
+  return material;
+}
+
+Floor parse_floor(const Node& node) {
+  Floor floor;
+  if (node.value().is_null()) {
+    floor.present = false;
+    return floor;
+  }
+  node.expect_keys({"height_m", "static_friction", "dynamic_friction", "restitution"});
+  if (node.has("height_m")) floor.height_m = node.child("height_m").number();
+  floor.material = parse_material(node, floor.material);
+  return floor;
+}
+
+PhysicsParams parse_physics(const Node& node) {
+  node.expect_keys(
+      {"world_rate_hz", "substeps", "solver", "solver_iterations", "erp", "cfm", "auto_disable", "seed"});
+  PhysicsParams physics;
+  if (node.has("world_rate_hz")) {
+    const Node rate = node.child("world_rate_hz");
+    physics.world_rate_hz = rate.positive();
+    // A denormal rate is positive but its period 1/rate is infinite.
+    if (!std::isfinite(physics.world_period_s())) rate.fail("too small: the world period 1/rate is not finite");
+  }
+  if (node.has("substeps")) physics.substeps = node.child("substeps").positive_int();
+  if (node.has("solver")) {
+    const Node solver = node.child("solver");
+    const std::string name = solver.string();
+    if (name == "quickstep") {
+      physics.solver = PhysicsParams::Solver::quickstep;
+    } else if (name == "direct") {
+      physics.solver = PhysicsParams::Solver::direct;
+    } else {
+      solver.fail("expected \"quickstep\" or \"direct\"");
+    }
+  }
+  if (node.has("solver_iterations")) physics.solver_iterations = node.child("solver_iterations").positive_int();
+  if (node.has("erp")) physics.erp = node.child("erp").in_unit_interval();
+  if (node.has("cfm")) physics.cfm = node.child("cfm").non_negative();
+  if (node.has("auto_disable")) physics.auto_disable = node.child("auto_disable").boolean();
+  if (node.has("seed")) {
+    const Node seed = node.child("seed");
+    if (!seed.value().is_number_unsigned()) seed.fail("expected a non-negative integer");
+    physics.seed = seed.value().get<std::uint64_t>();
+  }
+  return physics;
+}
+
+HapticParams parse_haptic(const Node& node) {
+  node.expect_keys({"reach_radius_m", "stiffness_Npm", "damping_Nspm", "static_friction", "dynamic_friction"});
+  HapticParams haptic;
+  if (node.has("reach_radius_m")) haptic.reach_radius_m = node.child("reach_radius_m").positive();
+  if (node.has("stiffness_Npm")) haptic.stiffness_Npm = node.child("stiffness_Npm").positive();
+  if (node.has("damping_Nspm")) haptic.damping_Nspm = node.child("damping_Nspm").non_negative();
+  if (node.has("static_friction") || node.has("dynamic_friction")) {
+    if (!node.has("static_friction")) node.fail_missing("static_friction", "the finger material needs both");
+    haptic.finger_material_given = true;
+    haptic.finger_material = parse_material(node, haptic.finger_material);
+  }
+  return haptic;
+}
+
+Shape parse_shape(const Node& node, ShapeKind kind) {
+  Shape shape;
+  shape.kind = kind;
+  switch (kind) {
+    case ShapeKind::box: {
+      const Node size = node.required("size_m");
+      shape.box_size_m = size.numbers<3>();
+      for (std::size_t i = 0; i < 3; ++i) {
+        if (!(shape.box_size_m[i] > 0.0)) size.element(i).fail("box size must be positive");
+      }
+      break;
+    }
+    case ShapeKind::sphere:
+      shape.radius_m = node.required("radius_m").positive();
+      break;
+    case ShapeKind::capsule:
+    case ShapeKind::cylinder:
+      shape.radius_m = node.required("radius_m").positive();
+      // A capsule of zero length is a sphere, which is allowed; a cylinder needs a length.
+      shape.length_m = kind == ShapeKind::capsule ? node.required("length_m").non_negative()
+                                                  : node.required("length_m").positive();
+      break;
+  }
+  return shape;
+}
+
+ShapeKind parse_shape_kind(const Node& node) {
+  const std::string name = node.string();
+  for (ShapeKind kind : {ShapeKind::box, ShapeKind::sphere, ShapeKind::capsule, ShapeKind::cylinder}) {
+    if (name == to_string(kind)) return kind;
+  }
+  node.fail("unknown shape, expected box, sphere, capsule or cylinder");
+}
+
+SceneObject parse_object(const Node& node) {
+  node.expect_object();
+  SceneObject object;
+  const ShapeKind kind = parse_shape_kind(node.required("shape"));
+  switch (kind) {
+    case ShapeKind::box:
+      node.expect_keys({"name", "shape", "size_m", "dynamic", "mass_kg", "density_kgpm3", "position_m",
+                        "orientation_wxyz", "linear_velocity_mps", "angular_velocity_radps", "static_friction",
+                        "dynamic_friction", "restitution"});
+      break;
+    case ShapeKind::sphere:
+      node.expect_keys({"name", "shape", "radius_m", "dynamic", "mass_kg", "density_kgpm3", "position_m",
+                        "orientation_wxyz", "linear_velocity_mps", "angular_velocity_radps", "static_friction",
+                        "dynamic_friction", "restitution"});
+      break;
+    case ShapeKind::capsule:
+    case ShapeKind::cylinder:
+      node.expect_keys({"name", "shape", "radius_m", "length_m", "dynamic", "mass_kg", "density_kgpm3",
+                        "position_m", "orientation_wxyz", "linear_velocity_mps", "angular_velocity_radps",
+                        "static_friction", "dynamic_friction", "restitution"});
+      break;
+  }
+  object.name = node.required("name").string();
+  if (object.name.empty()) node.child("name").fail("name must not be empty");
+  object.shape = parse_shape(node, kind);
+  object.dynamic = node.required("dynamic").boolean();
+
+  if (object.dynamic) {
+    const bool has_mass = node.has("mass_kg");
+    const bool has_density = node.has("density_kgpm3");
+    if (has_mass == has_density) {
+      if (has_mass) node.child("density_kgpm3").fail("give either mass_kg or density_kgpm3, not both");
+      node.fail_missing("mass_kg", "a dynamic object needs mass_kg or density_kgpm3");
+    }
+    object.mass_kg = has_mass ? node.child("mass_kg").positive()
+                              : node.child("density_kgpm3").positive() * object.shape.volume_m3();
+    // Each factor can be valid while the product over- or underflows; ODE needs a positive finite mass.
+    if (!has_mass && !(object.mass_kg > 0.0 && std::isfinite(object.mass_kg))) {
+      node.child("density_kgpm3").fail("density × volume is not a positive finite mass (" +
+                                       std::to_string(object.mass_kg) + " kg)");
+    }
+  } else {
+    // A static object is immovable: a mass or a velocity would be silently ignored, so it is an error.
+    for (std::string_view key : {"mass_kg", "density_kgpm3", "linear_velocity_mps", "angular_velocity_radps"}) {
+      if (node.has(key)) node.child(key).fail("static objects cannot have " + std::string(key));
+    }
+  }
+
+  object.position_m = node.required("position_m").numbers<3>();
+  if (node.has("orientation_wxyz")) {
+    const Node q_node = node.child("orientation_wxyz");
+    object.orientation_wxyz = q_node.numbers<4>();
+    const auto& q = object.orientation_wxyz;
+    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (std::abs(norm - 1.0) > kUnitQuaternionTolerance) {
+      q_node.fail("quaternion must be unit within 1e-6 (norm " + std::to_string(norm) + ")");
+    }
+  }
+  if (node.has("linear_velocity_mps")) object.linear_velocity_mps = node.child("linear_velocity_mps").numbers<3>();
+  if (node.has("angular_velocity_radps")) {
+    object.angular_velocity_radps = node.child("angular_velocity_radps").numbers<3>();
+  }
+  object.material = parse_material(node, Material{});
+  return object;
+}
+
+}  // namespace
+
+double combine_friction(double a, double b) { return std::sqrt(a * b); }
+double combine_restitution(double a, double b) { return std::max(a, b); }
+
+const char* to_string(ShapeKind kind) {
+  switch (kind) {
+    case ShapeKind::box:
+      return "box";
+    case ShapeKind::sphere:
+      return "sphere";
+    case ShapeKind::capsule:
+      return "capsule";
+    case ShapeKind::cylinder:
+      return "cylinder";
+  }
+  return "unknown";
+}
+
+double Shape::volume_m3() const {
+  constexpr double kPi = std::numbers::pi;
+  const double sphere_m3 = 4.0 / 3.0 * kPi * radius_m * radius_m * radius_m;
+  switch (kind) {
+    case ShapeKind::box:
+      return box_size_m[0] * box_size_m[1] * box_size_m[2];
+    case ShapeKind::sphere:
+      return sphere_m3;
+    case ShapeKind::capsule:
+      return kPi * radius_m * radius_m * length_m + sphere_m3;
+    case ShapeKind::cylinder:
+      return kPi * radius_m * radius_m * length_m;
+  }
+  return 0.0;
+}
+
+Scene parse_scene(const nlohmann::json& document, const std::string& source_name) {
+  const Node root(document, "", source_name);
+  root.expect_keys({"description", "gravity_mps2", "floor", "physics", "haptic", "objects"});
+  if (root.has("description")) root.child("description").string();  // free text for the reader; must be a string
+
+  Scene scene;
+  scene.source_name = source_name;
+  if (root.has("gravity_mps2")) scene.gravity_mps2 = root.child("gravity_mps2").numbers<3>();
+  if (root.has("floor")) scene.floor = parse_floor(root.child("floor"));
+  if (root.has("physics")) scene.physics = parse_physics(root.child("physics"));
+  if (root.has("haptic")) scene.haptic = parse_haptic(root.child("haptic"));
+
+  const Node objects = root.required("objects");
+  if (!objects.value().is_array()) objects.fail("expected an array of objects");
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < objects.value().size(); ++i) {
+    const Node node = objects.element(i);
+    SceneObject object = parse_object(node);
+    if (!names.insert(object.name).second) node.child("name").fail("duplicate object name");
+    scene.objects.push_back(std::move(object));
+  }
+  return scene;
+}
+
+Scene load_scene(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw SceneError(path + ": cannot open scene file");
+  std::stringstream text;
+  text << file.rdbuf();
+  return parse_scene_text(text.str(), path);
+}
+
+Scene parse_scene_text(std::string_view text, const std::string& source_name) {
+  nlohmann::json document;
+  try {
+    document = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& error) {
+    // Not only parse_error: a number too large for a double ("1e400") throws out_of_range (406) from the parser.
+    throw SceneError(source_name + ": not valid JSON: " + error.what());
+  }
+  return parse_scene(document, source_name);
+}
+
+}  // namespace impetus

@@ -1,0 +1,163 @@
+#pragma once
+// The scene model: what a world contains (DESIGN.md §4), parsed and validated from JSON before anything starts.
+//
+// File format (SI units; every key name carries its unit; world frame right-handed, z up):
+//
+//   {
+//     "description": "...",                     optional free text (JSON has no comments: the scene's reasoning)
+//     "gravity_mps2": [0, 0, -9.81],            optional, default [0, 0, -9.81]
+//     "floor": {                                optional object, default: a floor at z = 0 with default material;
+//       "height_m": 0.0,                        `"floor": null` means no floor at all
+//       "static_friction": 0.5, "dynamic_friction": 0.5, "restitution": 0.0
+//     },
+//     "physics": {                              optional, every key optional
+//       "world_rate_hz": 20,                    paper §4.2.1
+//       "substeps": 10,                         ODE steps inside one world period
+//       "solver": "quickstep",                  quickstep (iterative, O(n)) | direct (ODE's dWorldStep: exact
+//                                               LCP, O(n³), for stacks with large mass ratios QuickStep cannot hold)
+//       "solver_iterations": 20,                QuickStep iterations
+//       "erp": 0.2, "cfm": 1e-5,                ODE error reduction / constraint force mixing
+//       "auto_disable": false,                  let resting bodies sleep (off: "model only what a scene needs")
+//       "seed": 1                               dRandSetSeed, so QuickStep runs are bitwise reproducible
+//     },
+//     "haptic": {                               optional, every key optional
+//       "reach_radius_m": 0.05,                 base radius of the feature query (paper §3.1 step 1)
+//       "stiffness_Npm": 2000,                  k_p of paper §3.3 (2 kN/m in §4.2.1)
+//       "damping_Nspm": 5,                      k_d of paper §3.3
+//       "static_friction": 1.0,                 the finger pad's material; when given it is combined with each
+//       "dynamic_friction": 1.0                 object's material like two bodies are (see combine_friction)
+//     },
+//     "objects": [                              required (may be empty)
+//       { "name": "cube",                       required, unique
+//         "shape": "box",                       required: box | sphere | capsule | cylinder
+//         "size_m": [0.05, 0.05, 0.05],         box: full extents along body x, y, z
+//         "radius_m": 0.02,                     sphere, capsule, cylinder
+//         "length_m": 0.1,                      capsule: cylindrical part (caps excluded); cylinder: total length;
+//                                               both along body z
+//         "dynamic": true,                      required
+//         "mass_kg": 1.0,                       dynamic only, exactly one of mass_kg / density_kgpm3
+//         "density_kgpm3": 1000,
+//         "position_m": [x, y, z],              required: centre (= centre of mass)
+//         "orientation_wxyz": [1, 0, 0, 0],     optional, unit within 1e-6
+//         "linear_velocity_mps": [0, 0, 0],     optional, dynamic only
+//         "angular_velocity_radps": [0, 0, 0],  optional, dynamic only, world frame
+//         "static_friction": 0.5, "dynamic_friction": 0.5, "restitution": 0.0    optional material
+//       } ]
+//   }
+//
+// Keys for another shape (e.g. "radius_m" on a box) are unknown keys. Every error throws SceneError with the message
+// `FILE: /json/pointer: reason (got VALUE)`.
+
+#include "common/contract/vec3.h"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace impetus {
+
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A surface material. Coefficients are dimensionless; dynamic_friction <= static_friction; restitution in [0, 1].
+struct Material {
+  // Dry wood or plastic on a table: a common default that neither slips nor sticks unrealistically.
+  static constexpr double kDefaultFriction = 0.5;
+  double static_friction = kDefaultFriction;
+  double dynamic_friction = kDefaultFriction;
+  double restitution = 0.0;  // default: contacts do not bounce
+};
+
+// Contact between two materials. Geometric mean for friction (a slippery surface makes the pair slippery, and
+// mu with itself gives mu); the larger restitution (a bouncy ball bounces on any floor).
+double combine_friction(double a, double b);
+double combine_restitution(double a, double b);
+
+enum class ShapeKind { box, sphere, capsule, cylinder };
+const char* to_string(ShapeKind kind);
+
+// Shape in the body frame, centred on the body origin (which is the centre of mass).
+struct Shape {
+  ShapeKind kind = ShapeKind::sphere;
+  Vec3 box_size_m{};      // box: full extents along body x, y, z
+  double radius_m = 0.0;  // sphere, capsule, cylinder
+  double length_m = 0.0;  // capsule: between the cap centres; cylinder: total; along body z
+  double volume_m3() const;
+};
+
+struct SceneObject {
+  std::string name;
+  Shape shape;
+  bool dynamic = false;
+  double mass_kg = 0.0;  // dynamic: resolved from mass_kg or density × volume; static: 0 (immovable)
+  Vec3 position_m{};
+  std::array<double, 4> orientation_wxyz{1.0, 0.0, 0.0, 0.0};  // unit quaternion, body → world
+  Vec3 linear_velocity_mps{};
+  Vec3 angular_velocity_radps{};  // world frame
+  Material material;
+};
+
+struct Floor {
+  bool present = true;
+  double height_m = 0.0;  // the plane z = height_m; solid below
+  Material material;
+};
+
+struct HapticParams {
+  // A fingertip-sized neighbourhood (paper §3.1): planes of objects farther than this plus what can move in one world
+  // period are not needed before the next frame.
+  double reach_radius_m = 0.05;
+  double stiffness_Npm = 2000.0;  // paper §4.2.1
+  // About 5 N·s/m damps the 2 kN/m spring on a ~0.1 kg fingertip near critically (2·sqrt(k·m) ≈ 28 N·s/m is
+  // critical; the hand adds its own damping), and keeps k_d/Δt well inside the 1 kHz stability bound.
+  double damping_Nspm = 5.0;
+  bool finger_material_given = false;  // false: planes carry the object's own friction
+  Material finger_material;
+};
+
+struct PhysicsParams {
+  double world_rate_hz = 20.0;  // paper §4.2.1
+  // 50 ms is too coarse for ODE's contacts: a body falls g·T² ≈ 2.5 cm into the floor in one step, half a 5 cm cube.
+  // Ten 5 ms substeps keep that under 0.25 mm for the cost of ten cheap steps.
+  int substeps = 10;
+  // QuickStep is ODE's fast iterative solver; it converges badly when a light body carries a much heavier one
+  // (a 1000:1 stack collapses at any iteration count), where the direct solver is exact but cubic in the contacts.
+  enum class Solver { quickstep, direct };
+  Solver solver = Solver::quickstep;
+  int solver_iterations = 20;  // ODE's own default for QuickStep; enough for stacks of a few boxes
+  double erp = 0.2;            // ODE's default: corrects 20 % of a penetration per step
+  // A little compliance (ODE default is 1e-10 in double) lets QuickStep settle stacks without jitter.
+  double cfm = 1e-5;
+  bool auto_disable = false;
+  std::uint64_t seed = 1;
+
+  double world_period_s() const { return 1.0 / world_rate_hz; }
+};
+
+struct Scene {
+  std::string source_name;  // file the scene came from, for messages
+  Vec3 gravity_mps2{0.0, 0.0, -9.81};
+  Floor floor;
+  std::vector<SceneObject> objects;  // an object's index is its object_id on the world link
+  HapticParams haptic;
+  PhysicsParams physics;
+
+  // object_id of the floor on the world link: one past the objects.
+  std::int32_t floor_object_id() const { return static_cast<std::int32_t>(objects.size()); }
+};
+
+// Reads and validates a scene file; throws SceneError (also for unreadable files and JSON syntax errors).
+Scene load_scene(const std::string& path);
+// Validates an already-parsed document; `source_name` prefixes every error message.
+Scene parse_scene(const nlohmann::json& document, const std::string& source_name);
+// Parses and validates scene text (the body of load_scene without the file); throws SceneError, also for bad JSON.
+Scene parse_scene_text(std::string_view text, const std::string& source_name);
+
+}  // namespace impetus

@@ -1,0 +1,183 @@
+#include "world_manager/world_node.h"
+
+#include "common/runtime/lockstep_schedule.h"
+#include "common/runtime/process.h"
+#include "common/runtime/realtime_clock.h"
+#include "common/runtime/staleness.h"
+#include "common/spidar/geometry.h"
+#include "world_manager/impulse_limits.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace impetus {
+namespace {
+
+Scene scene_with_overrides(const WorldNodeOptions& options) {
+  Scene scene = load_scene(options.scene_path);
+  if (options.substeps) scene.physics.substeps = *options.substeps;
+  return scene;
+}
+
+WorldOptions world_options(const WorldNodeOptions& options) {
+  WorldOptions world;
+  world.coupling = options.coupling;
+  world.world_rate_hz = options.rate_hz;
+  world.world_session = options.world_session != 0 ? options.world_session : new_session_id();
+  return world;
+}
+
+nlohmann::json to_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+WorldNode::WorldNode(const WorldNodeOptions& options)
+    : options_(options), scene_(scene_with_overrides(options)), world_(scene_, world_options(options)) {
+  if (options.clock == ClockMode::lockstep) {
+    LockstepSchedule::ticks_per_world_step(world_.world_period_s(), options.haptic_rate_hz);  // throws if not whole
+  }
+  if (!options.log_path.empty()) {
+    log_file_.emplace(options.log_path);
+    if (!*log_file_) throw std::runtime_error("cannot open log file '" + options.log_path + "' for writing");
+    log_.emplace(world_);
+    log_->write_header(*log_file_);
+  }
+}
+
+WorldLinkInfo WorldNode::link_info() const {
+  WorldLinkInfo info;
+  info.world_rate_hz = 1.0 / world_.world_period_s();
+  info.world_period_s = world_.world_period_s();
+  info.phase_ticks = options_.phase_ticks;
+  info.clock = options_.clock;
+  info.coupling = options_.coupling;
+  return info;
+}
+
+std::string WorldNode::warnings() const {
+  if (options_.coupling != Coupling::impulse) return "";
+  const double max_force_N = SpidarGeometry{}.max_force_N;
+  const LightObjects light = light_for_impulse_coupling(scene_, world_.world_period_s(), max_force_N);
+  if (light.count == 0) return "";
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "%zu object(s) are light for impulse coupling at %.1f Hz, the lightest '%s' (%.3g kg): the device's "
+                "%.0f N held for one world period would give it %.3g m/s; a push can launch it. Use --coupling "
+                "local or a faster --rate.",
+                light.count, 1.0 / world_.world_period_s(), light.lightest_name.c_str(), light.lightest_mass_kg,
+                max_force_N, light.lightest_speed_mps);
+  return text;
+}
+
+void WorldNode::step_world() {
+  const std::int64_t now_ns = monotonic_now_ns();
+  HapticReport incoming;
+  if (link_->latest_report(incoming)) {
+    if (!have_report_ || incoming.haptic_session != report_session_ || incoming.tick != report_tick_) {
+      report_fresh_ns_ = now_ns;
+      report_session_ = incoming.haptic_session;
+      report_tick_ = incoming.tick;
+    }
+    report_ = incoming;
+    have_report_ = true;
+  }
+  // An endpoint that stopped reporting (killed, stalled) no longer knows where the finger is: drop its finger so
+  // position coupling stops pushing with a stale sample. Its impulse totals stay as they were, so the ledger applies
+  // nothing more from them; a restarted controller starts a new session from zero.
+  if (options_.clock == ClockMode::realtime && have_report_ &&
+      static_cast<double>(now_ns - report_fresh_ns_) * 1e-9 > endpoint_stale_s(world_.world_period_s())) {
+    report_.finger_valid = 0;
+  }
+  const std::int64_t cpu_before_ns = thread_cpu_now_ns();
+  const PlaneFrame& frame = world_.step(have_report_ ? &report_ : nullptr);
+  step_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
+  link_->publish_frame(frame);
+  if (log_) log_->write_row(*log_file_);
+}
+
+void WorldNode::publish_stats(const RealtimeClock* clock) {
+  stats_ = loop_stats_now(clock);
+  stats_.ticks = world_.steps_taken();
+  stats_.rejected_frames = link_->rejected_reports();
+  link_->publish_stats(stats_);
+}
+
+int WorldNode::run() {
+  if (link_ == nullptr) throw std::logic_error("WorldNode::run without a link");
+  const std::uint64_t max_steps =
+      options_.duration_s > 0.0
+          ? static_cast<std::uint64_t>(std::llround(options_.duration_s / world_.world_period_s()))
+          : std::numeric_limits<std::uint64_t>::max();
+  if (options_.clock == ClockMode::lockstep) {
+    while (world_.steps_taken() < max_steps) {
+      const TurnResult result = link_->wait_turn();
+      if (result != TurnResult::ok) {
+        if (result == TurnResult::peer_gone && !g_stop_requested.load()) {
+          std::fprintf(stderr, "world_manager: the haptic controller went away\n");
+        }
+        break;
+      }
+      step_world();
+      publish_stats(nullptr);
+      link_->finish_turn();
+    }
+    publish_stats(nullptr);
+  } else {
+    RealtimeClock clock(world_.world_period_s());
+    while (!g_stop_requested.load() && world_.steps_taken() < max_steps) {
+      clock.wait_next();
+      step_world();
+      publish_stats(&clock);
+    }
+  }
+  if (log_file_) {
+    log_file_->flush();
+    if (!*log_file_) throw std::runtime_error("writing log '" + options_.log_path + "' failed");
+  }
+  return 0;
+}
+
+nlohmann::json WorldNode::summary() const {
+  nlohmann::json objects = nlohmann::json::object();
+  const auto states = world_.states();
+  for (std::size_t id = 0; id < scene_.objects.size(); ++id) {
+    const auto& object = scene_.objects[id];
+    if (!object.dynamic) continue;
+    const ObjectState& state = states[id];
+    const Eigen::Quaterniond& q = state.pose.orientation;
+    objects[object.name] = {{"position", to_json(state.pose.position_m)},
+                            {"orientation", {q.w(), q.x(), q.y(), q.z()}},
+                            {"velocity", to_json(state.velocity_mps)},
+                            {"angular_velocity", to_json(state.angular_velocity_radps)},
+                            {"impulse_Ns", to_json(world_.total_impulse_Ns(id))},
+                            {"angular_impulse_Nms", to_json(world_.total_angular_impulse_Nms(id))}};
+  }
+  return {{"objects", objects},
+          {"world",
+           {{"steps", world_.steps_taken()},
+            {"time_s", world_.time_s()},
+            {"period_s", world_.world_period_s()},
+            {"skipped_periods", stats_.skipped_periods},
+            {"rejected_reports", stats_.rejected_frames},
+            {"lateness_p50_ns", stats_.lateness_p50_ns},
+            {"lateness_p99_ns", stats_.lateness_p99_ns},
+            {"lateness_max_ns", stats_.lateness_max_ns},
+            {"static_impulse_Ns", to_json(world_.total_static_impulse_Ns())},
+            {"mechanical_energy_J", world_.mechanical_energy_J()},
+            {"cpu_per_step_p50_us", step_cpu_ns_.percentile_ns(0.5) / 1e3},
+            {"cpu_per_step_p99_us", step_cpu_ns_.percentile_ns(0.99) / 1e3},
+            {"cpu_per_step_mean_us", step_cpu_ns_.mean_ns() / 1e3},
+            {"cpu_per_simulated_s", step_cpu_ns_.mean_ns() * 1e-9 / world_.world_period_s()}}},
+          {"config",
+           {{"scene", options_.scene_path},
+            {"world_rate_hz", 1.0 / world_.world_period_s()},
+            {"coupling", to_string(world_.coupling())},
+            {"clock", to_string(options_.clock)},
+            {"phase_ticks", options_.phase_ticks},
+            {"substeps", scene_.physics.substeps},
+            {"solver_iterations", scene_.physics.solver_iterations}}}};
+}
+
+}  // namespace impetus

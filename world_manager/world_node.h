@@ -1,0 +1,77 @@
+#pragma once
+// The world node (DESIGN.md §1.3): one World on its schedule. Each step takes the newest report from the world link,
+// steps the world, publishes the frame and the loop statistics, and logs a row. Real time: its own clock at the world
+// rate. Lockstep: a step per turn the link gives (shared memory), or whenever the in-process link calls step_world().
+//
+// Owns its World, log and statistics; its summary is the world half of summary.json (DESIGN.md §4).
+
+#include "common/link/inproc/inproc_world_link.h"
+#include "common/link/world_link.h"
+#include "common/runtime/loop_stats.h"
+#include "world_manager/scene.h"
+#include "world_manager/world.h"
+#include "world_manager/world_log.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <fstream>
+#include <optional>
+#include <string>
+
+namespace impetus {
+
+struct WorldNodeOptions {
+  std::string scene_path;
+  std::optional<double> rate_hz;  // default: the scene's physics.world_rate_hz
+  std::optional<int> substeps;    // default: the scene's physics.substeps
+  Coupling coupling = Coupling::impulse;
+  ClockMode clock = ClockMode::realtime;
+  std::uint64_t phase_ticks = 0;
+  double duration_s = 0.0;  // 0: until stopped
+  std::string log_path;     // "" : no log
+  double haptic_rate_hz = 1000.0;  // lockstep: the world period must be a whole number of haptic ticks
+  std::uint64_t world_session = 0;  // 0: a fresh new_session_id()
+};
+
+class WorldNode final : public WorldStepper {
+ public:
+  // Loads the scene (SceneError names the file and field), builds the world, opens the log. Throws
+  // std::invalid_argument for a lockstep period that is not a whole number of haptic ticks.
+  explicit WorldNode(const WorldNodeOptions& options);
+
+  // What the link tells haptic nodes at attach.
+  WorldLinkInfo link_info() const;
+  // The link to serve; must be set before run() or the first step, and outlive the node.
+  void connect(WorldLinkServer& link) { link_ = &link; }
+
+  // Runs until the duration, a stop request, or (lockstep) the end of the session. Returns the exit status.
+  int run();
+  // One world step (the in-process link's lockstep turn).
+  void step_world() override;
+
+  // Start-up warnings a user should see (objects too light for the coupling at this rate), one per line; "" if none.
+  std::string warnings() const;
+  // The world half of summary.json: objects, world statistics, config.
+  nlohmann::json summary() const;
+  const World& world() const { return world_; }
+
+ private:
+  void publish_stats(const class RealtimeClock* clock);
+
+  WorldNodeOptions options_;
+  Scene scene_;
+  World world_;
+  WorldLinkServer* link_ = nullptr;
+  std::optional<std::ofstream> log_file_;
+  std::optional<WorldLog> log_;
+  HapticReport report_{};
+  bool have_report_ = false;
+  std::uint64_t report_tick_ = 0;
+  std::uint64_t report_session_ = 0;
+  std::int64_t report_fresh_ns_ = 0;
+  LoopStats stats_;
+  LatencyHistogram step_cpu_ns_;  // CPU time of World::step (coupling + engine + features), per step
+};
+
+}  // namespace impetus
