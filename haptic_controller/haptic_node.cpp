@@ -32,8 +32,9 @@ void format_row(std::ostream& out, const HapticLogRow& row) {
   line.number(row.interpolation_weight).integer(row.lateness_ns).integer(row.active_planes).integer(row.flags);
 }
 
-ServoOptions servo_options(const HapticNodeOptions& options) {
+ServoOptions servo_options(const HapticNodeOptions& options, const DeviceLimits& limits) {
   ServoOptions servo;
+  servo.max_force_N = limits.max_force_N;
   servo.stiffness_Npm = options.stiffness_Npm;
   servo.damping_Nspm = options.damping_Nspm;
   servo.tick_period_s = 1.0 / options.rate_hz;
@@ -42,12 +43,12 @@ ServoOptions servo_options(const HapticNodeOptions& options) {
 
 }  // namespace
 
-HapticNode::HapticNode(const HapticNodeOptions& options, WorldLinkClient& world, DevicePortHost& device)
+HapticNode::HapticNode(const HapticNodeOptions& options, WorldLinkClient& world, HapticDevice& device)
     : options_(options),
       period_s_(1.0 / options.rate_hz),
       world_(world),
       device_(device),
-      servo_(servo_options(options), options.haptic_session != 0 ? options.haptic_session : new_session_id()) {
+      servo_(servo_options(options, device.limits()), options.haptic_session) {
   if (options.clock == ClockMode::lockstep) {
     LockstepSchedule::ticks_per_world_step(world.info().world_period_s, options.rate_hz);  // throws if not whole
   }
@@ -66,17 +67,13 @@ void HapticNode::receive_frame(double now_s) {
   if (world_.receive_frame(frame_buffer_)) servo_.on_plane_frame(frame_buffer_, now_s);
 }
 
-// Everything after the device reading: the servo tick, the command to the device, the report to the world, the log.
-void HapticNode::tick(const DeviceState* device, std::uint64_t tick, double now_s, double dt_s,
-                      std::int64_t lateness_ns) {
+// After the world's frame: the finger, the servo tick, the force to the device, the report to the world, the log.
+void HapticNode::tick(std::uint64_t tick, double now_s, double dt_s, std::int64_t lateness_ns) {
+  const FingerSample* finger = device_.read(tick, now_s);
   const std::int64_t cpu_before_ns = thread_cpu_now_ns();
-  const TickResult& result = servo_.tick(device, now_s, dt_s);
+  const TickResult& result = servo_.tick(finger, now_s, dt_s);
   tick_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
-  DeviceCommand command;
-  command.tick = tick;
-  command.haptic_session = servo_.report().haptic_session;
-  command.tension_N = result.tension_N;
-  device_.send_command(command);
+  const bool saturated = !device_.command(tick, to_eigen(result.force_N), result.render);
   const HapticReport& report = servo_.report();
   world_.publish_report(report);
 
@@ -94,7 +91,7 @@ void HapticNode::tick(const DeviceState* device, std::uint64_t tick, double now_
     row.interpolation_weight = result.interpolation_weight;
     row.lateness_ns = lateness_ns;
     row.active_planes = result.active_planes;
-    row.flags = (result.finger_valid ? 1u : 0u) | (result.saturated ? 2u : 0u) | (result.fault ? 4u : 0u) |
+    row.flags = (result.finger_valid ? 1u : 0u) | (saturated ? 2u : 0u) | (result.fault ? 4u : 0u) |
                 (result.world_stale ? 8u : 0u) | (result.sticking ? 16u : 0u);
     log_->push(row);
   }
@@ -109,11 +106,10 @@ void HapticNode::run_lockstep() {
   const LockstepSchedule schedule(LockstepSchedule::ticks_per_world_step(world_.info().world_period_s, options_.rate_hz),
                                   world_.info().phase_ticks);
   const std::uint64_t ticks = max_ticks();
-  for (std::uint64_t t = 0; t < ticks && device_.wait_for_device(); ++t) {
+  for (std::uint64_t t = 0; t < ticks && device_.wait_attached(); ++t) {
     // Exactly t·T: interpolation weights are then tick counts over n, the same in every run.
     const double now_s = static_cast<double>(t) * period_s_;
-    const DeviceState* device = device_.lockstep_turn(t);
-    tick(device, t, now_s, period_s_, 0);
+    tick(t, now_s, period_s_, 0);
     if (schedule.world_step_due(t) && world_.step_world(t)) receive_frame(now_s);
     if (t % kStatsEveryTicks == 0) publish_stats(nullptr);
   }
@@ -137,9 +133,8 @@ void HapticNode::run_realtime() {
   const std::uint64_t ticks = max_ticks();
   while (!g_stop_requested.load() && clock.ticks() < ticks) {
     const TickTiming timing = clock.wait_next();
-    const DeviceState* device = device_.latest_state(timing.now_s);
     receive_frame(timing.now_s);
-    tick(device, timing.index, timing.now_s, timing.elapsed_s, timing.lateness_ns);
+    tick(timing.index, timing.now_s, timing.elapsed_s, timing.lateness_ns);
     if (timing.index % kStatsEveryTicks == 0) publish_stats(&clock);
   }
   loop_done.store(true);
@@ -164,7 +159,7 @@ void HapticNode::publish_stats(const RealtimeClock* clock) {
   LoopStats stats = loop_stats_now(clock);
   stats.ticks = servo_.counters().ticks;
   stats.faults = servo_.counters().faults;
-  stats.rejected_frames = world_.rejected_frames() + device_.rejected_states();
+  stats.rejected_frames = world_.rejected_frames() + device_.counters().rejected_frames;
   world_.publish_stats(stats);
 }
 
@@ -181,7 +176,7 @@ nlohmann::json HapticNode::summary() const {
             {"rate_hz", options_.rate_hz},
             {"faults", counters.faults},
             {"force_clamps", counters.force_clamps},
-            {"saturations", counters.saturations},
+            {"saturations", device_.counters().saturations},
             {"infeasible_contacts", counters.infeasible_contacts},
             {"stale_world_ticks", counters.stale_world_ticks},
             {"no_device_ticks", counters.no_device_ticks},
@@ -189,7 +184,7 @@ nlohmann::json HapticNode::summary() const {
             {"contact_frame_boundaries", counters.contact_frame_boundaries},
             {"frame_jump_max_m", counters.frame_jump_max_m},
             {"local_model_error_max_m", counters.local_model_error_max_m},
-            {"rejected_frames", world_.rejected_frames() + device_.rejected_states()},
+            {"rejected_frames", world_.rejected_frames() + device_.counters().rejected_frames},
             {"world_attaches", world_.attaches()},
             {"log_rows_dropped", log_ ? log_->dropped() : 0},
             {"max_force_N", max_force_N_},

@@ -1,16 +1,16 @@
 #pragma once
-// The haptic node (DESIGN.md §1.3): the 1 kHz servo on its schedule. Each tick: the device's state from the device
-// port, the world's newest frame from the world link, HapticServo::tick, the command back to the device, the report to
-// the world, a log row into the real-time ring. Real time: its own clock, and a supervisor thread that does what the
+// The haptic node (DESIGN.md §1.3): the 1 kHz servo on its schedule. Each tick: the finger from the device, the
+// world's newest frame from the world link, HapticServo::tick, the force back to the device, the report to the world,
+// a log row into the real-time ring. Real time: its own clock, and a supervisor thread that does what the
 // servo loop must not (re-attaching to a restarted world). Lockstep: the master; the device advances once per tick
 // and the world steps at tick i·n + phase (common/runtime/lockstep_schedule.h).
 //
 // Owns the servo, its log and statistics; its summary is the haptic half of summary.json (DESIGN.md §4).
 
-#include "common/link/device_port.h"
 #include "common/link/world_link.h"
 #include "common/runtime/loop_stats.h"
 #include "common/runtime/rt_log.h"
+#include "haptic_controller/device/haptic_device.h"
 #include "haptic_controller/servo.h"
 
 #include <nlohmann/json.hpp>
@@ -30,7 +30,7 @@ struct HapticNodeOptions {
   double duration_s = 0.0;  // 0: until stopped (lockstep: until the device leaves, or stopped)
   std::string log_path;     // "": no log
   bool realtime_priority = true;
-  std::uint64_t haptic_session = 0;  // 0: a fresh new_session_id()
+  std::uint64_t haptic_session = 1;  // nonzero; the nodes' mains pass new_session_id() (common/runtime/process.h)
 };
 
 // One row of the haptic log (the ring holds these; formatted by the drain thread).
@@ -48,9 +48,9 @@ struct HapticLogRow {
 
 class HapticNode {
  public:
-  // Both links must outlive the node. Throws std::invalid_argument for a lockstep world period that is not a whole
-  // number of ticks, std::runtime_error if the log cannot be opened.
-  HapticNode(const HapticNodeOptions& options, WorldLinkClient& world, DevicePortHost& device);
+  // The link and the device must outlive the node. Throws std::invalid_argument for a lockstep world period that is
+  // not a whole number of ticks, std::runtime_error if the log cannot be opened.
+  HapticNode(const HapticNodeOptions& options, WorldLinkClient& world, HapticDevice& device);
 
   // Runs until the duration, a stop request, or (lockstep) no device. Returns the exit status.
   int run();
@@ -60,7 +60,7 @@ class HapticNode {
   const HapticServo& servo() const { return servo_; }
 
  private:
-  void tick(const DeviceState* device, std::uint64_t tick, double now_s, double dt_s, std::int64_t lateness_ns);
+  void tick(std::uint64_t tick, double now_s, double dt_s, std::int64_t lateness_ns);
   void receive_frame(double now_s);
   void run_lockstep();
   void run_realtime();
@@ -70,7 +70,7 @@ class HapticNode {
   HapticNodeOptions options_;
   double period_s_;
   WorldLinkClient& world_;
-  DevicePortHost& device_;
+  HapticDevice& device_;
   HapticServo servo_;
   std::optional<RtLog<HapticLogRow>> log_;
   PlaneFrame frame_buffer_{};

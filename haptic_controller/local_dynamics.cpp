@@ -1,5 +1,7 @@
 #include "haptic_controller/local_dynamics.h"
 
+#include "haptic_controller/plane_matching.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,28 +9,11 @@
 namespace impetus {
 namespace {
 
-// Normals further apart than 90° are not blended; such a plane switches at the midpoint (plane_interpolator.h).
-constexpr double kMinBlendCosine = 0.0;
-constexpr double kFlipSwitchWeight = 0.5;
 // Gauss–Seidel passes over the contacts: enough for a corner of three supports to settle.
 constexpr int kContactPasses = 3;
 // Bound on drift substeps applied in one tick (a tick longer than the world's substep, e.g. after a stall).
 constexpr int kMaxDriftChunksPerTick = 8;
 
-// Index of the `occurrence`-th plane of `object_id` in `set`, or −1.
-int find_in_set(const PlaneSet& set, std::int32_t object_id, int occurrence) {
-  const std::uint32_t count = std::min(set.count, kMaxPlanes);
-  for (std::uint32_t k = 0; k < count; ++k) {
-    if (set.planes[k].object_id == object_id && occurrence-- == 0) return static_cast<int>(k);
-  }
-  return -1;
-}
-
-int occurrence_in_frame(const PlaneFrame& frame, std::uint32_t k) {
-  int occurrence = 0;
-  for (std::uint32_t q = 0; q < k; ++q) occurrence += frame.planes[q].object_id == frame.planes[k].object_id ? 1 : 0;
-  return occurrence;
-}
 
 }  // namespace
 
@@ -134,7 +119,7 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
     const Eigen::Vector3d normal = to_eigen(plane.normal);
     PlaneBlend& blend = blends_[k];
     blend = PlaneBlend{point, normal, 0.0, false};
-    const int match = displayed ? find_in_set(*displayed, plane.object_id, occurrence_in_frame(frame_, k)) : -1;
+    const int match = displayed ? find_plane(*displayed, plane.object_id, occurrence_of(frame_, k)) : -1;
     if (match < 0) continue;  // a new plane starts at the world's value
     const ContactPlane& before = displayed->planes[static_cast<std::size_t>(match)];
     blend.from_point_m = before.point_m;
@@ -177,9 +162,8 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
     if (slip_mps > 0.0) v -= std::min(slip_mps, body.contact_friction[c] * normal_impulse[c]) / slip_mps * slip;
   }
   // Rotation is left free: supports do not stop a ball rolling, and where they would stop a box tipping the model
-  // over-predicts the surface's motion, the passive error. Stopping it instead (as this model once did) let the
-  // finger's friction spin a ball in the world far past rolling with the finger, since the model saw its surface
-  // still: 3 g balls reached 1800 rad/s (hard case 10).
+  // over-predicts the surface's motion, the passive error. Stopping it would let the finger's friction spin a ball
+  // in the world far past rolling with the finger, since the model would see its surface still.
 }
 
 void LocalDynamics::advance(double dt_s) {
@@ -227,8 +211,8 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
     const Eigen::Vector3d target_normal = to_eigen(now.normal);
     Eigen::Vector3d point = target_point;
     Eigen::Vector3d normal = target_normal;
-    if (blend.from_normal.dot(target_normal) < kMinBlendCosine) {
-      if (w < kFlipSwitchWeight) {  // §3.2 rule: switch whole planes at the midpoint instead of blending through zero
+    if (normals_flip(blend.from_normal, target_normal)) {
+      if (!flip_switched(w)) {  // §3.2's flip rule (plane_matching.h)
         point = blend.from_point_m;
         normal = blend.from_normal;
       }

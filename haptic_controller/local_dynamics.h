@@ -1,5 +1,5 @@
 #pragma once
-// Local dynamics: the haptic side moves the touched objects between world frames (paper §6.3, issue 9,
+// Local dynamics: the haptic side moves the touched objects between world frames (paper §6.3,
 // `--coupling local`).
 //
 // With impulse coupling (§2.2) the finger pushes on a plane that cannot move until the next world step, so the object
@@ -36,7 +36,7 @@
 // the finger's travel in a period, 25 mm at 10 Hz). With small, fast-spinning bodies this is an active wall: 3 g balls
 // (I = 1.2e-7 kg·m²) roll at ~20 rad/s in the world, and a friction share at L = 1 cm adds ~200 rad/s per 10 N·ms, so
 // the swept plane strikes the finger, the reaction at lever L spins the ball faster, and the swept planes pinch the
-// proxy into infeasible sets (hard case 10 gained 2.4e10 J, tests/haptic_controller/test_local_dynamics.cpp). The
+// proxy into infeasible sets (docs/hard_cases.md, case 10). The
 // rotation within a period is not lost: the world integrates the angular impulses, and its next frame brings the
 // rotated face, blended in like §3.2's interpolation (the lag impulse coupling has for every plane). ω is still
 // integrated: it gives the surface velocity friction sees (a sphere's plane is taken again at the proxy each tick
@@ -44,7 +44,7 @@
 //
 // Which way a wrong model errs. A model that gives way *less* than the world (a neighbour taken as immovable, a turn
 // it stopped) has the finger press a plane that does not yield, and the world then hands the object momentum the
-// finger never felt: energy from nowhere, as impulse coupling does (hard case 10 gained 790 J this way). A model that
+// finger never felt: energy from nowhere, as impulse coupling does. A model that
 // gives way *more* than the world only lets the finger in deeper, and the frame-boundary rule below then holds the
 // plane where the finger is: softer, never active. So every approximation here leans toward more give: loose
 // neighbours yield, rotation is free, the tick is solved implicitly.

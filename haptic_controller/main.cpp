@@ -4,6 +4,7 @@
 #include "common/link/shm/shm_device_port.h"
 #include "common/link/shm/shm_world_link.h"
 #include "common/runtime/cli.h"
+#include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/haptic_node.h"
 
 #include <fstream>
@@ -35,11 +36,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   return run_node("haptic_controller", [&] {
-    ShmDevicePortHost device(shm, options.clock, 1.0 / options.rate_hz);
+    options.haptic_session = new_session_id();
+    ShmDevicePortHost port(shm, options.clock, 1.0 / options.rate_hz);
+    SpidarDriver device(SpidarGeometry{}, port, options.clock, options.haptic_session);
     ShmWorldLinkClient world(shm, options.clock, world_wait_s);
     HapticNode node(options, world, device);
     std::fprintf(stderr, "haptic_controller: %.0f Hz, %s clock, world at %.1f Hz, device port '%s'\n",
-                 options.rate_hz, to_string(options.clock), world.info().world_rate_hz, device.name().c_str());
+                 options.rate_hz, to_string(options.clock), world.info().world_rate_hz, port.name().c_str());
     const int status = node.run();
     if (!summary_path.empty()) {
       std::ofstream summary(summary_path);
@@ -50,7 +53,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "haptic_controller: %llu ticks, %llu faults, %llu force clamps, %llu saturations\n",
                  static_cast<unsigned long long>(counters.ticks), static_cast<unsigned long long>(counters.faults),
                  static_cast<unsigned long long>(counters.force_clamps),
-                 static_cast<unsigned long long>(counters.saturations));
+                 static_cast<unsigned long long>(device.counters().saturations));
     return status;
   });
 }

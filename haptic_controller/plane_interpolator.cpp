@@ -1,27 +1,15 @@
 #include "haptic_controller/plane_interpolator.h"
 
+#include "haptic_controller/plane_matching.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace impetus {
 namespace {
 
-// Normals further apart than 90° are not blended (see the header): cos 90° = 0.
-constexpr double kMinBlendCosine = 0.0;
-// Above this weight a flipped plane is frame i's: the midpoint of the world period.
-constexpr double kFlipSwitchWeight = 0.5;
-
 Eigen::Vector3d lerp(const Vec3& from, const Vec3& to, double w) {
   return (1.0 - w) * to_eigen(from) + w * to_eigen(to);
-}
-
-// Index in `previous` of the `occurrence`-th plane of `object_id`, or -1.
-int find_match(const PlaneFrame& previous, std::int32_t object_id, int occurrence) {
-  const std::uint32_t count = std::min(previous.plane_count, kMaxPlanes);
-  for (std::uint32_t k = 0; k < count; ++k) {
-    if (previous.planes[k].object_id == object_id && occurrence-- == 0) return static_cast<int>(k);
-  }
-  return -1;
 }
 
 }  // namespace
@@ -57,14 +45,12 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, d
     ContactPlane& plane = out.planes[k];
     plane = to_contact_plane(now);  // velocities, friction, flags: frame i's
 
-    int occurrence = 0;
-    for (std::uint32_t q = 0; q < k; ++q) occurrence += current.planes[q].object_id == now.object_id ? 1 : 0;
-    const int match = find_match(previous, now.object_id, occurrence);
+    const int match = find_plane(previous, now.object_id, occurrence_of(current, k));
     if (match < 0) continue;  // new object: starts at frame i's value
     const Plane& before = previous.planes[match];
 
-    if (to_eigen(before.normal).dot(to_eigen(now.normal)) < kMinBlendCosine) {
-      if (w < kFlipSwitchWeight) {  // switch whole planes at the midpoint instead of blending through zero
+    if (normals_flip(to_eigen(before.normal), to_eigen(now.normal))) {
+      if (!flip_switched(w)) {
         plane.point_m = to_eigen(before.point_m);
         plane.normal = to_eigen(before.normal);
         plane.com_m = to_eigen(before.com_m);

@@ -1,8 +1,9 @@
 #include "haptic_controller/servo.h"
 
+#include "common/runtime/staleness.h"
 #include "haptic_controller/plane_interpolator.h"
+#include "haptic_controller/plane_matching.h"
 #include "haptic_controller/sphere_planes.h"
-#include "haptic_controller/tension_distribution.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,19 +14,6 @@ namespace {
 
 double positive_or(double value, double fallback) { return value > 0.0 && std::isfinite(value) ? value : fallback; }
 
-int occurrence_in(const PlaneSet& set, std::uint32_t k) {
-  int occurrence = 0;
-  for (std::uint32_t q = 0; q < k; ++q) occurrence += set.planes[q].object_id == set.planes[k].object_id ? 1 : 0;
-  return occurrence;
-}
-
-int find_in(const PlaneSet& set, std::int32_t object_id, int occurrence) {
-  for (std::uint32_t k = 0; k < set.count; ++k) {
-    if (set.planes[k].object_id == object_id && occurrence-- == 0) return static_cast<int>(k);
-  }
-  return -1;
-}
-
 double signed_distance_m(const Eigen::Vector3d& x_m, const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal) {
   return normal.dot(x_m - point_m);
 }
@@ -33,13 +21,7 @@ double signed_distance_m(const Eigen::Vector3d& x_m, const Eigen::Vector3d& poin
 }  // namespace
 
 HapticServo::HapticServo(const ServoOptions& options, std::uint64_t haptic_session)
-    : options_(options),
-      kinematics_(options.geometry),
-      renderer_(options.geometry.max_force_N),
-      accumulator_(haptic_session) {
-  for (int i = 0; i < kStringCount; ++i) motors_m_[i] = kinematics_.motor_m(i);
-  result_.tension_N.fill(options_.geometry.tension_min_N);
-}
+    : options_(options), renderer_(options.max_force_N), accumulator_(haptic_session) {}
 
 void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   // Interpolate from the previous frame of the same world session only; the first frame starts where it is.
@@ -64,7 +46,7 @@ void HapticServo::measure_frame_boundary(const ProxySolution& contact) {
     bool measured = false;
     for (int k = 0; k < watched_count_; ++k) {
       const WatchedPlane& seen = watched_[static_cast<std::size_t>(k)];
-      const int now = find_in(planes_, seen.object_id, seen.occurrence);
+      const int now = find_plane(planes_, seen.object_id, seen.occurrence);
       if (!seen.has_previous || now < 0) continue;
       const ContactPlane& plane = planes_.planes[static_cast<std::size_t>(now)];
       const double d_now = signed_distance_m(seen.proxy_m, plane.point_m, plane.normal);
@@ -84,7 +66,7 @@ void HapticServo::measure_frame_boundary(const ProxySolution& contact) {
     const ContactPlane& plane = planes_.planes[index];
     WatchedPlane& entry = next[static_cast<std::size_t>(next_count++)];
     entry.object_id = plane.object_id;
-    entry.occurrence = occurrence_in(planes_, index);
+    entry.occurrence = occurrence_of(planes_, index);
     entry.point_m = plane.point_m;
     entry.normal = plane.normal;
     entry.proxy_m = contact.proxy_m;
@@ -106,33 +88,32 @@ void HapticServo::idle_tick(bool fault) {
   god_object_.reset();
   renderer_.reset();
   result_.force_N = {};
-  result_.tension_N.fill(options_.geometry.tension_min_N);
-  result_.saturated = false;
+  result_.render = false;
   result_.fault = fault;
   result_.sticking = false;
   result_.active_planes = 0;
   result_.proxy_m = result_.finger_m;
 }
 
-const TickResult& HapticServo::tick(const DeviceState* device, double now_s, double dt_s) {
+const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, double dt_s) {
   ++counters_.ticks;
   HapticReport& report = accumulator_.report();
   report.tick = counters_.ticks;
   report.haptic_time_s = now_s;
 
   // 1. Finger position C_j.
-  Eigen::Vector3d finger_m = finger_m_;
-  const bool finger_valid = device != nullptr && kinematics_.finger_position(device->encoder_counts, finger_m);
+  const bool finger_valid = finger != nullptr && finger->valid && finger->position_m.allFinite();
   result_.finger_valid = finger_valid;
   if (!finger_valid) {
-    if (device) ++counters_.faults;
+    if (finger) ++counters_.faults;
     else ++counters_.no_device_ticks;
     report.finger_valid = 0;
     report.finger_velocity_mps = {};
     finger_known_ = false;
-    idle_tick(device != nullptr);
+    idle_tick(finger != nullptr);
     return result_;
   }
+  const Eigen::Vector3d finger_m = finger->position_m;
   const Eigen::Vector3d finger_velocity_mps =
       finger_known_ && dt_s > 0.0 ? Eigen::Vector3d((finger_m - finger_m_) / dt_s) : Eigen::Vector3d::Zero();
   if (!finger_known_) god_object_.begin_finger_session(finger_m);  // a finger that appears inside an object is not kicked
@@ -149,7 +130,7 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
   result_.world_stale = false;
   if (have_frame_) {
     w = interpolation_weight(now_s, frame_arrival_s_, current_frame_.world_period_s);
-    result_.world_stale = now_s - frame_arrival_s_ > kStaleWorldPeriods * current_frame_.world_period_s;
+    result_.world_stale = world_stale(now_s - frame_arrival_s_, current_frame_.world_period_s);
     if (result_.world_stale) ++counters_.stale_world_ticks;
     if (current_frame_.coupling == Coupling::local) {
       // Local coupling: the frame's planes carried by the local model (a stale world: the model holds still).
@@ -215,12 +196,8 @@ const TickResult& HapticServo::tick(const DeviceState* device, double now_s, dou
     }
   }
 
-  // 6. String tensions.
-  const TensionSolution tensions = distribute_tension(force_N, finger_m, motors_m_, options_.geometry.tension_min_N,
-                                                      options_.geometry.tension_max_N);
-  result_.tension_N = tensions.tension_N;
-  result_.saturated = tensions.saturated;
-  if (tensions.saturated) ++counters_.saturations;
+  // 6. The device renders it (DESIGN.md §1.2 step 6: the haptic node commands the device).
+  result_.render = true;
   return result_;
 }
 

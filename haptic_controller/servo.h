@@ -1,19 +1,18 @@
 #pragma once
-// The 1 kHz haptic servo (DESIGN.md §1 "One haptic tick"): composes SPIDAR kinematics, plane interpolation (§3.2),
-// the god-object with friction (§3.3, §6.2), force rendering (§3.3), impulse integration (§3.4) and tension
-// distribution. main.cpp wires it to the clock, the world link and the device port; tests drive it directly.
+// The 1 kHz haptic servo (DESIGN.md §1.2): `tick(finger sample, dt) -> force`, device-agnostic. Composes plane
+// interpolation (§3.2), the god-object with friction (§3.3, §6.2), force rendering (§3.3) and impulse integration
+// (§3.4). The haptic node wires it to its clock, the world link and a HapticDevice; tests drive it directly.
 //
 // Threading: one servo thread owns the object; on_plane_frame, tick and report are called from that thread only.
 // Real time: the constructor preallocates everything; on_plane_frame and tick never allocate, lock, block or throw.
 
-#include "common/spidar/geometry.h"
 #include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
+#include "haptic_controller/device/haptic_device.h"
 #include "haptic_controller/force_renderer.h"
 #include "haptic_controller/god_object.h"
 #include "haptic_controller/impulse_accumulator.h"
 #include "haptic_controller/local_dynamics.h"
-#include "haptic_controller/spidar_kinematics.h"
 
 #include <array>
 #include <cstdint>
@@ -28,23 +27,20 @@ struct ServoOptions {
   double stiffness_Npm = std::numeric_limits<double>::quiet_NaN();
   double damping_Nspm = std::numeric_limits<double>::quiet_NaN();
   double tick_period_s = 1e-3;  // nominal servo period T, for the default damping only; forces use the real dt
-  SpidarGeometry geometry{};
+  double max_force_N = 10.0;    // the device's limit (DeviceLimits): forces are clamped to it
 };
 
 // The DESIGN.md default for --stiffness when nothing else is given.
 inline constexpr double kFallbackStiffness_Npm = 2000.0;
-// A world frame older than this many world periods is stale: the servo keeps rendering its last planes (w = 1).
-inline constexpr double kStaleWorldPeriods = 3.0;
 
 struct TickResult {
   Vec3 finger_m{};  // C_j (last valid position when no device)
   Vec3 proxy_m{};   // D_j
   Vec3 force_N{};   // on the finger, after clamping (zero on fault, without device, or out of contact)
-  std::array<double, kStringCount> tension_N{};  // to command; t_min on every string without device
-  bool finger_valid = false;  // a device reading gave a finite finger position this tick
-  bool saturated = false;     // the strings could not render force_N exactly (nearest feasible force commanded)
+  bool render = false;        // command force_N; false: the device's minimum output (no finger, or a fault)
+  bool finger_valid = false;  // the device gave a valid finger sample this tick
   bool fault = false;         // non-finite finger or force this tick: force zeroed
-  bool world_stale = false;   // the newest world frame is older than kStaleWorldPeriods
+  bool world_stale = false;   // the newest world frame is stale (common/runtime/staleness.h): its planes hold
   bool sticking = false;      // friction holds the proxy
   int active_planes = 0;      // constraints holding the proxy (0 free, 1 face, 2 edge, 3 corner; 4 infeasible pinch)
   double interpolation_weight = 1.0;  // w of §3.2
@@ -54,12 +50,11 @@ struct ServoCounters {
   std::uint64_t ticks = 0;
   std::uint64_t faults = 0;            // non-finite finger position or force
   std::uint64_t force_clamps = 0;      // |f| limited to max_force_N
-  std::uint64_t saturations = 0;       // tension distribution could not reach the force
   std::uint64_t infeasible_contacts = 0;  // pinch: no point outside all planes
   std::uint64_t stale_world_ticks = 0;
   std::uint64_t no_device_ticks = 0;
   std::uint64_t dropped_impulse_shares = 0;  // reaction shares that found no report entry
-  // Frame-boundary continuity (issue 9), any coupling. At the first tick after a world frame, for every plane that
+  // Frame-boundary continuity, any coupling. At the first tick after a world frame, for every plane that
   // held the proxy in the tick before: the second difference of the plane's signed distance at that proxy over the
   // three ticks around the boundary, |d_j − 2·d_{j−1} + d_{j−2}|. Steady plane motion cancels; what remains is the
   // jump (or the velocity kink × Δt) the finger feels when the new frame takes over, plus the plane's own
@@ -78,9 +73,10 @@ class HapticServo {
   // A validated world frame arrived at servo time now_s. Frames of a new world session restart interpolation.
   void on_plane_frame(const PlaneFrame& frame, double now_s);
 
-  // One tick at servo time now_s, dt_s after the previous tick (real elapsed time). device == nullptr means no
-  // device is attached or its state is stale: no finger, minimum tensions, no contact, nothing accumulated.
-  const TickResult& tick(const DeviceState* device, double now_s, double dt_s);
+  // One tick at servo time now_s, dt_s after the previous tick (real elapsed time). finger == nullptr means no
+  // device is attached or its reading is stale: no finger, minimum output, no contact, nothing accumulated; an
+  // invalid sample is the same plus a counted fault.
+  const TickResult& tick(const FingerSample* finger, double now_s, double dt_s);
 
   // Cumulative impulses and the finger, updated by every tick; the caller seals and publishes it.
   const HapticReport& report() const { return accumulator_.report(); }
@@ -106,8 +102,6 @@ class HapticServo {
   };
 
   ServoOptions options_;
-  SpidarKinematics kinematics_;
-  std::array<Eigen::Vector3d, kStringCount> motors_m_;
   PlaneFrame previous_frame_{};
   PlaneFrame current_frame_{};
   bool have_frame_ = false;

@@ -50,7 +50,7 @@ void FeatureExtractor::index(std::span<const ObjectState> states, double world_p
   grid_.rebuild(swept_bounds_);
 }
 
-void FeatureExtractor::within_reach(const FingerSample& finger, std::span<const ObjectState> states,
+void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const ObjectState> states,
                                     double world_period_s, std::vector<ReachCandidate>& out) const {
   out.clear();
   const double finger_speed_mps = finger.velocity_mps.norm();
@@ -119,7 +119,7 @@ Plane FeatureExtractor::make_plane(const ReachCandidate& candidate, std::span<co
   return plane;
 }
 
-std::uint32_t FeatureExtractor::extract(const FingerSample& finger, std::span<const ObjectState> states,
+std::uint32_t FeatureExtractor::extract(const ReachQuery& finger, std::span<const ObjectState> states,
                                         double world_period_s, std::array<Plane, kMaxPlanes>& planes) const {
   within_reach(finger, states, world_period_s, reach_scratch_);
   // Sorted nearest first, so a crowded neighbourhood keeps the kMaxPlanes planes the finger can touch soonest.

@@ -27,7 +27,7 @@ namespace impetus {
 // Where the planes are extracted around: the haptic proxy when the report has one (it never enters an object, so a
 // finger pushed deep into a thin plate still gets the plate's near face), else the finger itself. `reach_extra_m`
 // widens the reach by how far the finger is from that point, so nothing between proxy and finger is missed.
-struct FingerSample {
+struct ReachQuery {
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
   double reach_extra_m = 0.0;
@@ -48,11 +48,11 @@ class FeatureExtractor {
   void index(std::span<const ObjectState> states, double world_period_s);
 
   // Every object (and the floor) within reach, nearest first (ties by id). `states` must be those last indexed.
-  void within_reach(const FingerSample& finger, std::span<const ObjectState> states, double world_period_s,
+  void within_reach(const ReachQuery& finger, std::span<const ObjectState> states, double world_period_s,
                     std::vector<ReachCandidate>& out) const;
 
   // Fills planes[0..count) with the nearest kMaxPlanes objects within reach and returns count (paper §3.1).
-  std::uint32_t extract(const FingerSample& finger, std::span<const ObjectState> states, double world_period_s,
+  std::uint32_t extract(const ReachQuery& finger, std::span<const ObjectState> states, double world_period_s,
                         std::array<Plane, kMaxPlanes>& planes) const;
 
   // For tests and benchmarks: how many objects the last query tested exactly.

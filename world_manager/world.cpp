@@ -229,7 +229,7 @@ const PlaneFrame& World::step(const HapticReport* report) {
     if (finger_valid_) {
       finger_.position_m = to_eigen(report->finger_m);
       finger_.velocity_mps = to_eigen(report->finger_velocity_mps);
-      // Planes come from around the proxy (feature_extractor.h, FingerSample); a report without a finite proxy
+      // Planes come from around the proxy (feature_extractor.h, ReachQuery); a report without a finite proxy
       // falls back to the finger.
       plane_query_ = finger_;
       if (all_finite(report->proxy_m)) {
@@ -321,7 +321,7 @@ void World::apply_velocity_change(std::size_t id, const Eigen::Vector3d& impulse
 
 void World::schedule_local_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment,
                                    double window_start_s, double window_s) {
-  // Local coupling (issue 9, paper §6.3). The haptic side moved the object tick by tick: an impulse J_k rendered at
+  // Local coupling (paper §6.3). The haptic side moved the object tick by tick: an impulse J_k rendered at
   // haptic time t_k has displaced it by J_k·(t_end − t_k)/m by the end of the window. ODE's semi-implicit Euler step
   // gives a force held during substep s (length h) exactly the effect of an impulse at time s·h (v changes at the end
   // of the substep, x then integrates the new v), so the world reproduces both the momentum Σ J_k and the displacement
@@ -373,9 +373,8 @@ void World::apply_local_schedule(int slot) {
   // Substep slots: the scheduled impulse as a force held for one substep (ODE clears forces after every step).
   // Slot `substeps` (an impulse at the very end of the window): for a free body, a velocity change after the last
   // substep (exact: no displacement). For a body that touched something at the last frame it goes into the last
-  // substep instead, where the contacts see it: as a bare velocity change it would skip them for a whole step, and a
-  // 3 g ball pushed into the floor in the last tick entered it at 1.5 m/s, 5 mm deep, before ODE pushed it back out
-  // (hard case 10). The price there is h·J/m of displacement, blended in at the next frame (local_dynamics.h).
+  // substep instead, where the contacts see it: as a bare velocity change it would skip them for a whole step (a light
+  // ball pushed into the floor in the last tick would sink into it before ODE pushed it back out). The price there is h·J/m of displacement, blended in at the next frame (local_dynamics.h).
   const int substeps = scene_.physics.substeps;
   const double h = period_s_ / substeps;
   for (std::size_t id = 0; id < local_impulse_schedule_Ns_.size(); ++id) {

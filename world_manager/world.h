@@ -102,7 +102,7 @@ class World {
   std::vector<ObjectState> states_;
   std::vector<Eigen::Matrix3d> inverse_inertia_body_;  // per object; zero for static ones
   ImpulseLedger ledger_;
-  // Local coupling (issue 9): the same running totals' first moments in time (ObjectImpulse::impulse_moment_Nss),
+  // Local coupling: the same running totals' first moments in time (ObjectImpulse::impulse_moment_Nss),
   // differenced with the same session/epoch rules as the impulses themselves.
   ImpulseLedger moment_ledger_;
   // When the impulses of the current step were rendered: the haptic time of the previous report applied.
@@ -121,8 +121,8 @@ class World {
   Eigen::Vector3d total_static_impulse_Ns_ = Eigen::Vector3d::Zero();
   std::uint64_t rejected_entries_ = 0;
 
-  FingerSample finger_;       // the sampled finger: position coupling's penetration
-  FingerSample plane_query_;  // where planes are extracted: the proxy, reach widened to cover the finger
+  ReachQuery finger_;       // the sampled finger: position coupling's penetration
+  ReachQuery plane_query_;  // where planes are extracted: the proxy, reach widened to cover the finger
   bool finger_valid_ = false;
   double time_s_ = 0.0;
   std::uint64_t steps_taken_ = 0;

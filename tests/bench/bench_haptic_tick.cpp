@@ -1,5 +1,5 @@
-// Tick cost of the haptic servo (interpolation + proxy + force + accumulation + tensions) against the number of
-// planes in the world frame: p50 / p99 in ns. Prints only; no assertions.
+// Tick cost of the haptic servo with its SPIDAR driver (kinematics + interpolation + proxy + force + accumulation +
+// tensions) against the number of planes in the world frame: p50 / p99 in ns. Prints only; no assertions.
 
 #include <algorithm>
 #include <chrono>
@@ -7,8 +7,9 @@
 #include <cstdio>
 #include <vector>
 
+#include "common/link/inproc/inproc_device_port.h"
+#include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/servo.h"
-#include "haptic_controller/spidar_kinematics.h"
 
 using namespace impetus;
 
@@ -45,23 +46,43 @@ PlaneFrame make_frame(int planes, std::uint64_t index, double phase) {
   return frame;
 }
 
+// A device whose finger is `finger_m`, reported through its encoders (computed outside the timed section).
+class ScriptedDevice final : public DeviceStepper {
+ public:
+  explicit ScriptedDevice(InProcessDevicePort& port) : port_(port) {}
+  bool step_device() override {
+    port_.publish_state(state);
+    return true;
+  }
+  DeviceState state{};
+
+ private:
+  InProcessDevicePort& port_;
+};
+
 void run(int planes) {
   ServoOptions options;
   HapticServo servo(options, 1);
-  const SpidarKinematics kinematics(options.geometry);
+  const SpidarGeometry geometry;
+  const SpidarKinematics kinematics(geometry);
+  InProcessDevicePort port(1e-3);
+  ScriptedDevice device(port);
+  port.connect(device);
+  SpidarDriver driver(geometry, port, ClockMode::lockstep, 1);
   std::vector<double> ns(kTicks);
-  DeviceState state;
   int contact_ticks = 0;
   for (int tick = 0; tick < kTicks; ++tick) {
     const double now_s = tick * 1e-3;
     if (tick % kTicksPerWorldStep == 0)
       servo.on_plane_frame(make_frame(planes, tick / kTicksPerWorldStep, now_s), now_s);
     const Eigen::Vector3d finger =
-        to_eigen(options.geometry.centre_m) +
+        to_eigen(geometry.centre_m) +
         0.05 * Eigen::Vector3d(std::sin(tick * 0.0031), std::sin(tick * 0.0023), std::sin(tick * 0.0017));
-    state.encoder_counts = kinematics.encoder_counts(finger);
+    device.state.encoder_counts = kinematics.encoder_counts(finger);
     const auto start = std::chrono::steady_clock::now();
-    const TickResult& result = servo.tick(&state, now_s, 1e-3);
+    const FingerSample* sample = driver.read(static_cast<std::uint64_t>(tick), now_s);
+    const TickResult& result = servo.tick(sample, now_s, 1e-3);
+    driver.command(static_cast<std::uint64_t>(tick), to_eigen(result.force_N), result.render);
     const auto stop = std::chrono::steady_clock::now();
     ns[tick] = std::chrono::duration<double, std::nano>(stop - start).count();
     contact_ticks += result.active_planes > 0 ? 1 : 0;

@@ -1,4 +1,4 @@
-// World manager benchmarks (issue 3): printed, no assertions.
+// World manager benchmarks: printed, no assertions.
 //  1. World::step time for 20 / 200 / 2000 dynamic spheres on the floor (ODE dominates).
 //  2. FeatureExtractor::extract time vs number of objects at a constant density around the finger: the query must
 //     cost what is near the finger, not the size of the world. index() (once per step, O(N log N)) is shown apart.
@@ -97,7 +97,7 @@ void bench_features() {
       index_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
     }
     std::array<impetus::Plane, impetus::kMaxPlanes> planes{};
-    impetus::FingerSample finger;
+    impetus::ReachQuery finger;
     finger.position_m = {0.01, 0.01, 0.05};
     finger.velocity_mps = {0.3, 0.0, 0.0};
     std::vector<double> samples_us;

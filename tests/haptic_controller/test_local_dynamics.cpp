@@ -1,11 +1,11 @@
-// Local dynamics (haptic_controller/local_dynamics.h, paper §6.3, issue 9): the haptic side moves the touched object
+// Local dynamics (haptic_controller/local_dynamics.h, paper §6.3): the haptic side moves the touched object
 // between world frames. Physics-backed checks: a free body gives way by J/m per second, a sliding cube loses μ·g·h of
 // speed per world substep and never reverses, a support blocks, a wrong model never pushes the finger out, and the
 // impulse the model moved the object with is the impulse reported to the world.
 
 #include "haptic_controller/local_dynamics.h"
 #include "haptic_controller/servo.h"
-#include "haptic_controller/spidar_kinematics.h"
+#include "haptic_controller/device/spidar_kinematics.h"
 #include "test_support.h"
 
 #include <catch2/catch.hpp>
@@ -53,11 +53,6 @@ void add_support(Plane& plane, const Vector3d& normal, double friction, bool hol
                                                        holds ? impetus::kContactHolds : 0u};
 }
 
-DeviceState device_at(const SpidarKinematics& kinematics, const Vector3d& finger_m) {
-  DeviceState state;
-  state.encoder_counts = kinematics.encoder_counts(finger_m);
-  return state;
-}
 
 }  // namespace
 
@@ -141,11 +136,11 @@ TEST_CASE("servo, local coupling: the pushed cube gives way between frames and t
           "that moved it") {
   ServoOptions options;
   HapticServo servo(options, 3);
-  const SpidarKinematics kinematics(options.geometry);
+  const SpidarKinematics kinematics(SpidarGeometry{});
   servo.on_plane_frame(local_frame({cube_face()}), 0.0);
-  const DeviceState outside = device_at(kinematics, Vector3d(-0.001, 0, 0.05));  // arrive from outside the face
+  const FingerSample outside = test::finger_at(kinematics, Vector3d(-0.001, 0, 0.05));  // arrive from outside the face
   servo.tick(&outside, 0.0, kTick_s);
-  const DeviceState state = device_at(kinematics, Vector3d(0.002, 0, 0.05));  // then 2 mm into it, held
+  const FingerSample state = test::finger_at(kinematics, Vector3d(0.002, 0, 0.05));  // then 2 mm into it, held
   for (int tick = 1; tick <= 40; ++tick) servo.tick(&state, tick * kTick_s, kTick_s);
   const LocalBody* body = servo.local_dynamics().find(1);
   REQUIRE(body != nullptr);
@@ -170,11 +165,11 @@ TEST_CASE("servo, local coupling: a 3 g body under the finger takes no more ener
   frame.damping_Nspm = 5.0;
   ServoOptions options;
   HapticServo servo(options, 3);
-  const SpidarKinematics kinematics(options.geometry);
+  const SpidarKinematics kinematics(SpidarGeometry{});
   servo.on_plane_frame(frame, 0.0);
-  const DeviceState outside = device_at(kinematics, Vector3d(-0.001, 0, 0.05));
+  const FingerSample outside = test::finger_at(kinematics, Vector3d(-0.001, 0, 0.05));
   servo.tick(&outside, 0.0, kTick_s);
-  const DeviceState inside = device_at(kinematics, Vector3d(0.002, 0, 0.05));
+  const FingerSample inside = test::finger_at(kinematics, Vector3d(0.002, 0, 0.05));
   double largest_kinetic_J = 0.0;
   for (int tick = 1; tick <= 40; ++tick) {
     servo.tick(&inside, tick * kTick_s, kTick_s);
@@ -194,9 +189,9 @@ TEST_CASE("servo, local coupling: a wrong model (the world says the object did n
   // never positive. A 20 kg body, so the finger stays on it across frames (about 0.25 mm of give per frame).
   ServoOptions options;
   HapticServo servo(options, 3);
-  const SpidarKinematics kinematics(options.geometry);
-  const DeviceState outside = device_at(kinematics, Vector3d(-0.001, 0, 0.05));
-  const DeviceState state = device_at(kinematics, Vector3d(0.002, 0, 0.05));
+  const SpidarKinematics kinematics(SpidarGeometry{});
+  const FingerSample outside = test::finger_at(kinematics, Vector3d(-0.001, 0, 0.05));
+  const FingerSample state = test::finger_at(kinematics, Vector3d(0.002, 0, 0.05));
   servo.on_plane_frame(local_frame({cube_face(0.05)}), 0.0);
   servo.tick(&outside, 0.0, kTick_s);  // arrive from outside the face
   double work_on_finger_J = 0.0;
@@ -225,9 +220,9 @@ TEST_CASE("servo: the frame-boundary diagnostic sees a plane jump under the fing
   ServoOptions options;
   options.stiffness_Npm = 1000.0;
   HapticServo servo(options, 3);
-  const SpidarKinematics kinematics(options.geometry);
-  const DeviceState above = device_at(kinematics, Vector3d(0, 0, 0.001));
-  const DeviceState state = device_at(kinematics, Vector3d(0, 0, -0.002));
+  const SpidarKinematics kinematics(SpidarGeometry{});
+  const FingerSample above = test::finger_at(kinematics, Vector3d(0, 0, 0.001));
+  const FingerSample state = test::finger_at(kinematics, Vector3d(0, 0, -0.002));
   // Impulse coupling, a static floor moving up steadily 1 mm per frame: interpolation is continuous, and at the
   // boundaries the second difference is zero.
   int tick = 0;

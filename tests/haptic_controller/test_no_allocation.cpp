@@ -1,4 +1,5 @@
-// Real-time discipline: tick() and on_plane_frame() never touch the heap. Global operator new/delete are replaced for
+// Real-time discipline: the servo's tick() and on_plane_frame() and the SPIDAR driver's read() and command() never
+// touch the heap. Global operator new/delete are replaced for
 // the whole test binary, but count only while `g_counting` is set, so other tests are unaffected.
 //
 // Under AddressSanitizer the sanitizer owns operator new/delete (some allocations reach its own operator new, and our
@@ -10,8 +11,9 @@
 #include <cstdlib>
 #include <new>
 
+#include "common/link/inproc/inproc_device_port.h"
+#include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/servo.h"
-#include "haptic_controller/spidar_kinematics.h"
 #include "test_support.h"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
@@ -46,10 +48,36 @@ using impetus::test::make_frame;
 using impetus::test::wire_plane;
 
 #if IMPETUS_COUNT_ALLOCATIONS
-TEST_CASE("the servo tick allocates nothing over 10^4 ticks") {
+namespace {
+
+// A device whose finger follows `finger_m`, reported through its encoders.
+class WanderingDevice final : public DeviceStepper {
+ public:
+  WanderingDevice(InProcessDevicePort& port, const SpidarKinematics& kinematics) : port_(port), kinematics_(kinematics) {}
+  bool step_device() override {
+    state_.encoder_counts = kinematics_.encoder_counts(finger_m);
+    port_.publish_state(state_);
+    return true;
+  }
+  Vector3d finger_m = Vector3d::Zero();
+
+ private:
+  InProcessDevicePort& port_;
+  const SpidarKinematics& kinematics_;
+  DeviceState state_{};
+};
+
+}  // namespace
+
+TEST_CASE("the servo tick and the SPIDAR driver allocate nothing over 10^4 ticks") {
   ServoOptions options;
   HapticServo servo(options, 3);
-  const SpidarKinematics kinematics(options.geometry);
+  const SpidarGeometry geometry;
+  const SpidarKinematics kinematics(geometry);
+  InProcessDevicePort port(1e-3);
+  WanderingDevice device(port, kinematics);
+  port.connect(device);
+  SpidarDriver driver(geometry, port, ClockMode::lockstep, 3);
   PlaneFrame frame = make_frame({wire_plane(0, {0, 0, 0}, {0, 0, 1}, false), wire_plane(1, {0, 0, 0.05}, {0, 0, 1}),
                                  wire_plane(2, {0.03, 0, 0}, {-1, 0, 0}), wire_plane(3, {0, 0.02, 0}, {0, -1, 1})});
   for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
@@ -57,7 +85,6 @@ TEST_CASE("the servo tick allocates nothing over 10^4 ticks") {
     frame.planes[k].dynamic_friction = 0.4;
     frame.planes[k].velocity_mps = {0.01, 0.0, 0.0};
   }
-  DeviceState state;
 
   g_allocations = 0;
   g_counting = true;
@@ -73,8 +100,10 @@ TEST_CASE("the servo tick allocates nothing over 10^4 ticks") {
     // The finger wanders through free space, the cube, the edge and the corner.
     const Vector3d finger(0.02 * std::sin(tick * 0.003), 0.015 * std::cos(tick * 0.002),
                           0.04 + 0.03 * std::sin(tick * 0.001));
-    state.encoder_counts = kinematics.encoder_counts(finger);
-    servo.tick(tick % 997 == 0 ? nullptr : &state, now_s, 1e-3);
+    device.finger_m = finger;
+    const FingerSample* sample = driver.read(static_cast<std::uint64_t>(tick), now_s);
+    const TickResult& result = servo.tick(tick % 997 == 0 ? nullptr : sample, now_s, 1e-3);
+    driver.command(static_cast<std::uint64_t>(tick), to_eigen(result.force_N), result.render);
   }
   g_counting = false;
   REQUIRE(g_allocations == 0);

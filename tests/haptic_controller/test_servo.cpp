@@ -1,5 +1,5 @@
 #include "haptic_controller/servo.h"
-#include "haptic_controller/spidar_kinematics.h"
+#include "haptic_controller/device/spidar_kinematics.h"
 #include "test_support.h"
 
 #include <catch2/catch.hpp>
@@ -13,11 +13,6 @@ using Eigen::Vector3d;
 
 namespace {
 
-DeviceState device_at(const SpidarKinematics& kinematics, const Vector3d& finger_m) {
-  DeviceState state;
-  state.encoder_counts = kinematics.encoder_counts(finger_m);
-  return state;
-}
 
 // The floor (static, id 0) at z = 0 and the top of a dynamic 5 cm cube (id 1) at z = 0.05.
 PlaneFrame cube_on_floor(std::uint64_t index) {
@@ -32,20 +27,20 @@ PlaneFrame cube_on_floor(std::uint64_t index) {
 TEST_CASE("servo: a finger pressing on a cube on the floor is pushed up and the cube is pushed down") {
   ServoOptions options;
   HapticServo servo(options, 5);
-  const SpidarKinematics kinematics(options.geometry);
+  const SpidarKinematics kinematics(SpidarGeometry{});
   servo.on_plane_frame(cube_on_floor(0), 0.0);
   const Vector3d above(0.0, 0.0, 0.055);   // the finger arrives from above the cube...
   const Vector3d finger(0.0, 0.0, 0.047);  // ...and presses 3 mm into it
   TickResult r{};
   for (int tick = 1; tick <= 100; ++tick) {
-    const DeviceState state = device_at(kinematics, tick == 1 ? above : finger);
+    const FingerSample state = test::finger_at(kinematics, tick == 1 ? above : finger);
     r = servo.tick(&state, tick * 1e-3, 1e-3);
   }
   REQUIRE(r.finger_valid);
   REQUIRE(r.active_planes == 1);
   REQUIRE(r.proxy_m[2] == Approx(0.05).margin(1e-12));
   REQUIRE(r.force_N[2] == Approx(2000.0 * 0.003).margin(2000.0 * 2e-5));  // k·depth, within a count's resolution
-  REQUIRE(!r.saturated);
+  REQUIRE(r.render);
   REQUIRE(!r.fault);
   const HapticReport& report = servo.report();
   REQUIRE(report.tick == 100);
@@ -58,7 +53,7 @@ TEST_CASE("servo: a finger pressing on a cube on the floor is pushed up and the 
   REQUIRE(report.static_impulse_Ns[2] == 0.0);
 }
 
-TEST_CASE("servo: no device means no finger, minimum tensions, zero force, nothing accumulated") {
+TEST_CASE("servo: no device means no finger, minimum output, zero force, nothing accumulated") {
   ServoOptions options;
   HapticServo servo(options, 5);
   servo.on_plane_frame(cube_on_floor(0), 0.0);
@@ -66,21 +61,22 @@ TEST_CASE("servo: no device means no finger, minimum tensions, zero force, nothi
   REQUIRE(!r.finger_valid);
   REQUIRE(r.active_planes == 0);
   REQUIRE(Eigen::Vector3d(to_eigen(r.force_N)) == Vector3d::Zero());
-  for (const double t : r.tension_N) REQUIRE(t == options.geometry.tension_min_N);
+  REQUIRE(!r.render);
   REQUIRE(servo.report().finger_valid == 0);
   REQUIRE(servo.counters().no_device_ticks == 1);
   REQUIRE(servo.accumulator().total_impulse_Ns() == Vector3d::Zero());
 }
 
-TEST_CASE("servo: garbage encoder counts give zero force and a counted fault") {
+TEST_CASE("servo: an invalid finger sample gives zero force, minimum output and a counted fault") {
   ServoOptions options;
-  options.geometry.metres_per_count = std::nan("");
   HapticServo servo(options, 5);
   servo.on_plane_frame(cube_on_floor(0), 0.0);
-  DeviceState state;
-  state.encoder_counts = {1, 2, 3, 4};
-  const TickResult& r = servo.tick(&state, 1e-3, 1e-3);
+  FingerSample sample;
+  sample.position_m = Vector3d(0.0, 0.0, 0.047);
+  sample.valid = false;
+  const TickResult& r = servo.tick(&sample, 1e-3, 1e-3);
   REQUIRE(r.fault);
+  REQUIRE(!r.render);
   REQUIRE(Eigen::Vector3d(to_eigen(r.force_N)) == Vector3d::Zero());
   REQUIRE(servo.counters().faults == 1);
 }
@@ -89,14 +85,14 @@ TEST_CASE("servo: lockstep interpolation weight is ticks since arrival / n, and 
   ServoOptions options;
   options.stiffness_Npm = 500.0;  // the flag overrides the scene
   HapticServo servo(options, 5);
-  const SpidarKinematics kinematics(options.geometry);
+  const SpidarKinematics kinematics(SpidarGeometry{});
   PlaneFrame first = make_frame({wire_plane(1, {0, 0, 0.0}, {0, 0, 1})}, 0, 0.05);
   PlaneFrame second = make_frame({wire_plane(1, {0, 0, 0.01}, {0, 0, 1})}, 1, 0.05);
   servo.on_plane_frame(first, 0.0);
   servo.on_plane_frame(second, 0.05);
   const Vector3d finger(0.0, 0.0, -0.002);
-  const DeviceState state = device_at(kinematics, finger);
-  const DeviceState arriving = device_at(kinematics, Vector3d(0.0, 0.0, 0.02));  // first seen outside the surface
+  const FingerSample state = test::finger_at(kinematics, finger);
+  const FingerSample arriving = test::finger_at(kinematics, Vector3d(0.0, 0.0, 0.02));  // first seen outside the surface
   servo.tick(&arriving, 0.05, 1e-3);
   for (int j = 0; j <= 50; j += 10) {
     const TickResult& r = servo.tick(&state, 0.05 + j * 1e-3, 1e-3);
@@ -114,10 +110,10 @@ TEST_CASE("servo: lockstep interpolation weight is ticks since arrival / n, and 
 TEST_CASE("servo: a finger that appears inside an object is not kicked out until it has left the object") {
   ServoOptions options;
   HapticServo servo(options, 5);
-  const SpidarKinematics kinematics(options.geometry);
+  const SpidarKinematics kinematics(SpidarGeometry{});
   servo.on_plane_frame(cube_on_floor(0), 0.0);
-  const DeviceState inside = device_at(kinematics, Vector3d(0.0, 0.0, 0.045));  // 5 mm into the cube
-  const DeviceState outside = device_at(kinematics, Vector3d(0.0, 0.0, 0.052));
+  const FingerSample inside = test::finger_at(kinematics, Vector3d(0.0, 0.0, 0.045));  // 5 mm into the cube
+  const FingerSample outside = test::finger_at(kinematics, Vector3d(0.0, 0.0, 0.052));
   for (int tick = 1; tick <= 20; ++tick) {
     const TickResult& r = servo.tick(&inside, tick * 1e-3, 1e-3);
     REQUIRE(r.active_planes == 0);
@@ -131,7 +127,7 @@ TEST_CASE("servo: a finger that appears inside an object is not kicked out until
   // A finger that starts outside and is inside when the first planes arrive was driven in: it is pushed out.
   {
     HapticServo late(options, 6);
-    const DeviceState approaching = device_at(kinematics, Vector3d(0.0, 0.0, 0.08));
+    const FingerSample approaching = test::finger_at(kinematics, Vector3d(0.0, 0.0, 0.08));
     late.tick(&approaching, 0.001, 1e-3);  // no world frame yet
     late.on_plane_frame(cube_on_floor(0), 0.002);
     const TickResult& pushed = late.tick(&inside, 0.003, 1e-3);

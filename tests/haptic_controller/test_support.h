@@ -3,12 +3,22 @@
 
 #include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
+#include "haptic_controller/device/haptic_device.h"
+#include "haptic_controller/device/spidar_kinematics.h"
 
 #include <Eigen/Core>
 
 #include <initializer_list>
 
 namespace impetus::test {
+
+// The finger sample a SPIDAR driver reads for a finger at `finger_m`: through the encoders (rounded to whole counts)
+// and back, as on the device.
+inline FingerSample finger_at(const SpidarKinematics& kinematics, const Eigen::Vector3d& finger_m) {
+  FingerSample sample;
+  sample.valid = kinematics.finger_position(kinematics.encoder_counts(finger_m), sample.position_m);
+  return sample;
+}
 
 inline ContactPlane make_plane(const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal, int object_id = 0,
                                bool dynamic = false, double static_friction = 0.0, double dynamic_friction = 0.0) {

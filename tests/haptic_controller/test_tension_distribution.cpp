@@ -1,5 +1,5 @@
-#include "haptic_controller/spidar_kinematics.h"
-#include "haptic_controller/tension_distribution.h"
+#include "haptic_controller/device/spidar_kinematics.h"
+#include "haptic_controller/device/tension_distribution.h"
 
 #include <catch2/catch.hpp>
 

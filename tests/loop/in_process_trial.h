@@ -4,6 +4,7 @@
 
 #include "common/link/inproc/inproc_device_port.h"
 #include "common/link/inproc/inproc_world_link.h"
+#include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/haptic_node.h"
 #include "spidar_sim/device_node.h"
 #include "spidar_sim/trajectory.h"
@@ -43,7 +44,8 @@ inline nlohmann::json run_in_process_trial(const InProcessTrialOptions& options)
   haptic_options.clock = ClockMode::lockstep;
   haptic_options.log_path = (options.out_dir / "haptic.csv").string();
   InProcessDevicePort port(1.0 / haptic_options.rate_hz);
-  HapticNode haptic(haptic_options, world_link, port);
+  SpidarDriver driver(SpidarGeometry{}, port, ClockMode::lockstep, haptic_options.haptic_session);
+  HapticNode haptic(haptic_options, world_link, driver);
 
   DeviceSim sim(SpidarGeometry{}, HardwareParams{}, FingerParams{}, load_trajectory(options.trajectory));
   DeviceNode device(sim, port, (options.out_dir / "device.csv").string(), 1);

@@ -8,7 +8,7 @@
 #include <set>
 
 using impetus::FeatureExtractor;
-using impetus::FingerSample;
+using impetus::ReachQuery;
 using impetus::ObjectState;
 using impetus::ReachCandidate;
 using impetus::Scene;
@@ -53,7 +53,7 @@ RandomWorld make_random_world(std::uint32_t seed, int count) {
 }
 
 // Brute force: every object (and the floor), exact distance against the reach of DESIGN.md §1 step 4.
-std::set<std::int32_t> brute_force_within_reach(const RandomWorld& world, const FingerSample& finger) {
+std::set<std::int32_t> brute_force_within_reach(const RandomWorld& world, const ReachQuery& finger) {
   std::set<std::int32_t> ids;
   const double finger_speed = finger.velocity_mps.norm();
   for (std::size_t i = 0; i < world.states.size(); ++i) {
@@ -80,7 +80,7 @@ TEST_CASE("the feature query returns exactly the objects within reach, checked a
   std::size_t total_found = 0;
   std::size_t total_tested = 0;
   for (int trial = 0; trial < 300; ++trial) {
-    FingerSample finger;
+    ReachQuery finger;
     finger.position_m = Vector3d(unit(rng), unit(rng), 0.1 * unit(rng) + (trial % 2) * unit(rng));
     finger.velocity_mps = (trial % 5 == 0 ? 2.0 : 0.3) * Vector3d(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5);
     std::vector<ReachCandidate> found;
@@ -121,7 +121,7 @@ TEST_CASE("more objects within reach than a frame holds: the nearest kMaxPlanes 
   }
   FeatureExtractor extractor(world.scene);
   extractor.index(world.states, kPeriod_s);
-  FingerSample finger;
+  ReachQuery finger;
   std::array<impetus::Plane, impetus::kMaxPlanes> planes{};
   const std::uint32_t count = extractor.extract(finger, world.states, kPeriod_s, planes);
   REQUIRE(count == impetus::kMaxPlanes);

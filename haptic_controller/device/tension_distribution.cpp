@@ -1,4 +1,4 @@
-#include "haptic_controller/tension_distribution.h"
+#include "haptic_controller/device/tension_distribution.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "haptic_controller/spidar_kinematics.h"
+#include "haptic_controller/device/spidar_kinematics.h"
 
 #include <Eigen/LU>
 

@@ -1,0 +1,51 @@
+#pragma once
+// A haptic device as the servo sees it (DESIGN.md §1.2): finger samples in, forces out, within its limits. What a
+// device is made of — strings and encoders (SpidarDriver), linkages, a network bridge — stays behind this interface,
+// so the servo is `tick(finger sample, dt) -> force` for any of them.
+//
+// Called from the servo thread once per tick: read() first, then command(). Implementations do not allocate, lock or
+// throw there; read() may block only in lockstep (the device's turn).
+
+#include <Eigen/Core>
+
+#include <cstdint>
+
+namespace impetus {
+
+// One finger's reading. `valid` is false when the device answered but its reading is unusable (non-finite, out of
+// its workspace): the servo renders no force and counts a fault.
+struct FingerSample {
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // world frame
+  bool valid = false;
+};
+
+// What the device can render; the servo clamps to it.
+struct DeviceLimits {
+  double max_force_N = 0.0;
+};
+
+struct DeviceCounters {
+  std::uint64_t saturations = 0;      // forces the device could render only approximately
+  std::uint64_t rejected_frames = 0;  // readings its transport refused (checksum, range)
+};
+
+class HapticDevice {
+ public:
+  virtual ~HapticDevice() = default;
+
+  virtual const DeviceLimits& limits() const = 0;
+
+  // Lockstep: blocks until a device is attached; false if a stop was requested first (or it will never attach).
+  virtual bool wait_attached() = 0;
+  // The finger at haptic tick `tick` (time now_s); nullptr when no device is attached or its reading is stale.
+  virtual const FingerSample* read(std::uint64_t tick, double now_s) = 0;
+  // Renders `force_N` on the finger read last; `render` false commands the device's minimum output (no finger, or a
+  // fault upstream). Returns true if the force was rendered exactly (false: saturated, the nearest feasible force).
+  virtual bool command(std::uint64_t tick, const Eigen::Vector3d& force_N, bool render) = 0;
+  // Lockstep: ends the session (a waiting device is released).
+  virtual void end_session() = 0;
+
+  virtual DeviceCounters counters() const = 0;
+};
+
+}  // namespace impetus
