@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   std::string summary_path;
   std::string shm = "impetus";
   double world_wait_s = 10.0;
+  std::string device_spec = "spidar";
   CLI::App app{"haptic_controller: the 1 kHz haptic servo of Impetus. Interpolates the world's planes, renders the "
                "god-object force on the SPIDAR and integrates it into impulses for the world."};
   app.add_option("--rate", options.rate_hz, "servo rate in Hz (1000)")->check(CLI::Range(100.0, 20000.0));
@@ -31,14 +32,17 @@ int main(int argc, char** argv) {
   add_shm_flag(app, shm);
   app.add_option("--world-wait", world_wait_s, "seconds to wait for the world manager's link (10)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--device", device_spec, "spidar (the built-in geometry) or spidar:FILE.json (a device file)");
   app.add_flag("!--no-realtime-priority", options.realtime_priority,
                "do not ask for SCHED_FIFO and mlockall in real time");
   CLI11_PARSE(app, argc, argv);
 
   return run_node("haptic_controller", [&] {
     options.haptic_session = new_session_id();
-    ShmDevicePortHost port(shm, options.clock, 1.0 / options.rate_hz);
-    SpidarDriver device(SpidarGeometry{}, port, options.clock, options.haptic_session);
+    const SpidarDevice spidar = parse_device_spec(device_spec);
+    ShmDevicePortHost port(shm, options.clock, 1.0 / options.rate_hz,
+                           {geometry_hash(spidar.geometry), spidar.source});
+    SpidarDriver device(spidar.geometry, port, options.clock, options.haptic_session);
     ShmWorldLinkClient world(shm, options.clock, world_wait_s);
     HapticNode node(options, world, device);
     std::fprintf(stderr, "haptic_controller: %.0f Hz, %s clock, world at %.1f Hz, device port '%s'\n",

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   std::string log_path;
   std::string shm = "impetus";
   double attach_timeout_s = 10.0;
+  std::string device_spec = "spidar";
   HardwareParams hardware;
   FingerParams finger;
   CLI::App app{"spidar_sim: a simulated SPIDAR device and finger playing a scripted trajectory against a running "
@@ -28,6 +29,8 @@ int main(int argc, char** argv) {
   add_shm_flag(app, shm);
   app.add_option("--attach-timeout", attach_timeout_s, "seconds to wait for the haptic controller's port")
       ->check(CLI::PositiveNumber);
+  app.add_option("--device", device_spec,
+                 "spidar (the built-in geometry) or spidar:FILE.json; must match the haptic controller's");
   app.add_option("--hand-stiffness", finger.hand_stiffness_Npm, "hand impedance stiffness, N/m (300)")
       ->check(CLI::PositiveNumber);
   app.add_option("--hand-damping", finger.hand_damping_Nspm, "hand impedance damping, N·s/m (8)")
@@ -39,8 +42,9 @@ int main(int argc, char** argv) {
 
   return run_node("spidar_sim", [&] {
     const Trajectory trajectory = load_trajectory(trajectory_spec);
-    DeviceSim sim(SpidarGeometry{}, hardware, finger, trajectory);
-    ShmDevicePortClient port(shm, clock, attach_timeout_s);
+    const SpidarDevice spidar = parse_device_spec(device_spec);
+    DeviceSim sim(spidar.geometry, hardware, finger, trajectory);
+    ShmDevicePortClient port(shm, clock, attach_timeout_s, {geometry_hash(spidar.geometry), spidar.source});
     DeviceNode node(sim, port, log_path, new_session_id());
     std::fprintf(stderr, "spidar_sim: attached to '%s' (%s), trajectory %.3f s\n", port.name().c_str(),
                  to_string(clock), trajectory.duration_s());

@@ -12,8 +12,16 @@
 #include "common/runtime/loop_stats.h"
 
 #include <cstdint>
+#include <string>
 
 namespace impetus {
+
+// Which device an end was configured for: a hash of its description (e.g. geometry_hash of a SPIDAR) and where the
+// description came from, for messages. Both ends of a port must agree.
+struct DeviceDescription {
+  std::uint64_t hash = 0;
+  std::string source;
+};
 
 // The haptic side's end. Used from the servo thread; no call allocates, and only lockstep_turn() and
 // wait_for_device() block.

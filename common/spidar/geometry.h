@@ -13,6 +13,9 @@
 #include "common/contract/vec3.h"
 
 #include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
 
 namespace impetus {
 
@@ -39,5 +42,24 @@ struct SpidarGeometry {
     return motors;
   }
 };
+
+// A device description file (JSON, e.g. common/spidar/desktop_spidar.json): the fields of SpidarGeometry, each
+// optional (a missing one keeps its default above). Unknown keys and unusable values are errors naming the file and
+// the key. Throws SpidarGeometryError.
+class SpidarGeometryError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+SpidarGeometry load_spidar_geometry(const std::string& path);
+
+// `spidar` (the built-in geometry above) or `spidar:FILE.json` (--device on haptic_controller and spidar_sim).
+struct SpidarDevice {
+  SpidarGeometry geometry;
+  std::string source = "built-in";  // the file it came from, for messages
+};
+SpidarDevice parse_device_spec(const std::string& spec);
+
+// A hash of the values (not the file's text): two descriptions with equal values are the same device.
+std::uint64_t geometry_hash(const SpidarGeometry& geometry);
 
 }  // namespace impetus

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <fstream>
 
 namespace impetus {
 namespace {
@@ -53,6 +54,8 @@ TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment 
       {world + "--scene scenes/tap.json --clock sometimes", "sometimes"},
       {world + "--scene scenes/tap.json --clock lockstep --rate 300", "whole number of haptic ticks"},
       {haptic + "--rate 0", "--rate"},
+      {haptic + "--device spidar:nosuchdevice.json", "nosuchdevice.json"},
+      {haptic + "--device falcon", "falcon"},
       {haptic + "--stiffness -1", "--stiffness"},
       {haptic, "world link"},  // no world manager running
       {device + "--trajectory tap:speed=-1", "speed"},
@@ -68,6 +71,33 @@ TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment 
     CHECK_THAT(result.output, Catch::Contains(test_case.expected));
     CHECK_FALSE(segments_left(shm));
   }
+}
+
+TEST_CASE("a device started with another geometry than the haptic controller's is refused, naming both files") {
+  const auto dir = test::out_dir("device-mismatch");
+  const std::string shm = "impetus_test_mismatch_" + std::to_string(getpid());
+  const std::string other = (dir / "wide_spidar.json").string();
+  {
+    std::ofstream file(other);
+    file << R"({"frame_side_m": 0.6})";
+  }
+  const std::string shipped = std::string(IMPETUS_SOURCE_DIR) + "/common/spidar/desktop_spidar.json";
+  const pid_t world = test::spawn({test::binary("world_manager"), "--scene", std::string(IMPETUS_SOURCE_DIR) +
+                                   "/scenes/tap.json", "--clock", "lockstep", "--shm", shm}, dir / "world.out");
+  const pid_t haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm,
+                                    "--device", "spidar:" + shipped}, dir / "haptic.out");
+  const Result device = run(test::binary("spidar_sim") + " --clock lockstep --shm " + shm +
+                                " --attach-timeout 5 --trajectory tap --device spidar:" + other,
+                            "device-mismatch-sim");
+  kill(haptic, SIGTERM);
+  kill(world, SIGTERM);
+  CHECK(test::wait_for(haptic, 10) == 0);
+  CHECK(test::wait_for(world, 10) == 0);
+  INFO(device.output);
+  CHECK(device.status == 1);
+  CHECK_THAT(device.output, Catch::Contains("desktop_spidar.json"));
+  CHECK_THAT(device.output, Catch::Contains("wide_spidar.json"));
+  CHECK_FALSE(segments_left(shm));
 }
 
 }  // namespace impetus

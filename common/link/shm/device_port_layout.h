@@ -13,6 +13,7 @@
 #include "common/link/shm/segment.h"
 #include "common/link/shm/seqlock.h"
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 
@@ -25,6 +26,8 @@ struct DevicePortLayout {
   ClockMode clock = ClockMode::realtime;    // set by the haptic controller at creation
   std::uint32_t reserved = 0;
   double haptic_period_s = 0.0;             // the device's tick in lockstep
+  std::uint64_t device_hash = 0;            // DeviceDescription::hash of the host's device
+  std::array<char, 256> device_source{};    // and where it came from, NUL-terminated (truncated if longer)
   SeqlockChannel<wire::DeviceCommand> command;    // writer: haptic controller
   SeqlockChannel<wire::DeviceState> state;        // writer: device
   SeqlockChannel<LoopStats> device_stats;   // writer: device

@@ -18,10 +18,13 @@ constexpr double kTurnTimeout_s = 60.0;
 
 }  // namespace
 
-ShmDevicePortHost::ShmDevicePortHost(const std::string& shm, ClockMode clock, double haptic_period_s)
+ShmDevicePortHost::ShmDevicePortHost(const std::string& shm, ClockMode clock, double haptic_period_s,
+                                     const DeviceDescription& device)
     : segment_(Segment<DevicePortLayout>::create(device_port_name(shm), [&](DevicePortLayout& port) {
         port.clock = clock;
         port.haptic_period_s = haptic_period_s;
+        port.device_hash = device.hash;
+        device.source.copy(port.device_source.data(), port.device_source.size() - 1);
       })) {}
 
 // Its turn semaphores are re-initialised first, while no live device can be waiting on them (the slot is still
@@ -93,11 +96,18 @@ bool ShmDevicePortHost::wait_for_device() {
 
 void ShmDevicePortHost::end_session() { segment_->device_turn.request_shutdown(); }
 
-ShmDevicePortClient::ShmDevicePortClient(const std::string& shm, ClockMode clock, double timeout_s)
+ShmDevicePortClient::ShmDevicePortClient(const std::string& shm, ClockMode clock, double timeout_s,
+                                         const DeviceDescription& device)
     : segment_(open_when_ready<DevicePortLayout>(device_port_name(shm), timeout_s)) {
   if (segment_->clock != clock) {
     throw std::runtime_error(std::string("the haptic controller runs --clock ") + to_string(segment_->clock) +
                              " but the device was started with --clock " + to_string(clock));
+  }
+  if (segment_->device_hash != device.hash) {
+    const std::string host_source(segment_->device_source.data());
+    throw std::runtime_error("the haptic controller drives the device described by '" + host_source +
+                             "' but this device is described by '" + device.source +
+                             "', and the two differ: start both with the same --device");
   }
   // A slot held by a live device is an error; one held by a dead device is freed by the host within a few ticks.
   const auto me = static_cast<std::int32_t>(getpid());

@@ -1,0 +1,68 @@
+// The SPIDAR description file (common/spidar/geometry.h): the shipped file is the built-in device, bad files are
+// errors naming the file and key, and the hash tells devices apart.
+
+#include "common/spidar/geometry.h"
+
+#include <catch2/catch.hpp>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+using namespace impetus;
+
+namespace {
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const std::string path = std::string(IMPETUS_BINARY_DIR) + "/" + name + "-" + std::to_string(getpid()) + ".json";
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string error_of(const std::string& path) {
+  try {
+    load_spidar_geometry(path);
+  } catch (const SpidarGeometryError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("the shipped desktop SPIDAR file describes the built-in geometry") {
+  const SpidarDevice device =
+      parse_device_spec("spidar:" + std::string(IMPETUS_SOURCE_DIR) + "/common/spidar/desktop_spidar.json");
+  CHECK(geometry_hash(device.geometry) == geometry_hash(SpidarGeometry{}));
+  CHECK(parse_device_spec("spidar").source == "built-in");
+}
+
+TEST_CASE("a device file with an unknown key or an unusable value is an error naming the file and the key") {
+  const std::string typo = write_file("typo", R"({"frame_side": 0.4})");
+  CHECK_THAT(error_of(typo), Catch::Contains(typo) && Catch::Contains("frame_side"));
+  const std::string negative = write_file("negative", R"({"tension_min_N": -1})");
+  CHECK_THAT(error_of(negative), Catch::Contains("tension_min_N") && Catch::Contains("-1"));
+  const std::string inverted = write_file("inverted", R"({"tension_min_N": 5, "tension_max_N": 2})");
+  CHECK_THAT(error_of(inverted), Catch::Contains("tension_max_N"));
+  const std::string centre = write_file("centre", R"({"centre_m": [0, 0]})");
+  CHECK_THAT(error_of(centre), Catch::Contains("centre_m"));
+  CHECK_THAT(error_of("/nonexistent/spidar.json"), Catch::Contains("/nonexistent/spidar.json"));
+  CHECK_THROWS_AS(parse_device_spec("phantom"), SpidarGeometryError);
+  for (const std::string& path : {typo, negative, inverted, centre}) std::remove(path.c_str());
+}
+
+TEST_CASE("devices that differ in any value hash differently") {
+  const SpidarGeometry base;
+  SpidarGeometry wider = base;
+  wider.frame_side_m = 0.6;
+  SpidarGeometry moved = base;
+  moved.centre_m[2] += 1e-3;
+  SpidarGeometry stronger = base;
+  stronger.max_force_N = 12.0;
+  CHECK(geometry_hash(base) == geometry_hash(SpidarGeometry{}));
+  CHECK(geometry_hash(wider) != geometry_hash(base));
+  CHECK(geometry_hash(moved) != geometry_hash(base));
+  CHECK(geometry_hash(stronger) != geometry_hash(base));
+}
