@@ -3,7 +3,7 @@
 
 #include "common/link/shm/shm_world_link.h"
 #include "common/runtime/cli.h"
-#include "world_manager/ode_runtime.h"
+#include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world_node.h"
 
 #include <fstream>

@@ -5,8 +5,8 @@
 // Uses world_manager symbols only.
 
 #include "world_manager/scene.h"
-#include "world_manager/feature_extractor.h"
-#include "world_manager/ode_runtime.h"
+#include "world_manager/features/feature_extractor.h"
+#include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world.h"
 
 #include <algorithm>

@@ -8,7 +8,7 @@
 #include "haptic_controller/haptic_node.h"
 #include "spidar_sim/device_node.h"
 #include "spidar_sim/trajectory.h"
-#include "world_manager/ode_runtime.h"
+#include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world_node.h"
 
 #include <nlohmann/json.hpp>

@@ -1,7 +1,7 @@
 // Which contacts hold the finger's push in the local model (contact_graph.h): a chain of contacts within their
 // friction cones to static geometry holds; a loose neighbour does not.
 
-#include "world_manager/contact_graph.h"
+#include "world_manager/features/contact_graph.h"
 
 #include <catch2/catch.hpp>
 

@@ -1,4 +1,4 @@
-#include "world_manager/feature_extractor.h"
+#include "world_manager/features/feature_extractor.h"
 #include "world_test_support.h"
 
 #include <catch2/catch.hpp>

@@ -155,8 +155,8 @@ TEST_CASE("position coupling pushes with k_p times the penetration, held for the
   world->step(&report);
   // Still finger, still cube: no damping term; the force acts through the face centre, so no torque.
   const Vector3d expected_force_N(2000.0 * kDepth_m, 0.0, 0.0);
-  CHECK(close(world->coupling_force_N(0), expected_force_N));
   const double period_s = world->world_period_s();
+  CHECK(close(world->step_impulse_Ns(0), expected_force_N * period_s));  // the force held for the period
   CHECK(close(world->states()[0].velocity_mps, expected_force_N * period_s / 1.0));
   CHECK(world->states()[0].angular_velocity_radps.norm() < 1e-12);
 }

@@ -4,7 +4,7 @@
 
 #include "common/link/shm/wire_frames.h"
 #include "world_manager/scene.h"
-#include "world_manager/ode_runtime.h"
+#include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world.h"
 
 #include <nlohmann/json.hpp>

@@ -11,9 +11,9 @@
 
 #include "common/contract/frames.h"
 #include "world_manager/scene.h"
-#include "world_manager/body_geometry.h"
+#include "world_manager/features/body_geometry.h"
 #include "world_manager/object_state.h"
-#include "world_manager/spatial_grid.h"
+#include "world_manager/features/spatial_grid.h"
 
 #include <Eigen/Core>
 

@@ -1,4 +1,4 @@
-#include "world_manager/body_geometry.h"
+#include "world_manager/features/body_geometry.h"
 
 #include <algorithm>
 #include <cmath>

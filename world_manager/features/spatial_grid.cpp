@@ -1,4 +1,4 @@
-#include "world_manager/spatial_grid.h"
+#include "world_manager/features/spatial_grid.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "world_manager/ode_runtime.h"
+#include "world_manager/engine/ode_runtime.h"
 
 #include <ode/ode.h>
 

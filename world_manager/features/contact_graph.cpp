@@ -1,4 +1,4 @@
-#include "world_manager/contact_graph.h"
+#include "world_manager/features/contact_graph.h"
 
 #include <algorithm>
 #include <cmath>

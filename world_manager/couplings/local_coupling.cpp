@@ -1,0 +1,107 @@
+#include "world_manager/couplings/local_coupling.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace impetus {
+
+LocalCoupling::LocalCoupling(const CouplingContext& context)
+    : CouplingStrategy(context),
+      impulse_Ns_(context.scene.objects.size(),
+                  std::vector<Eigen::Vector3d>(static_cast<std::size_t>(context.substeps) + 1, Eigen::Vector3d::Zero())),
+      angular_Nms_(impulse_Ns_) {}
+
+void LocalCoupling::take_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment,
+                                 bool moment_finite, const RenderWindow& window) {
+  if (moment_finite) {
+    schedule(id, delta, moment, window);
+  } else {
+    apply_velocity_change(id, delta.impulse_Ns, delta.angular_impulse_Nms);  // cannot place it in time
+  }
+}
+
+void LocalCoupling::schedule(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment,
+                             const RenderWindow& window) {
+  const int substeps = context_.substeps;
+  const double period_s = context_.world_period_s;
+  const double h = period_s / substeps;
+  const double scale = period_s / window.length_s;  // lockstep: 1; real time: the window mapped onto this step
+  auto place = [&](double amount, double first_moment, int axis, std::vector<Eigen::Vector3d>& slots) {
+    // Moment about the window's start, mapped onto this step: Σ J_k·c_k with c_k ∈ [0, T_w].
+    const double moment_about_start = (first_moment - window.start_s * amount) * scale;
+    if (!std::isfinite(moment_about_start)) {  // cannot place it: all of it after the last substep (velocity only)
+      slots[static_cast<std::size_t>(substeps)][axis] += amount;
+      return;
+    }
+    const double c = amount != 0.0 ? moment_about_start / amount : -1.0;
+    if (c >= 0.0 && c <= period_s) {
+      const double position = c / h;
+      const int k = std::min(static_cast<int>(std::floor(position)), substeps);
+      const double alpha = k < substeps ? position - k : 0.0;
+      slots[static_cast<std::size_t>(k)][axis] += (1.0 - alpha) * amount;
+      if (alpha > 0.0) slots[static_cast<std::size_t>(k + 1)][axis] += alpha * amount;
+    } else if (amount != 0.0 || moment_about_start != 0.0) {
+      // The impulse changed sign within the window (its centroid lies outside it, or it summed to zero): split it
+      // between the window's ends, b at T_w and a = J − b at 0, with b·T_w = Σ J_k·c_k: still exact in momentum and
+      // in displacement for a free body.
+      const double at_end = moment_about_start / period_s;
+      slots[0][axis] += amount - at_end;
+      slots[static_cast<std::size_t>(substeps)][axis] += at_end;
+    }
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    place(delta.impulse_Ns[axis], moment.impulse_Ns[axis], axis, impulse_Ns_[id]);
+    place(delta.angular_impulse_Nms[axis], moment.angular_impulse_Nms[axis], axis, angular_Nms_[id]);
+  }
+  context_.engine.wake(id);
+  context_.applied.add(id, delta.impulse_Ns, delta.angular_impulse_Nms);
+}
+
+void LocalCoupling::apply_slot(int slot) {
+  // Substep slots: the scheduled impulse as a force held for one substep (the engine clears forces after each).
+  // Slot `substeps` (an impulse at the very end of the window): for a free body, a velocity change after the last
+  // substep (exact: no displacement). For a body that touched something at the last frame it goes into the last
+  // substep instead, where the contacts see it: as a bare velocity change it would skip them for a whole step (a
+  // light ball pushed into the floor in the last tick would sink into it before the engine pushed it back out). The
+  // price there is h·J/m of displacement, blended in at the next frame (local_dynamics.h).
+  const int substeps = context_.substeps;
+  const double h = context_.world_period_s / substeps;
+  const ContactGraph& contacts = context_.engine.contacts();  // still the last step's: recorded after this hook
+  for (std::size_t id = 0; id < impulse_Ns_.size(); ++id) {
+    Eigen::Vector3d& impulse_Ns = impulse_Ns_[id][static_cast<std::size_t>(slot)];
+    Eigen::Vector3d& angular_Nms = angular_Nms_[id][static_cast<std::size_t>(slot)];
+    if (slot + 1 == substeps && contacts.touching(static_cast<std::int32_t>(id))) {
+      Eigen::Vector3d& end_Ns = impulse_Ns_[id][static_cast<std::size_t>(substeps)];
+      Eigen::Vector3d& end_Nms = angular_Nms_[id][static_cast<std::size_t>(substeps)];
+      impulse_Ns += end_Ns;
+      angular_Nms += end_Nms;
+      end_Ns.setZero();
+      end_Nms.setZero();
+    }
+    if (impulse_Ns.isZero(0.0) && angular_Nms.isZero(0.0)) continue;
+    if (slot < substeps) {
+      context_.engine.add_force(id, impulse_Ns / h, angular_Nms / h);
+    } else {
+      Eigen::Vector3d velocity_mps;
+      Eigen::Vector3d angular_radps;
+      context_.engine.velocity(id, velocity_mps, angular_radps);
+      const ObjectState& state = context_.states[id];
+      context_.engine.set_velocity(id, velocity_mps + state.inverse_mass_per_kg * impulse_Ns,
+                                   angular_radps + state.inverse_inertia_world * angular_Nms);
+    }
+    impulse_Ns.setZero();
+    angular_Nms.setZero();
+  }
+}
+
+void LocalCoupling::annotate(PlaneFrame& frame) {
+  ContactGraph& contacts = context_.engine.contacts();
+  for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
+    Plane& plane = frame.planes[k];
+    plane.local_contact_count = 0;
+    if ((plane.flags & kPlaneDynamic) == 0 || plane.object_id < 0) continue;
+    plane.local_contact_count = contacts.local_contacts(plane.object_id, plane.local_contacts);
+  }
+}
+
+}  // namespace impetus

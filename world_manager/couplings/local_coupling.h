@@ -1,0 +1,48 @@
+#pragma once
+// Local coupling, the world's side (paper §6.3): the haptic side moves the touched objects between world frames
+// (haptic_controller/local_dynamics.h), so the world must apply each impulse when it was rendered, not all at the
+// start of the step, and tell the haptic side what each object touches (its frames' LocalContacts).
+//
+// The haptic side moved the object tick by tick: an impulse J_k rendered at haptic time t_k has displaced it by
+// J_k·(t_end − t_k)/m by the end of the window. The engine's semi-implicit Euler step gives a force held during
+// substep s (length h) exactly the effect of an impulse at time s·h (v changes at the end of the substep, x then
+// integrates the new v), so the world reproduces both the momentum Σ J_k and the displacement Σ J_k·(t_end − t_k)/m by
+// putting each axis's impulse at its centroid time
+//     c = (Σ J_k·t_k − t_start·Σ J_k) / Σ J_k      (from the report's first moments, contract/frames.h)
+// split between the two substeps around c: (1 − α) at ⌊c/h⌋ and α at ⌊c/h⌋ + 1, α = frac(c/h). Slot `substeps` is
+// the end of the window (an impulse in the very last tick). The world's next state then agrees with what the finger
+// felt exactly for a free body (up to h·J/m for an impulse at the very end); with contacts, up to how friction sees the
+// impulse compressed to its centroid (it only acts while the object slides: ≈ 0.3 mm at the start of a tap, while
+// the contact itself is blended, local_dynamics.h).
+
+#include "world_manager/couplings/coupling.h"
+
+#include <vector>
+
+namespace impetus {
+
+class LocalCoupling final : public CouplingStrategy {
+ public:
+  explicit LocalCoupling(const CouplingContext& context);
+
+  Coupling kind() const override { return Coupling::local; }
+  void take_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment, bool moment_finite,
+                    const RenderWindow& window) override;
+  void before_substep(int substep) override { apply_slot(substep); }
+  void after_step() override { apply_slot(context_.substeps); }
+  bool needs_contacts() const override { return true; }
+  // Each dynamic object's plane carries the contacts the object had in the last substep, the constraints of the
+  // haptic side's local model.
+  void annotate(PlaneFrame& frame) override;
+
+ private:
+  void schedule(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment, const RenderWindow& window);
+  void apply_slot(int slot);
+
+  // Per object, the impulse and angular impulse to apply in each substep of this step (slot `substeps`: after the
+  // last substep, a pure velocity change).
+  std::vector<std::vector<Eigen::Vector3d>> impulse_Ns_;
+  std::vector<std::vector<Eigen::Vector3d>> angular_Nms_;
+};
+
+}  // namespace impetus

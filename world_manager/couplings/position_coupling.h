@@ -1,0 +1,32 @@
+#pragma once
+// Position coupling, the paper's previous method (§2.3, fig. 3 "d"): the world samples the finger once per step, and
+// the finger's penetration d into each dynamic object gives a penalty force k_p·d + k_d·ḋ along the inward normal,
+// held for the whole world period. The report's impulses still advance the ledger (so its counters stay in step) but
+// move nothing.
+
+#include "world_manager/couplings/coupling.h"
+
+#include <vector>
+
+namespace impetus {
+
+class PositionCoupling final : public CouplingStrategy {
+ public:
+  // k_p and k_d of the penalty (N/m, N·s/m); the World passes the scene's haptic stiffness and damping, so both
+  // couplings see the same surface.
+  PositionCoupling(const CouplingContext& context, double stiffness_Npm, double damping_Nspm);
+
+  Coupling kind() const override { return Coupling::position; }
+  void take_impulse(std::size_t, const ImpulseDelta&, const ImpulseDelta&, bool, const RenderWindow&) override {}
+  void before_step(const FingerState& finger, const FeatureExtractor& features) override;
+  void before_substep(int substep) override;
+
+ private:
+  double stiffness_Npm_;
+  double damping_Nspm_;
+  std::vector<Eigen::Vector3d> force_N_;  // per object, held during the step
+  std::vector<Eigen::Vector3d> point_m_;  // where it acts
+  std::vector<ReachCandidate> touching_;  // reused between steps
+};
+
+}  // namespace impetus

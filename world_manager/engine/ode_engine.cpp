@@ -1,0 +1,235 @@
+#include "world_manager/engine/ode_engine.h"
+
+#include <ode/ode.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace impetus {
+namespace {
+
+// Contact points ODE may return per geom pair: box–box needs up to 8 for a face resting on a face.
+constexpr int kMaxContactsPerPair = 8;
+// Below this approach speed a contact does not bounce: resting and sliding objects would otherwise chatter on every
+// substep's tiny penetration-correction velocity (ERP pushes at a few mm/s).
+constexpr double kBounceThreshold_mps = 0.05;
+
+void* id_to_data(std::size_t id) { return reinterpret_cast<void*>(static_cast<std::uintptr_t>(id)); }
+std::size_t data_to_id(void* data) { return static_cast<std::size_t>(reinterpret_cast<std::uintptr_t>(data)); }
+
+Eigen::Matrix3d ode_inertia(const dMass& mass) {
+  Eigen::Matrix3d inertia;
+  // dMatrix3 is row-major 3×4 (one padding column).
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) inertia(r, c) = mass.I[4 * r + c];
+  }
+  return inertia;
+}
+
+}  // namespace
+
+struct OdeEngine::Handles {
+  const Scene* scene = nullptr;
+  dWorldID world = nullptr;
+  dSpaceID space = nullptr;
+  dJointGroupID contacts = nullptr;
+  std::vector<dBodyID> bodies;      // per object; nullptr for static objects
+  std::vector<dGeomID> geoms;       // per object
+  std::vector<Material> materials;  // per id, the floor last
+  std::vector<Eigen::Matrix3d> inverse_inertia_body;  // per object; zero for static ones
+  unsigned long random_state = 0;   // ODE's generator state between this engine's steps
+  bool record_contacts = false;
+  ContactGraph contact_graph;
+
+  ~Handles() {
+    if (contacts != nullptr) dJointGroupDestroy(contacts);
+    if (space != nullptr) dSpaceDestroy(space);  // destroys the geoms it holds (cleanup mode on)
+    if (world != nullptr) dWorldDestroy(world);  // destroys the bodies
+  }
+
+  // ODE's near callback: contact joints with the two materials combined (scene.h combine_*).
+  static void near_callback(void* data, dGeomID a, dGeomID b) {
+    auto* self = static_cast<Handles*>(data);
+    dBodyID body_a = dGeomGetBody(a);
+    dBodyID body_b = dGeomGetBody(b);
+    if (body_a == nullptr && body_b == nullptr) return;  // static against static never moves
+    dContact contacts[kMaxContactsPerPair];
+    const int count = dCollide(a, b, kMaxContactsPerPair, &contacts[0].geom, sizeof(dContact));
+    if (count == 0) return;
+    const Material& ma = self->materials[data_to_id(dGeomGetData(a))];
+    const Material& mb = self->materials[data_to_id(dGeomGetData(b))];
+    const double restitution = combine_restitution(ma.restitution, mb.restitution);
+    for (int i = 0; i < count; ++i) {
+      dSurfaceParameters& surface = contacts[i].surface;
+      // Approx1: the friction bound is mu times the normal force (a Coulomb pyramid). ODE has a single coefficient;
+      // it gets the dynamic one because sliding (how far a tapped cube goes, paper §4.2.2) is governed by it. The
+      // static coefficient matters for the finger, and the planes carry it to the haptic side.
+      surface.mode = dContactApprox1;
+      surface.mu = combine_friction(ma.dynamic_friction, mb.dynamic_friction);
+      if (restitution > 0.0) {
+        surface.mode |= dContactBounce;
+        surface.bounce = restitution;
+        surface.bounce_vel = kBounceThreshold_mps;
+      }
+      dJointID joint = dJointCreateContact(self->world, self->contacts, &contacts[i]);
+      dJointAttach(joint, body_a, body_b);
+      if (self->record_contacts) {
+        // ODE's normal points into geom 1 (contact.h): the contact pushes body a along +n and body b along −n.
+        const dReal* n = contacts[i].geom.normal;
+        const Eigen::Vector3d normal(n[0], n[1], n[2]);
+        if (!(normal.squaredNorm() > 0.0) || !normal.allFinite()) continue;
+        const auto id_a = static_cast<std::int32_t>(data_to_id(dGeomGetData(a)));
+        const auto id_b = static_cast<std::int32_t>(data_to_id(dGeomGetData(b)));
+        if (body_a != nullptr) {
+          self->contact_graph.add(id_a, body_b != nullptr ? id_b : ContactGraph::kStatic, normal, surface.mu);
+        }
+        if (body_b != nullptr) {
+          self->contact_graph.add(id_b, body_a != nullptr ? id_a : ContactGraph::kStatic, -normal, surface.mu);
+        }
+      }
+    }
+  }
+};
+
+OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
+  Handles& ode = *ode_;
+  ode.scene = &scene;
+  ode.world = dWorldCreate();
+  ode.space = dHashSpaceCreate(nullptr);
+  ode.contacts = dJointGroupCreate(0);
+  dWorldSetGravity(ode.world, scene.gravity_mps2[0], scene.gravity_mps2[1], scene.gravity_mps2[2]);
+  dWorldSetERP(ode.world, scene.physics.erp);
+  dWorldSetCFM(ode.world, scene.physics.cfm);
+  dWorldSetQuickStepNumIterations(ode.world, scene.physics.solver_iterations);
+  dWorldSetAutoDisableFlag(ode.world, scene.physics.auto_disable ? 1 : 0);
+
+  ode.bodies.assign(scene.objects.size(), nullptr);
+  ode.contact_graph.reset(scene.objects.size());
+  ode.geoms.assign(scene.objects.size(), nullptr);
+  ode.inverse_inertia_body.assign(scene.objects.size(), Eigen::Matrix3d::Zero());
+  for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+    const SceneObject& object = scene.objects[id];
+    const Shape& shape = object.shape;
+    dGeomID geom = nullptr;
+    dMass mass;
+    dMassSetZero(&mass);
+    constexpr int kAxisZ = 3;  // ODE's direction code for the body z axis
+    switch (shape.kind) {
+      case ShapeKind::box:
+        geom = dCreateBox(ode.space, shape.box_size_m[0], shape.box_size_m[1], shape.box_size_m[2]);
+        if (object.dynamic) {
+          dMassSetBoxTotal(&mass, object.mass_kg, shape.box_size_m[0], shape.box_size_m[1], shape.box_size_m[2]);
+        }
+        break;
+      case ShapeKind::sphere:
+        geom = dCreateSphere(ode.space, shape.radius_m);
+        if (object.dynamic) dMassSetSphereTotal(&mass, object.mass_kg, shape.radius_m);
+        break;
+      case ShapeKind::capsule:
+        geom = dCreateCapsule(ode.space, shape.radius_m, shape.length_m);
+        if (object.dynamic) dMassSetCapsuleTotal(&mass, object.mass_kg, kAxisZ, shape.radius_m, shape.length_m);
+        break;
+      case ShapeKind::cylinder:
+        geom = dCreateCylinder(ode.space, shape.radius_m, shape.length_m);
+        if (object.dynamic) dMassSetCylinderTotal(&mass, object.mass_kg, kAxisZ, shape.radius_m, shape.length_m);
+        break;
+    }
+    dGeomSetData(geom, id_to_data(id));
+    ode.geoms[id] = geom;
+
+    const auto& q = object.orientation_wxyz;
+    const dQuaternion orientation{q[0], q[1], q[2], q[3]};
+    if (object.dynamic) {
+      dBodyID body = dBodyCreate(ode.world);
+      dBodySetMass(body, &mass);
+      dGeomSetBody(geom, body);
+      dBodySetPosition(body, object.position_m[0], object.position_m[1], object.position_m[2]);
+      dBodySetQuaternion(body, orientation);
+      dBodySetLinearVel(body, object.linear_velocity_mps[0], object.linear_velocity_mps[1],
+                        object.linear_velocity_mps[2]);
+      dBodySetAngularVel(body, object.angular_velocity_radps[0], object.angular_velocity_radps[1],
+                         object.angular_velocity_radps[2]);
+      ode.bodies[id] = body;
+      ode.inverse_inertia_body[id] = ode_inertia(mass).inverse();
+    } else {
+      dGeomSetPosition(geom, object.position_m[0], object.position_m[1], object.position_m[2]);
+      dGeomSetQuaternion(geom, orientation);
+    }
+    ode.materials.push_back(object.material);
+  }
+  ode.materials.push_back(scene.floor.material);
+  if (scene.floor.present) {
+    dGeomID floor = dCreatePlane(ode.space, 0.0, 0.0, 1.0, scene.floor.height_m);
+    dGeomSetData(floor, id_to_data(scene.objects.size()));
+  }
+
+  dRandSetSeed(static_cast<unsigned long>(scene.physics.seed));
+  ode.random_state = dRandGetSeed();
+}
+
+OdeEngine::~OdeEngine() = default;
+
+void OdeEngine::read_state(std::size_t id, ObjectState& out) const {
+  dBodyID body = ode_->bodies[id];
+  const dReal* position = dBodyGetPosition(body);
+  const dReal* q = dBodyGetQuaternion(body);
+  const dReal* velocity = dBodyGetLinearVel(body);
+  const dReal* angular = dBodyGetAngularVel(body);
+  out.pose.position_m = Eigen::Vector3d(position[0], position[1], position[2]);
+  out.pose.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+  out.velocity_mps = Eigen::Vector3d(velocity[0], velocity[1], velocity[2]);
+  out.angular_velocity_radps = Eigen::Vector3d(angular[0], angular[1], angular[2]);
+}
+
+const Eigen::Matrix3d& OdeEngine::inverse_inertia_body(std::size_t id) const { return ode_->inverse_inertia_body[id]; }
+
+void OdeEngine::velocity(std::size_t id, Eigen::Vector3d& velocity_mps, Eigen::Vector3d& angular_radps) const {
+  const dReal* v = dBodyGetLinearVel(ode_->bodies[id]);
+  const dReal* w = dBodyGetAngularVel(ode_->bodies[id]);
+  velocity_mps = Eigen::Vector3d(v[0], v[1], v[2]);
+  angular_radps = Eigen::Vector3d(w[0], w[1], w[2]);
+}
+
+void OdeEngine::set_velocity(std::size_t id, const Eigen::Vector3d& velocity_mps,
+                             const Eigen::Vector3d& angular_radps) {
+  dBodyID body = ode_->bodies[id];
+  dBodySetLinearVel(body, velocity_mps.x(), velocity_mps.y(), velocity_mps.z());
+  dBodySetAngularVel(body, angular_radps.x(), angular_radps.y(), angular_radps.z());
+}
+
+void OdeEngine::wake(std::size_t id) { dBodyEnable(ode_->bodies[id]); }
+
+void OdeEngine::add_force(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm) {
+  dBodyID body = ode_->bodies[id];
+  dBodyAddForce(body, force_N.x(), force_N.y(), force_N.z());
+  dBodyAddTorque(body, torque_Nm.x(), torque_Nm.y(), torque_Nm.z());
+}
+
+void OdeEngine::add_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m) {
+  dBodyAddForceAtPos(ode_->bodies[id], force_N.x(), force_N.y(), force_N.z(), point_m.x(), point_m.y(), point_m.z());
+}
+
+void OdeEngine::step(int substeps, double substep_s, bool record_contacts, SubstepHook& hook) {
+  Handles& ode = *ode_;
+  const Scene& scene = *ode.scene;
+  dRandSetSeed(ode.random_state);
+  for (int substep = 0; substep < substeps; ++substep) {
+    hook.before_substep(substep);
+    ode.record_contacts = record_contacts && substep + 1 == substeps;
+    if (ode.record_contacts) ode.contact_graph.reset(scene.objects.size());
+    dSpaceCollide(ode.space, &ode, &Handles::near_callback);
+    if (ode.record_contacts) ode.contact_graph.finish();
+    ode.record_contacts = false;
+    if (scene.physics.solver == PhysicsParams::Solver::direct) {
+      dWorldStep(ode.world, substep_s);
+    } else {
+      dWorldQuickStep(ode.world, substep_s);
+    }
+    dJointGroupEmpty(ode.contacts);
+  }
+  ode.random_state = dRandGetSeed();
+}
+
+ContactGraph& OdeEngine::contacts() { return ode_->contact_graph; }
+
+}  // namespace impetus

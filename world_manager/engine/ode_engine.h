@@ -1,0 +1,40 @@
+#pragma once
+// The ODE implementation of RigidBodyEngine: a hash space, contact joints with the two materials combined
+// (scene.h combine_*), QuickStep or the direct solver as the scene asks.
+//
+// The process must have called init_ode_once() (ode_runtime.h) first. Each engine keeps its own stream of ODE's
+// global random generator (saved and restored around its steps), so runs are bitwise reproducible per engine even
+// when several live in one process. Used from one thread.
+
+#include "world_manager/engine/rigid_body_engine.h"
+#include "world_manager/scene.h"
+
+#include <memory>
+
+namespace impetus {
+
+class OdeEngine final : public RigidBodyEngine {
+ public:
+  // Builds the scene's bodies and geoms and seeds the generator with scene.physics.seed. Keeps a reference to
+  // `scene`, which must outlive the engine.
+  explicit OdeEngine(const Scene& scene);
+  ~OdeEngine() override;
+  OdeEngine(const OdeEngine&) = delete;
+  OdeEngine& operator=(const OdeEngine&) = delete;
+
+  void read_state(std::size_t id, ObjectState& out) const override;
+  const Eigen::Matrix3d& inverse_inertia_body(std::size_t id) const override;
+  void velocity(std::size_t id, Eigen::Vector3d& velocity_mps, Eigen::Vector3d& angular_radps) const override;
+  void set_velocity(std::size_t id, const Eigen::Vector3d& velocity_mps, const Eigen::Vector3d& angular_radps) override;
+  void wake(std::size_t id) override;
+  void add_force(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm) override;
+  void add_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m) override;
+  void step(int substeps, double substep_s, bool record_contacts, SubstepHook& hook) override;
+  ContactGraph& contacts() override;
+
+ private:
+  struct Handles;
+  std::unique_ptr<Handles> ode_;
+};
+
+}  // namespace impetus

@@ -1,0 +1,51 @@
+#pragma once
+// The rigid-body engine behind the world (DESIGN.md §1.3): the scene's bodies, advanced in substeps. The World and the
+// couplings see only this interface; ODE is one implementation (ode_engine.h).
+//
+// Ids are scene object indices. Velocities and forces are in the world frame, SI units. Static objects have no body:
+// calls naming them are not allowed (callers check SceneObject::dynamic).
+
+#include "world_manager/features/contact_graph.h"
+#include "world_manager/object_state.h"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+
+namespace impetus {
+
+// Called by RigidBodyEngine::step before each substep (couplings add their forces there).
+class SubstepHook {
+ public:
+  virtual ~SubstepHook() = default;
+  virtual void before_substep(int substep) = 0;
+};
+
+class RigidBodyEngine {
+ public:
+  virtual ~RigidBodyEngine() = default;
+
+  // Pose, velocity and angular velocity of dynamic object `id` now (the mass properties of `out` are left alone).
+  virtual void read_state(std::size_t id, ObjectState& out) const = 0;
+  // Inverse inertia about the centre of mass in the body frame, 1/(kg·m²).
+  virtual const Eigen::Matrix3d& inverse_inertia_body(std::size_t id) const = 0;
+
+  virtual void velocity(std::size_t id, Eigen::Vector3d& velocity_mps, Eigen::Vector3d& angular_radps) const = 0;
+  virtual void set_velocity(std::size_t id, const Eigen::Vector3d& velocity_mps,
+                            const Eigen::Vector3d& angular_radps) = 0;
+  // A sleeping body must wake to move.
+  virtual void wake(std::size_t id) = 0;
+  // Held during the next substep only.
+  virtual void add_force(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm) = 0;
+  virtual void add_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m) = 0;
+
+  // Advances `substeps` substeps of `substep_s` each, calling hook.before_substep(s) first in each. With
+  // `record_contacts` the contacts of the last substep replace contacts(). Reproducible: the same calls from the same
+  // state give the same bits, whatever other engines in the process do.
+  virtual void step(int substeps, double substep_s, bool record_contacts, SubstepHook& hook) = 0;
+
+  // The contacts recorded by the last step that recorded them.
+  virtual ContactGraph& contacts() = 0;
+};
+
+}  // namespace impetus
