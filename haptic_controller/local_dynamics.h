@@ -14,7 +14,7 @@
 //     v ← v + g·h                                               drift: gravity ...
 //     for each contact n (unilateral):                          ... the supports ...
 //       P = max(0, −v·n);  v ← v + P·n                          (normal impulse per unit mass)
-//       a loose contact (no kContactHolds: a neighbour that can give way, world_manager/contact_graph.h) takes at
+//       a loose contact (no kContactHolds: a neighbour that can give way, world_manager/features/contact_graph.h) takes at
 //       most the weight it carries, P ≤ max(0, −g·n)·h: it holds the body up but yields to the finger's push
 //       v_t = v − (v·n)·n;  v ← v − min(|v_t|, μ·P)·v_t/|v_t|   ... and their Coulomb friction (cube on a floor:
 //                                                                μ·g·Δt of speed per tick, as in the world)
@@ -65,6 +65,7 @@
 
 #include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
+#include "haptic_controller/plane_motion.h"
 #include "haptic_controller/proxy_projection.h"
 
 #include <Eigen/Core>
@@ -95,8 +96,24 @@ struct LocalBody {
   Eigen::Vector3d carry_point(const Eigen::Vector3d& x_m) const { return x_m + displacement_m; }
 };
 
-class LocalDynamics {
+class LocalDynamics final : public PlaneMotion {
  public:
+  // PlaneMotion: the steps below in the servo's order.
+  void on_frame(const PlaneFrame&, const PlaneFrame& frame, const PlaneSet* displayed,
+                const Eigen::Vector3d& proxy_m) override {
+    on_plane_frame(frame, displayed, proxy_m);
+  }
+  void planes_for_tick(double w, double dt_s, bool stale, const Eigen::Vector3d& pivot_m, PlaneSet& out) override {
+    if (!stale) advance(dt_s);  // a stale world: the model holds still
+    render(w, pivot_m, out);
+  }
+  void take_shares(const ImpulseShare* shares, int count) override {
+    for (int k = 0; k < count; ++k) {
+      if (shares[k].dynamic) apply_impulse(shares[k].object_id, shares[k].impulse_Ns, shares[k].angular_impulse_Nms);
+    }
+  }
+  double frame_disagreement_m() const override { return last_model_error_m(); }
+
   // A new world frame at the servo: restart every body from the frame's state and remember, per plane, the plane
   // the finger was feeling (`displayed`: the last tick's planes, or nullptr) to blend from. `proxy_m` is the proxy of
   // that tick, where last_model_error_m is measured.
@@ -124,7 +141,7 @@ class LocalDynamics {
   // inverse mass along `force_N` at the proxy (translation and rotation), the touched bodies' weighted by their shares
   // of the reaction (static planes: 0).
   double yield_scale(const PlaneSet& planes, const ProxySolution& contact, const Eigen::Vector3d& force_N,
-                     double stiffness_Npm, double damping_Nspm, double dt_s) const;
+                     double stiffness_Npm, double damping_Nspm, double dt_s) const override;
 
   const LocalBody* find(std::int32_t object_id) const;
   std::uint32_t body_count() const { return body_count_; }

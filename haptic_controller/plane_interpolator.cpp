@@ -1,6 +1,7 @@
 #include "haptic_controller/plane_interpolator.h"
 
 #include "haptic_controller/plane_matching.h"
+#include "haptic_controller/plane_motion.h"
 
 #include <algorithm>
 #include <cmath>
@@ -75,6 +76,20 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, d
     const double offset = (1.0 - w) * offset_before + w * offset_now;
     plane.point_m = point + (plane.normal.dot(pivot_m - point) - offset) * plane.normal;
   }
+}
+
+}  // namespace impetus
+
+namespace impetus {
+
+void InterpolatedPlanes::on_frame(const PlaneFrame& previous, const PlaneFrame& frame, const PlaneSet*,
+                                  const Eigen::Vector3d&) {
+  previous_ = previous;
+  current_ = frame;
+}
+
+void InterpolatedPlanes::planes_for_tick(double w, double, bool, const Eigen::Vector3d& pivot_m, PlaneSet& out) {
+  interpolate_planes(previous_, current_, w, pivot_m, out);
 }
 
 }  // namespace impetus

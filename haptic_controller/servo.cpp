@@ -26,14 +26,15 @@ HapticServo::HapticServo(const ServoOptions& options, std::uint64_t haptic_sessi
 void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   // Interpolate from the previous frame of the same world session only; the first frame starts where it is.
   const bool continues = have_frame_ && frame.world_session == current_frame_.world_session;
-  if (frame.coupling == Coupling::local) {
-    // Local coupling (paper §6.3): restart the model from the world's state, blending from what the finger felt.
-    local_.on_plane_frame(frame, continues ? &planes_ : nullptr, to_eigen(result_.proxy_m));
-    if (continues) counters_.local_model_error_max_m = std::max(counters_.local_model_error_max_m,
-                                                                local_.last_model_error_m());
+  // The one place the coupling is read: local coupling's planes move with a local model (paper §6.3), the others'
+  // are interpolated (§3.2).
+  motion_ = frame.coupling == Coupling::local ? static_cast<PlaneMotion*>(&local_) : &interpolated_;
+  motion_->on_frame(continues ? current_frame_ : frame, frame, continues ? &planes_ : nullptr,
+                    to_eigen(result_.proxy_m));
+  if (continues) {
+    counters_.local_model_error_max_m = std::max(counters_.local_model_error_max_m, motion_->frame_disagreement_m());
   }
   frame_since_last_tick_ = true;
-  previous_frame_ = continues ? current_frame_ : frame;
   current_frame_ = frame;
   have_frame_ = true;
   frame_arrival_s_ = now_s;
@@ -132,13 +133,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
     w = interpolation_weight(now_s, frame_arrival_s_, current_frame_.world_period_s);
     result_.world_stale = world_stale(now_s - frame_arrival_s_, current_frame_.world_period_s);
     if (result_.world_stale) ++counters_.stale_world_ticks;
-    if (current_frame_.coupling == Coupling::local) {
-      // Local coupling: the frame's planes carried by the local model (a stale world: the model holds still).
-      if (!result_.world_stale) local_.advance(dt_s);
-      local_.render(w, to_eigen(result_.proxy_m), planes_);
-    } else {
-      interpolate_planes(previous_frame_, current_frame_, w, to_eigen(result_.proxy_m), planes_);
-    }
+    motion_->planes_for_tick(w, dt_s, result_.world_stale, to_eigen(result_.proxy_m), planes_);
   } else {
     planes_.count = 0;
   }
@@ -175,9 +170,9 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   const RenderedForce rendered =
       renderer_.render(contact.contact.proxy_m, finger_m, stiffness_Npm, damping_Nspm, dt_s);
   Eigen::Vector3d force_N = contact.contact.active_count > 0 ? rendered.force_N : Eigen::Vector3d::Zero();
-  if (have_frame_ && current_frame_.coupling == Coupling::local && contact.contact.active_count > 0) {
-    // The local model moves the touched objects: the tick is solved implicitly (local_dynamics.h yield_scale).
-    force_N *= local_.yield_scale(planes_, contact.contact, force_N, stiffness_Npm, damping_Nspm, dt_s);
+  if (have_frame_ && contact.contact.active_count > 0) {
+    // Planes that give way within the tick (local coupling) solve it implicitly (local_dynamics.h yield_scale).
+    force_N *= motion_->yield_scale(planes_, contact.contact, force_N, stiffness_Npm, damping_Nspm, dt_s);
   }
   result_.fault = rendered.fault;
   if (rendered.fault) ++counters_.faults;
@@ -188,13 +183,8 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   accumulator_.add(planes_, contact.contact, force_N, dt_s > 0.0 && std::isfinite(dt_s) ? dt_s : 0.0,
                    counters_.ticks);
   counters_.dropped_impulse_shares = accumulator_.dropped_shares();
-  if (have_frame_ && current_frame_.coupling == Coupling::local) {
-    // The objects give way at the haptic rate (paper §6.3): this tick's shares move the local model.
-    for (int k = 0; k < accumulator_.last_share_count(); ++k) {
-      const ImpulseShare& share = accumulator_.last_shares()[k];
-      if (share.dynamic) local_.apply_impulse(share.object_id, share.impulse_Ns, share.angular_impulse_Nms);
-    }
-  }
+  // The objects give way at the haptic rate (local coupling, paper §6.3): this tick's shares move the model.
+  if (have_frame_) motion_->take_shares(accumulator_.last_shares(), accumulator_.last_share_count());
 
   // 6. The device renders it (DESIGN.md §1.2 step 6: the haptic node commands the device).
   result_.render = true;

@@ -13,6 +13,7 @@
 #include "haptic_controller/god_object.h"
 #include "haptic_controller/impulse_accumulator.h"
 #include "haptic_controller/local_dynamics.h"
+#include "haptic_controller/plane_motion.h"
 
 #include <array>
 #include <cstdint>
@@ -102,7 +103,6 @@ class HapticServo {
   };
 
   ServoOptions options_;
-  PlaneFrame previous_frame_{};
   PlaneFrame current_frame_{};
   bool have_frame_ = false;
   double frame_arrival_s_ = 0.0;
@@ -110,7 +110,9 @@ class HapticServo {
   GodObject god_object_;
   ForceRenderer renderer_;
   ImpulseAccumulator accumulator_;
+  InterpolatedPlanes interpolated_;
   LocalDynamics local_;
+  PlaneMotion* motion_ = &interpolated_;  // the coupling's, chosen by each frame
   bool frame_since_last_tick_ = false;
   std::array<WatchedPlane, kMaxActiveConstraints + 1> watched_{};
   int watched_count_ = 0;
