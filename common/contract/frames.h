@@ -38,7 +38,7 @@ inline constexpr std::uint32_t kPlaneSphere = 1u << 1;
 
 // LocalContact flags.
 // The other side holds a push along −normal: static geometry, or a body joined to static geometry by a chain of
-// contacts that each take the push within their friction cone (world_manager/contact_graph.h). Without it the
+// contacts that each take the push within their friction cone (world_manager/features/contact_graph.h). Without it the
 // contact carries the object's weight in the local model but gives way to the finger's push.
 inline constexpr std::uint32_t kContactHolds = 1u << 0;
 
@@ -62,7 +62,7 @@ struct Plane {
   Vec3 angular_velocity_radps{};  // angular velocity, world frame
   double static_friction = 0.0;   // coefficient, dimensionless
   double dynamic_friction = 0.0;  // coefficient, dimensionless, <= static_friction
-  // How far from point_m the plane still describes the object (world_manager/body_geometry.h plane_extent_m): a
+  // How far from point_m the plane still describes the object (world_manager/features/body_geometry.h plane_extent_m): a
   // sphere's radius, a box's diagonal. 0: unbounded (the floor).
   double extent_m = 0.0;
   // Local response model for the coming world period (paper §6.3). Zero means "not provided": the haptic

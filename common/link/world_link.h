@@ -14,7 +14,8 @@
 
 namespace impetus {
 
-// What the world tells every haptic side once, at attach: its schedule and coupling.
+// What the world tells every haptic side once, at attach: its schedule and coupling. Trivially copyable (the shared
+// memory transport keeps it in its segment).
 struct WorldLinkInfo {
   double world_rate_hz = 0.0;
   double world_period_s = 0.0;

@@ -127,18 +127,7 @@ ShmDevicePortClient::~ShmDevicePortClient() {
   if (!detached_) segment_->detaching.store(1, std::memory_order_release);
 }
 
-bool ShmDevicePortClient::latest_command(DeviceCommand& out) {
-  std::uint64_t any = 0;  // the newest command, new or not: the tensions hold until the next one
-  if (segment_->command.try_read(command_wire_, any)) {
-    if (decode(command_wire_, command_) == FrameError::ok) {
-      have_command_ = true;
-    } else {
-      ++rejected_;
-    }
-  }
-  if (have_command_) out = command_;
-  return have_command_;
-}
+bool ShmDevicePortClient::latest_command(DeviceCommand& out) { return commands_.read(segment_->command, out); }
 
 void ShmDevicePortClient::publish_state(const DeviceState& state) {
   encode(state, state_wire_);

@@ -6,6 +6,7 @@
 
 #include "common/link/device_port.h"
 #include "common/link/shm/device_port_layout.h"
+#include "common/link/shm/latest_valid.h"
 
 #include <string>
 
@@ -58,18 +59,15 @@ class ShmDevicePortClient final : public DevicePortClient {
   void finish_turn() override;
   void detach() override;
   bool host_alive() const override { return segment_.creator_alive(); }
-  std::uint64_t rejected_commands() const override { return rejected_; }
+  std::uint64_t rejected_commands() const override { return commands_.rejected(); }
 
   const std::string& name() const { return segment_.name(); }
 
  private:
   Segment<DevicePortLayout> segment_;
-  wire::DeviceCommand command_wire_{};
+  LatestValid<wire::DeviceCommand, DeviceCommand> commands_;
   wire::DeviceState state_wire_{};
-  DeviceCommand command_{};
-  bool have_command_ = false;
   bool detached_ = false;
-  std::uint64_t rejected_ = 0;
 };
 
 }  // namespace impetus

@@ -17,39 +17,13 @@ namespace {
 // milliseconds; this is a hang detector, not a deadline).
 constexpr double kTurnTimeout_s = 60.0;
 
-WorldLinkInfo info_of(const WorldLinkConfig& config) {
-  WorldLinkInfo info;
-  info.world_rate_hz = config.world_rate_hz;
-  info.world_period_s = config.world_period_s;
-  info.phase_ticks = config.phase_ticks;
-  info.clock = config.clock;
-  info.coupling = config.coupling;
-  return info;
-}
-
 }  // namespace
 
 ShmWorldLinkServer::ShmWorldLinkServer(const std::string& shm, const WorldLinkInfo& info)
-    : segment_(Segment<WorldLinkLayout>::create(world_link_name(shm), [&](WorldLinkLayout& layout) {
-        layout.config.world_rate_hz = info.world_rate_hz;
-        layout.config.world_period_s = info.world_period_s;
-        layout.config.phase_ticks = info.phase_ticks;
-        layout.config.clock = info.clock;
-        layout.config.coupling = info.coupling;
-      })) {}
+    : segment_(Segment<WorldLinkLayout>::create(world_link_name(shm),
+                                                [&](WorldLinkLayout& layout) { layout.config = info; })) {}
 
-bool ShmWorldLinkServer::latest_report(HapticReport& out) {
-  std::uint64_t any = 0;  // the newest frame, new or not: a report holds running totals, so re-reading is harmless
-  if (segment_->report.try_read(report_wire_, any)) {
-    if (decode(report_wire_, report_) == FrameError::ok) {
-      have_report_ = true;
-    } else {
-      ++rejected_;
-    }
-  }
-  if (have_report_) out = report_;
-  return have_report_;
-}
+bool ShmWorldLinkServer::latest_report(HapticReport& out) { return reports_.read(segment_->report, out); }
 
 void ShmWorldLinkServer::publish_frame(const PlaneFrame& frame) {
   encode(frame, frame_wire_);
@@ -76,7 +50,7 @@ ShmWorldLinkClient::ShmWorldLinkClient(const std::string& shm, ClockMode clock, 
   worlds_.push_back(
       std::make_unique<Segment<WorldLinkLayout>>(open_when_ready<WorldLinkLayout>(name_, wait_s)));
   current_.store(&**worlds_.back(), std::memory_order_release);
-  info_ = info_of(world().config);
+  info_ = world().config;
   if (info_.clock != clock) {
     throw std::runtime_error(std::string("the world manager runs --clock ") + to_string(info_.clock) +
                              " but the haptic controller was started with --clock " + to_string(clock));

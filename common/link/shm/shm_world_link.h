@@ -3,6 +3,7 @@
 // world node, opened by the haptic node. Frames cross as sealed wire frames (wire_frames.h); lockstep turns are the
 // segment's semaphores; liveness is the creator's pid and start time.
 
+#include "common/link/shm/latest_valid.h"
 #include "common/link/shm/world_link_layout.h"
 #include "common/link/world_link.h"
 
@@ -23,17 +24,14 @@ class ShmWorldLinkServer final : public WorldLinkServer {
   void publish_stats(const LoopStats& stats) override;
   TurnResult wait_turn() override;
   void finish_turn() override;
-  std::uint64_t rejected_reports() const override { return rejected_; }
+  std::uint64_t rejected_reports() const override { return reports_.rejected(); }
 
   const std::string& name() const { return segment_.name(); }
 
  private:
   Segment<WorldLinkLayout> segment_;
   wire::PlaneFrame frame_wire_{};
-  wire::HapticReport report_wire_{};
-  HapticReport report_{};
-  bool have_report_ = false;
-  std::uint64_t rejected_ = 0;
+  LatestValid<wire::HapticReport, HapticReport> reports_;
 };
 
 class ShmWorldLinkClient final : public WorldLinkClient {

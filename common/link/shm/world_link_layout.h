@@ -1,8 +1,9 @@
 #pragma once
 // The world link segment (DESIGN.md §2): created by the world manager, opened by the haptic controller.
-// Name on the system: "<shm>.world" (see link_names.h).
+// Name on the system: "<shm>.world" (see names.h).
 
 #include "common/link/shm/wire_frames.h"
+#include "common/link/world_link.h"
 #include "common/runtime/lockstep.h"
 #include "common/runtime/loop_stats.h"
 #include "common/link/shm/segment.h"
@@ -10,23 +11,17 @@
 
 #include <atomic>
 #include <cstdint>
+#include <type_traits>
 
 namespace impetus {
 
-// Written once by the world manager before the segment is published; read-only afterwards.
-struct WorldLinkConfig {
-  double world_rate_hz = 0.0;
-  double world_period_s = 0.0;
-  std::uint64_t phase_ticks = 0;  // lockstep: world step i happens at haptic tick i·n + phase_ticks
-  ClockMode clock = ClockMode::realtime;
-  Coupling coupling = Coupling::impulse;
-};
+static_assert(std::is_trivially_copyable_v<WorldLinkInfo>);
 
 struct WorldLinkLayout {
   static constexpr SegmentKind kKind = SegmentKind::world_link;
 
   SegmentHeader header;
-  WorldLinkConfig config;
+  WorldLinkInfo config;  // written once by the world manager before the segment is published; read-only after
   SeqlockChannel<wire::PlaneFrame> planes;       // writer: world manager
   SeqlockChannel<wire::HapticReport> report;     // writer: haptic controller
   SeqlockChannel<LoopStats> world_stats;   // writer: world manager
