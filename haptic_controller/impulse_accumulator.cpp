@@ -1,5 +1,7 @@
 #include "haptic_controller/impulse_accumulator.h"
 
+#include "haptic_controller/gram_solve.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -35,15 +37,7 @@ std::array<Eigen::Vector3d, kMaxActiveConstraints + 1> split_by_normals(const Pl
     }
     for (Eigen::Vector3d& part : parts) part.setZero();
     if (columns == 0) break;
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    const Eigen::Matrix3d gram = normals.transpose() * normals;
-    if (columns == 1) {
-      c[0] = normals.col(0).dot(reaction_Ns) / gram(0, 0);
-    } else if (columns == 2) {
-      c.head<2>() = gram.topLeftCorner<2, 2>().inverse() * (normals.leftCols<2>().transpose() * reaction_Ns);
-    } else {
-      c = gram.inverse() * (normals.transpose() * reaction_Ns);
-    }
+    const Eigen::Vector3d c = gram_solve(normals, columns, normals.transpose() * reaction_Ns);
     // The reaction pushes object k along −n_k: c_k ≤ 0 is a push, c_k > 0 would be a pull.
     bool all_push = true;
     for (int q = 0; q < columns; ++q) {

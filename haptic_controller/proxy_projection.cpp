@@ -1,5 +1,7 @@
 #include "haptic_controller/proxy_projection.h"
 
+#include "haptic_controller/gram_solve.h"
+
 #include <Eigen/LU>
 
 #include <algorithm>
@@ -29,17 +31,7 @@ struct ActiveBasis {
 
   // r = (NᵀN)⁻¹ Nᵀ v (coefficients of the projection of v onto span N).
   Eigen::Vector3d coefficients(const Eigen::Vector3d& v) const {
-    Eigen::Vector3d r = Eigen::Vector3d::Zero();
-    if (size == 1) {
-      r[0] = normals.col(0).dot(v) / normals.col(0).squaredNorm();
-    } else if (size == 2) {
-      const Eigen::Matrix<double, 3, 2> n = normals.leftCols<2>();
-      const Eigen::Matrix2d gram = n.transpose() * n;
-      r.head<2>() = gram.inverse() * (n.transpose() * v);
-    } else if (size == 3) {
-      r = normals.inverse() * v;
-    }
-    return r;
+    return gram_solve(normals, size, normals.transpose() * v);
   }
   Eigen::Vector3d combine(const Eigen::Vector3d& r) const {
     Eigen::Vector3d out = Eigen::Vector3d::Zero();
@@ -178,18 +170,7 @@ Eigen::Vector3d project_onto_active(const PlaneSet& planes, const ProxySolution&
   Eigen::Vector3d residual = Eigen::Vector3d::Zero();  // b − Nᵀx, per active plane
   for (int j = 0; j < basis.size; ++j) residual[j] = -slack(planes.planes[consistent.active[j].plane], x_m);
   // x + N (NᵀN)⁻¹ (b − Nᵀx): with G = NᵀN, the coefficients are G⁻¹·residual.
-  Eigen::Vector3d coefficients = Eigen::Vector3d::Zero();
-  if (basis.size == 1) {
-    coefficients[0] = residual[0];
-  } else if (basis.size == 2) {
-    const Eigen::Matrix<double, 3, 2> n = basis.normals.leftCols<2>();
-    const Eigen::Matrix2d gram = n.transpose() * n;
-    coefficients.head<2>() = gram.inverse() * residual.head<2>();
-  } else if (basis.size == 3) {
-    const Eigen::Matrix3d gram = basis.normals.transpose() * basis.normals;
-    coefficients = gram.inverse() * residual;
-  }
-  return x_m + basis.combine(coefficients);
+  return x_m + basis.combine(gram_solve(basis.normals, basis.size, residual));
 }
 
 }  // namespace impetus
