@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds Impetus (scripts/build.sh build) and runs its benchmarks, printing the numbers. Asserts nothing: timing on a
-# shared 2-core VM is a measurement, not a pass/fail test (issue 7, "Benchmarks").
+# shared 2-core VM is a measurement, not a pass/fail test (timing goals live in benchmarks).
 #   scripts/bench.sh [--short]       --short: 5 s instead of 30 s for the real-time loop benchmark
 #
 #   1. haptic tick cost vs number of planes            build/tests/bench_haptic_tick

@@ -1,12 +1,13 @@
 #!/usr/bin/python3
-"""Stability suite of issue 8 ("hard cases"): ten scenes and trajectories under tests/hard_cases/, each run through the
+"""Stability suite ("hard cases"): ten scenes and trajectories under tests/hard_cases/, each run through the
 real processes (scripts/run.sh, lockstep clock), each checked for
 
   * no NaN or Inf in any log (device, haptic, world) and no servo fault;
   * device force within limits: the servo's largest force <= the device maximum (10 N); clamps and string
     saturations are reported;
   * energy: the mechanical energy of the finger and the objects never grows beyond the work the hand put in,
-        E(t) - E(0) <= W_hand(t) + tolerance        (see energy_balance() for the derivation and the tolerance)
+        E(t) - E(0) <= W_hand(t) + tolerance
+    (the derivation and the tolerance: energy_balance in impetus_py/energy.py);
   * the case's own property (see each check_* function).
 
 Case 1 also sweeps the haptic stiffness to find the largest stable value at 1 kHz for three damping policies and
@@ -17,236 +18,67 @@ Writes OUT/table.md (and OUT/<case>/ with every trial's logs), prints the table;
 usage: hard_cases.py [--check] [--out DIR] [--jobs N] [--cases 1,3,7] [--fine]
 """
 import argparse
-import concurrent.futures
-import csv
 import json
 import math
 import os
 import pathlib
-import subprocess
 import sys
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-CASES_DIR = ROOT / "tests/hard_cases"
+import numpy as np
 
-# spidar_sim's defaults (spidar_sim/finger.h) and the device limit (common/device_geometry.h). The energy balance
-# recomputes the hand's force from the device log with these, so they must match the simulator.
-FINGER_MASS_KG = 0.1
-HAND_STIFFNESS_NPM = 300.0
-HAND_DAMPING_NSPM = 8.0
-DEVICE_MAX_FORCE_N = 10.0
-HAPTIC_PERIOD_S = 1e-3
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from impetus_py import logs  # noqa: E402
+from impetus_py.daemon_defaults import (DEVICE_MAX_FORCE_N, FINGER_MASS_KG, HAND_DAMPING_NSPM,  # noqa: E402
+                                        HAND_STIFFNESS_NPM, HAPTIC_RATE_HZ)
+from impetus_py.energy import energy_balance  # noqa: E402
+from impetus_py.parallel import run_parallel  # noqa: E402
+from impetus_py.paths import ROOT  # noqa: E402
+from impetus_py.scene import Scene  # noqa: E402
+from impetus_py.summary import Summary  # noqa: E402
+from impetus_py.trial import COUPLINGS, run_trial  # noqa: E402
+
+CASES_DIR = ROOT / "tests/hard_cases"
+# Every trial runs at haptic_controller's default rate; the stiffness sweep's theory uses its period.
+HAPTIC_PERIOD_S = 1.0 / HAPTIC_RATE_HZ
 
 # ---------------------------------------------------------------------------------------------------------------------
 # Running trials
 
 
-COUPLING = "impulse"  # set from --coupling: every case runs with it
-
-
-def run_trial(out_dir, scene, trajectory, rate=None, haptic_flags=()):
-    """One lockstep trial through scripts/run.sh into out_dir; returns out_dir or raises RuntimeError."""
-    out_dir.mkdir(parents=True, exist_ok=True)
-    command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), "--trajectory", str(trajectory),
-               "--clock", "lockstep", "--coupling", COUPLING, "--out", str(out_dir), "--quiet"]
-    if rate is not None:
-        command += ["--rate", str(rate)]
-    if haptic_flags:
-        command += ["--"] + [str(flag) for flag in haptic_flags]
-    result = subprocess.run(command, capture_output=True, text=True)
-    if result.returncode != 0:
-        raise RuntimeError(f"trial failed ({' '.join(command)}):\n{result.stdout}{result.stderr}")
-    return out_dir
-
-
-def read_csv(path):
-    """Header and rows of floats; also reports whether every value parsed as a finite number."""
-    with open(path) as f:
-        reader = csv.reader(f)
-        header = next(reader)
-        rows, finite = [], True
-        for line in reader:
-            values = [float(v) for v in line]
-            if not all(math.isfinite(v) for v in values):
-                finite = False
-            rows.append(values)
-    return header, rows, finite
+def run_case_trial(out_dir, scene, trajectory, coupling, rate_hz, haptic_flags):
+    """run_trial into out_dir; returns None, or the RuntimeError of a trial that failed (the suite reports it in the
+    case's row rather than stopping)."""
+    try:
+        run_trial(out_dir, scene, trajectory, coupling, rate_hz=rate_hz, haptic_flags=haptic_flags)
+    except RuntimeError as error:
+        return error
+    return None
 
 
 class Trial:
-    """The logs of one trial, as columns."""
+    """What one trial left in its directory: its summary, the scene it ran, and its logs (logs.Log)."""
 
-    def __init__(self, out_dir, scene_path):
-        self.dir = out_dir
-        self.scene = json.loads(pathlib.Path(scene_path).read_text())
-        self.summary = json.loads((out_dir / "summary.json").read_text())
-        self.finite = True
-        self.device = self._columns("device.csv")
-        self.haptic = self._columns("haptic.csv")
-        self.world = self._columns("world.csv")
+    def __init__(self, out_dir):
+        self.summary = Summary.read(out_dir)
+        self.scene = Scene(self.summary.scene_path)
+        self.objects = self.scene.objects
+        self.device = logs.read_log(out_dir / logs.DEVICE)
+        haptic = logs.read_log(out_dir / logs.HAPTIC)
+        self.world = logs.read_log(out_dir / logs.WORLD)
+        self.finite = self.device.finite and haptic.finite and self.world.finite
+        self.haptic_period_s = self.summary.haptic_period_s
+        self.world_period_s = self.summary.world_period_s
         # The device's session ends with its trajectory; the haptic controller runs a few more ticks without a device
         # (zero force) until run.sh stops it. Only ticks with a device are part of the trial.
         self.end_s = self.device["time_s"][-1]
-        keep = [i for i, t in enumerate(self.haptic["time_s"]) if t < self.end_s - 0.5 * HAPTIC_PERIOD_S]
-        self.haptic = {k: [v[i] for i in keep] for k, v in self.haptic.items()}
-        self.world_period_s = 1.0 / float(self.summary["config"]["world_rate_hz"])
-        self.objects = {o["name"]: o for o in self.scene["objects"]}
+        self.haptic = haptic.rows(haptic["time_s"] < self.end_s - 0.5 * self.haptic_period_s)
 
-    def _columns(self, name):
-        header, rows, finite = read_csv(self.dir / name)
-        self.finite &= finite
-        return {key: [row[i] for row in rows] for i, key in enumerate(header)}
-
-    def vec(self, log, prefix, i, names=("x", "y", "z")):
-        return [log[f"{prefix}{a}"][i] for a in names]
-
-    def force_magnitudes(self):
+    def force_magnitudes_N(self):
+        """|force on the finger| at each haptic tick."""
         h = self.haptic
-        return [math.sqrt(h["force_x"][i] ** 2 + h["force_y"][i] ** 2 + h["force_z"][i] ** 2)
-                for i in range(len(h["time_s"]))]
+        return [math.sqrt(x ** 2 + y ** 2 + z ** 2) for x, y, z in h.vectors("force_").tolist()]
 
-    def object_track(self, name, axis):
-        """World log column `name.axis` with time_s: the state after each world step."""
-        return self.world["time_s"], self.world[f"{name}.{axis}"]
-
-
-# ---------------------------------------------------------------------------------------------------------------------
-# Energy
-
-
-def mass_and_inertia(obj):
-    """Mass (kg) and principal moments of inertia about the centre of mass, in the body frame (solid bodies)."""
-    shape = obj["shape"]
-    if shape == "box":
-        a, b, c = obj["size_m"]
-        volume = a * b * c
-    elif shape == "sphere":
-        r = obj["radius_m"]
-        volume = 4.0 / 3.0 * math.pi * r ** 3
-    else:
-        raise ValueError(f"energy accounting supports boxes and spheres only, not {shape} ({obj['name']})")
-    mass = obj["mass_kg"] if "mass_kg" in obj else obj["density_kgpm3"] * volume
-    if shape == "box":
-        inertia = (mass / 12 * (b * b + c * c), mass / 12 * (a * a + c * c), mass / 12 * (a * a + b * b))
-    else:
-        inertia = (0.4 * mass * r * r,) * 3
-    return mass, inertia
-
-
-def rotate_to_body(q, w):
-    """World-frame vector w in the body frame of orientation q = (w, x, y, z) (body -> world): R^T w."""
-    qw, qx, qy, qz = q
-    # R^T w = conj(q) * w * q
-    x, y, z = w
-    # t = 2 * cross(-qv, w); w' = w + qw * t + cross(-qv, t)
-    vx, vy, vz = -qx, -qy, -qz
-    tx, ty, tz = 2 * (vy * z - vz * y), 2 * (vz * x - vx * z), 2 * (vx * y - vy * x)
-    return (x + qw * tx + (vy * tz - vz * ty), y + qw * ty + (vz * tx - vx * tz), z + qw * tz + (vx * ty - vy * tx))
-
-
-def object_energy(obj, gravity, position, orientation, velocity, omega):
-    mass, inertia = mass_and_inertia(obj)
-    wb = rotate_to_body(orientation, omega)
-    kinetic = 0.5 * mass * sum(v * v for v in velocity) + 0.5 * sum(i * w * w for i, w in zip(inertia, wb))
-    potential = -mass * sum(g * p for g, p in zip(gravity, position))
-    return kinetic + potential
-
-
-def energy_balance(trial):
-    """Energy of finger + dynamic objects against the hand's work.
-
-    The system is the finger (point mass m_f) and the dynamic objects. External forces on it: the hand
-    F_hand = k_h (target - x) + b_h (target_v - v), gravity (counted as potential energy), the static geometry
-    (floor, static boxes; they do no work on a body at rest against them and dissipate otherwise). The device force
-    f on the finger and the reaction -f delivered to the objects are internal: over a contact their net work is
-    -Delta(1/2 k_p |D - C|^2) - integral k_d |d(D - C)/dt|^2 dt, i.e. the virtual coupling only stores (then returns)
-    or dissipates energy *if* it is passive. So for a passive system
-
-        E(t) - E(0) + 1/2 k_p |D - C|^2 + dissipated = W_hand(t) = integral F_hand . v_finger dt
-        =>  E(t) - E(0) <= W_hand(t)
-
-    with E = 1/2 m_f v_f^2 + sum(1/2 m v^2 + 1/2 w . I w + m g z). The stored coupling energy is on the left with a
-    + sign, so leaving it out of E needs no tolerance (it makes the inequality harder to pass, never easier). Any
-    energy that the sampled (1 kHz) wall, the plane interpolation or the impulse coupling (20 Hz) create appears as
-    a violation. The hand spring's own stored energy 1/2 k_h |target - x|^2 never enters: W_hand is the work the
-    hand force does on the finger, not the work the scripted target does on the hand spring.
-
-    Tolerance, each term with its reason:
-      * quadrature: W_hand is integrated by the trapezoid rule from the 1 kHz device log (the simulator integrates
-        at 0.1 ms); the error of the trapezoid rule is ~h^2, so |W(h) - W(2h)| (= 3x the error at h) bounds it;
-      * ODE contact stabilisation: ODE pushes penetrating bodies apart with ERP and a soft constraint (CFM); a body
-        resting on another gains at most its weight times the depth it is pushed back out. Contact depths in these
-        scenes stay below CONTACT_SLOP_M, so the allowance is sum(m g) * CONTACT_SLOP_M over the dynamic bodies.
-
-    Objects are sampled at world steps: the state after the step taken at haptic tick k*n (phase 0) is compared with
-    the finger and W_hand at that tick, i.e. with the impulse the world has just applied.
-    """
-    gravity = trial.scene.get("gravity_mps2", [0.0, 0.0, -9.81])
-    g = math.sqrt(sum(x * x for x in gravity))
-    dyn = [o for o in trial.scene["objects"] if o["dynamic"]]
-    d = trial.device
-    n = len(d["time_s"])
-    times = [0.0] + d["time_s"]
-    tgt = [[d[f"target_{a}_m"][0] for a in "xyz"]] + [[d[f"target_{a}_m"][i] for a in "xyz"] for i in range(n)]
-    pos = [tgt[0]] + [[d[f"finger_{a}_m"][i] for a in "xyz"] for i in range(n)]
-    vel = [[0.0, 0.0, 0.0]] + [[d[f"finger_v{a}_mps"][i] for a in "xyz"] for i in range(n)]
-    # Target velocity by central finite differences (one-sided at the ends).
-    tv = []
-    for i in range(len(times)):
-        a, b = max(i - 1, 0), min(i + 1, len(times) - 1)
-        tv.append([(tgt[b][k] - tgt[a][k]) / (times[b] - times[a]) for k in range(3)])
-    power = []
-    for i in range(len(times)):
-        force = [HAND_STIFFNESS_NPM * (tgt[i][k] - pos[i][k]) + HAND_DAMPING_NSPM * (tv[i][k] - vel[i][k])
-                 for k in range(3)]
-        power.append(sum(force[k] * vel[i][k] for k in range(3)))
-    work = [0.0]
-    for i in range(1, len(times)):
-        work.append(work[-1] + 0.5 * (power[i] + power[i - 1]) * (times[i] - times[i - 1]))
-    work_coarse = {0: 0.0}
-    acc = 0.0
-    for i in range(2, len(times), 2):
-        acc += (power[i] + power[i - 2]) * 0.5 * (times[i] - times[i - 2])
-        work_coarse[i] = acc
-    quadrature = max(abs(work[i] - w) for i, w in work_coarse.items())
-
-    def finger_ke(i):
-        return 0.5 * FINGER_MASS_KG * sum(v * v for v in vel[i])
-
-    e0 = finger_ke(0)
-    for o in dyn:
-        e0 += object_energy(o, gravity, o["position_m"], o.get("orientation_wxyz", [1, 0, 0, 0]),
-                            o.get("linear_velocity_mps", [0, 0, 0]), o.get("angular_velocity_radps", [0, 0, 0]))
-    w = trial.world
-    worst = (-math.inf, 0.0, 0.0, 0.0)
-    series = []
-    for j, tw in enumerate(w["time_s"]):
-        t_tick = tw - trial.world_period_s
-        i = int(round(t_tick / HAPTIC_PERIOD_S))  # index into times (times[i] = i ms)
-        if i >= len(times):
-            break
-        e = finger_ke(i)
-        for o in dyn:
-            nm = o["name"]
-            e += object_energy(o, gravity, [w[f"{nm}.{a}_m"][j] for a in "xyz"],
-                               [w[f"{nm}.q{a}"][j] for a in "wxyz"], [w[f"{nm}.v{a}_mps"][j] for a in "xyz"],
-                               [w[f"{nm}.w{a}_radps"][j] for a in "xyz"])
-        excess = e - e0 - work[i]
-        series.append((times[i], e - e0, work[i]))
-        if excess > worst[0]:
-            worst = (excess, times[i], e - e0, work[i])
-    contact = sum(mass_and_inertia(o)[0] for o in dyn) * g * CONTACT_SLOP_M
-    tolerance = quadrature + contact
-    return {"excess_J": worst[0], "at_s": worst[1], "dE_J": worst[2], "W_J": worst[3], "tolerance_J": tolerance,
-            "quadrature_J": quadrature, "contact_J": contact, "W_total_J": work[-1], "series": series,
-            "ok": worst[0] <= tolerance}
-
-
-# ODE contact depth allowance for the energy tolerance (see energy_balance): ODE's steady contact compliance under
-# these loads is micrometres (k = ERP/(h CFM) = 4e6 N/m at h = 5 ms); 1 mm is the transient depth v·h of a body meeting
-# a surface at 0.2 m/s with 5 ms substeps, faster than anything in these scenes meets the floor.
-CONTACT_SLOP_M = 1e-3
 
 # ---------------------------------------------------------------------------------------------------------------------
 # Case properties. Each returns (ok, metric text, details list).
@@ -254,7 +86,7 @@ CONTACT_SLOP_M = 1e-3
 
 def check_generic(trial):
     """The checks every case shares: finite logs, no faults, force within the device's limit, energy."""
-    h = trial.summary["haptic"]
+    h = trial.summary.haptic
     problems = []
     if not trial.finite:
         problems.append("NaN or Inf in a log")
@@ -262,15 +94,11 @@ def check_generic(trial):
         problems.append(f"{h['faults']} servo faults (non-finite finger or force)")
     if not h["max_force_N"] <= DEVICE_MAX_FORCE_N + 1e-9:
         problems.append(f"max force {h['max_force_N']:.3f} N > {DEVICE_MAX_FORCE_N} N")
-    energy = energy_balance(trial)
+    energy = energy_balance(trial.scene, trial.device, trial.world, trial.world_period_s, trial.haptic_period_s)
     if not energy["ok"]:
         problems.append(f"energy grew {energy['excess_J']:.4f} J beyond the hand's work at t={energy['at_s']:.3f} s "
                         f"(tolerance {energy['tolerance_J']:.4f} J)")
     return problems, energy
-
-
-def hold_window(trial, start_s, end_s):
-    return [i for i, t in enumerate(trial.haptic["time_s"]) if start_s <= t <= end_s]
 
 
 def wall_stability(trial):
@@ -278,8 +106,8 @@ def wall_stability(trial):
     A linearly unstable sampled wall oscillates with growing amplitude until the one-sided contact lets go (or the
     device clamps), so losing contact or clamping during a steady press is the unambiguous sign of a limit cycle;
     a stable wall shows only the encoder-quantisation noise (its size is reported as force RMS / mean)."""
-    window = hold_window(trial, trial.end_s - 1.0, trial.end_s)
-    forces = trial.force_magnitudes()
+    window = [i for i, t in enumerate(trial.haptic["time_s"]) if trial.end_s - 1.0 <= t <= trial.end_s]
+    forces = trial.force_magnitudes_N()
     f = [forces[i] for i in window]
     mean = sum(f) / len(f)
     rms = math.sqrt(sum((x - mean) ** 2 for x in f) / len(f))
@@ -289,10 +117,12 @@ def wall_stability(trial):
 
 
 def check_wall(trial):
+    """The scene's own wall (its default stiffness and damping) must hold a steady press (wall_stability)."""
     s = wall_stability(trial)
     ok = s["stable"]
-    return ok, (f"2 kN/m: stable (noise {100 * s['rms_over_mean']:.1f} % of the press force)" if ok else
-                f"default wall unstable: contact lost {s['lost']} ticks"), []
+    stiffness_kNpm = trial.scene.haptic_stiffness_Npm / 1000
+    return ok, (f"{stiffness_kNpm:g} kN/m: stable (noise {100 * s['rms_over_mean']:.1f} % of the press force)" if ok
+                else f"default wall unstable: contact lost {s['lost']} ticks"), []
 
 
 def static_box_depth(obj, p):
@@ -302,14 +132,16 @@ def static_box_depth(obj, p):
 
 
 def proxy_steps(trial):
+    """Per haptic tick after the first: (proxy step, finger step, time, larger finger-proxy distance before and after
+    the step), in m and s."""
     h = trial.haptic
+    proxy, finger, times = h.vectors("proxy_").tolist(), h.vectors("finger_").tolist(), h["time_s"].tolist()
     steps = []
-    for i in range(1, len(h["time_s"])):
-        dp = math.dist(trial.vec(h, "proxy_", i), trial.vec(h, "proxy_", i - 1))
-        df = math.dist(trial.vec(h, "finger_", i), trial.vec(h, "finger_", i - 1))
-        cone = max(math.dist(trial.vec(h, "proxy_", i - 1), trial.vec(h, "finger_", i - 1)),
-                   math.dist(trial.vec(h, "proxy_", i), trial.vec(h, "finger_", i)))
-        steps.append((dp, df, h["time_s"][i], cone))
+    for i in range(1, len(times)):
+        dp = math.dist(proxy[i], proxy[i - 1])
+        df = math.dist(finger[i], finger[i - 1])
+        cone = max(math.dist(proxy[i - 1], finger[i - 1]), math.dist(proxy[i], finger[i]))
+        steps.append((dp, df, times[i], cone))
     return steps
 
 
@@ -322,28 +154,29 @@ def check_edge_corner(trial):
     h = trial.haptic
     planes = [int(p) for p in h["active_planes"]]
     deepest = 0.0
-    for i in range(len(h["time_s"])):
-        p = trial.vec(h, "proxy_", i)
-        for obj in trial.scene["objects"]:
+    for p in h.vectors("proxy_").tolist():
+        for obj in trial.objects.values():
             deepest = max(deepest, static_box_depth(obj, p))
         deepest = max(deepest, -p[2])  # the floor
     # With friction (section 6.2) the proxy sticks inside the friction cone, whose radius is mu_s times the
     # penetration |D - C|, and on slipping moves to the cone's edge: one tick's step may exceed the finger's by up to
     # that radius (the larger of the cones before and after the step). Anything beyond it is a pop.
-    mu = max(o.get("static_friction", 0.5) for o in trial.scene["objects"])
-    mu = max(mu, trial.scene.get("floor", {}).get("static_friction", 0.5))
+    mu = max(o["static_friction"] for o in trial.objects.values())
+    if trial.scene.floor_static_friction is not None:
+        mu = max(mu, trial.scene.floor_static_friction)
     # Without friction the proxy is the projection of the finger onto the interpolated planes; projection onto a
     # fixed convex set never moves farther than the finger did, and the planes themselves move toward the newest
     # nearest surface point, which (projection onto a convex body again) moves at most as far as the finger: a
     # tick's proxy step is at most twice the finger's.
     jump = max(dp - 2 * df - mu * cone for dp, df, _, cone in proxy_steps(trial))
     ok = max(planes) >= 3 and 2 in planes and deepest <= PROXY_SLOP_M and jump <= PROXY_SLOP_M
-    details = [f"ticks with 2 planes: {planes.count(2)}, with 3: {planes.count(3)}; deepest proxy {deepest * 1e6:.1f} um; "
+    details = [f"ticks with 2 planes: {planes.count(2)}, with 3: {planes.count(3)}; "
+               f"deepest proxy {deepest * 1e6:.1f} um; "
                f"largest proxy step beyond its bound (2 x finger step + friction cone) {jump * 1e6:.1f} um"]
     return ok, f"max planes {max(planes)}, proxy depth {deepest * 1e6:.1f} um, jump {jump * 1e6:.1f} um", details
 
 
-# 10 um: two encoder counts' worth of position noise (1.7e-5 m per count, common/device_geometry.h) is the finest
+# 10 um: two encoder counts' worth of position noise (1.7e-5 m per count, common/spidar/geometry.h) is the finest
 # displacement the device can resolve; a proxy that strays less than that into a surface or jumps less than that
 # per tick is indistinguishable from exact.
 PROXY_SLOP_M = 1e-5
@@ -356,12 +189,13 @@ def check_thin_plate(trial):
     near = plate["position_m"][0] - plate["size_m"][0] / 2
     far = plate["position_m"][0] + plate["size_m"][0] / 2
     h = trial.haptic
-    proxy_max = max(h["proxy_x"])
-    finger_max = max(h["finger_x"])
-    wrong = sum(1 for i in range(len(h["time_s"])) if h["finger_x"][i] > far and not h["force_x"][i] < 0)
+    proxy_max = h["proxy_x"].max()
+    finger_max = h["finger_x"].max()
+    wrong = np.count_nonzero((h["finger_x"] > far) & ~(h["force_x"] < 0))
     ok = proxy_max <= near + PROXY_SLOP_M and wrong == 0
     return ok, (f"proxy max x - near face {1e6 * (proxy_max - near):+.1f} um; finger reached "
-                f"{1e3 * (finger_max - near):.1f} mm past the face"), [f"ticks past the far face without a push back: {wrong}"]
+                f"{1e3 * (finger_max - near):.1f} mm past the face"), [
+        f"ticks past the far face without a push back: {wrong}"]
 
 
 def check_fast_finger(trial):
@@ -371,16 +205,16 @@ def check_fast_finger(trial):
     cube = trial.objects["cube"]
     face = cube["position_m"][0] - cube["size_m"][0] / 2
     h, d = trial.haptic, trial.device
-    forces = trial.force_magnitudes()
+    forces = trial.force_magnitudes_N()
     first_force = next((i for i, f in enumerate(forces) if f > 0), None)
     if first_force is None:
         return False, "no contact force at all", []
     depth = h["finger_x"][first_force] - face
     t = h["time_s"][first_force]
-    speed = max(abs(v) for v, tt in zip(d["finger_vx_mps"], d["time_s"]) if tt <= t + 1e-9)
-    pushed = trial.summary["objects"]["cube"]["impulse_Ns"][0]
-    ok = depth <= speed * HAPTIC_PERIOD_S + PROXY_SLOP_M and pushed > 0
-    return ok, (f"first force at {1e3 * depth:.2f} mm depth (v·T = {1e3 * speed * HAPTIC_PERIOD_S:.2f} mm at "
+    speed = np.abs(d["finger_vx_mps"][d["time_s"] <= t + 1e-9]).max()
+    pushed = trial.summary.impulse_Ns("cube")[0]
+    ok = depth <= speed * trial.haptic_period_s + PROXY_SLOP_M and pushed > 0
+    return ok, (f"first force at {1e3 * depth:.2f} mm depth (v·T = {1e3 * speed * trial.haptic_period_s:.2f} mm at "
                 f"{speed:.2f} m/s); cube impulse {pushed:.3f} N·s"), []
 
 
@@ -390,9 +224,8 @@ def check_pinch(trial):
     at most PINCH_GAP_M) and reports how the servo classified it."""
     block, slider = trial.objects["block"], trial.objects["slider"]
     block_face = block["position_m"][0] + block["size_m"][0] / 2
-    xs = trial.world["slider.x_m"]
-    min_gap = min(x - slider["size_m"][0] / 2 - block_face for x in xs)
-    h = trial.summary["haptic"]
+    min_gap = (trial.world["slider.x_m"] - slider["size_m"][0] / 2 - block_face).min()
+    h = trial.summary.haptic
     planes = [int(p) for p in trial.haptic["active_planes"]]
     # The finger must have been between the faces when they closed: it touched the slider (at least one active plane).
     ok = min_gap <= PINCH_GAP_M and max(planes) >= 1
@@ -409,8 +242,9 @@ def force_swing_deg(trial, start_s, end_s):
     """Range (degrees) of the contact force's direction in the x-z plane over the ticks in [start_s, end_s] that
     carry a force of at least 0.2 N (below that the direction is quantisation noise)."""
     h = trial.haptic
-    angles = [math.degrees(math.atan2(h["force_x"][i], h["force_z"][i])) for i, t in enumerate(h["time_s"])
-              if start_s <= t <= end_s and math.hypot(h["force_x"][i], h["force_z"][i]) >= FORCE_NOISE_N]
+    ticks = zip(h["time_s"].tolist(), h["force_x"].tolist(), h["force_z"].tolist())
+    angles = [math.degrees(math.atan2(fx, fz)) for t, fx, fz in ticks
+              if start_s <= t <= end_s and math.hypot(fx, fz) >= FORCE_NOISE_N]
     return (max(angles) - min(angles), min(angles), max(angles)) if angles else (0.0, 0.0, 0.0)
 
 
@@ -426,16 +260,16 @@ def check_normal_flip(trial):
     w, d, h = trial.world, trial.device, trial.haptic
     box = trial.objects["box"]
     half = box["size_m"][0] / 2
+    world_times, box_centres = w["time_s"].tolist(), w.vectors("box.", "_m").tolist()
+    fingers, forces = d.vectors("finger_", "_m").tolist(), h.vectors("force_").tolist()
     worst_pull, pressed, passed_at, last_contact = 0.0, 0.0, None, None
     j = 0
-    for i, t in enumerate(d["time_s"]):
+    for i, t in enumerate(d["time_s"].tolist()):
         if not 1.1 <= t <= 2.0:
             continue
-        while j + 1 < len(w["time_s"]) and w["time_s"][j + 1] <= t:
+        while j + 1 < len(world_times) and world_times[j + 1] <= t:
             j += 1
-        centre = [w[f"box.{a}_m"][j] for a in "xyz"]
-        finger = [d[f"finger_{a}_m"][i] for a in "xyz"]
-        force = [h[f"force_{a}"][i] for a in "xyz"]
+        centre, finger, force = box_centres[j], fingers[i], forces[i]
         away = [f - c for f, c in zip(finger, centre)]
         norm = math.sqrt(sum(a * a for a in away))
         worst_pull = min(worst_pull, sum(f * a for f, a in zip(force, away)) / norm)
@@ -446,11 +280,9 @@ def check_normal_flip(trial):
         if magnitude >= FORCE_NOISE_N:
             last_contact = t
     released = passed_at is not None and last_contact is not None and last_contact - passed_at <= trial.world_period_s
-    speeds = []
-    for name in ("ball", "box"):
-        for k in range(len(w["time_s"])):
-            speeds.append(math.sqrt(sum(w[f"{name}.v{a}_mps"][k] ** 2 for a in "xyz")))
-    object_step = max(speeds) * HAPTIC_PERIOD_S
+    speeds = [math.sqrt(sum(v ** 2 for v in velocity)) for name in ("ball", "box")
+              for velocity in w.vectors(f"{name}.v", "_mps").tolist()]
+    object_step = max(speeds) * trial.haptic_period_s
     jump = max(dp - 2 * df for dp, df, _, _ in proxy_steps(trial))  # the bound of check_edge_corner, mu = 0
     ok = (ball[0] >= MIN_SWING_DEG and pressed >= 2 * FORCE_NOISE_N and worst_pull >= -FORCE_NOISE_N and released
           and jump <= object_step + PROXY_SLOP_M)
@@ -469,16 +301,15 @@ def check_press_hold(trial):
     """Press a cube on the floor and hold 10 s: the cube stays at its rest height (ODE's contact compliance under
     the 1 kg weight plus the ~3 N press is micrometres, so REST_TOLERANCE_M = 0.1 mm means the floor holds), does
     not creep sideways (same tolerance), and the energy check covers 'no energy gain'."""
-    cube = trial.objects["cube"]
-    z0 = cube["position_m"][2]
+    x0, y0, z0 = trial.objects["cube"]["position_m"]
     w = trial.world
-    zs, xs, ys = w["cube.z_m"], w["cube.x_m"], w["cube.y_m"]
-    dz = max(abs(z - z0) for z in zs)
-    dxy = max(math.hypot(x - cube["position_m"][0], y - cube["position_m"][1]) for x, y in zip(xs, ys))
-    hold = [i for i, t in enumerate(trial.haptic["time_s"]) if t > 1.0]
-    press = sum(-trial.haptic["force_z"][i] for i in hold) / len(hold)
+    dz = np.abs(w["cube.z_m"] - z0).max()
+    dxy = max(math.hypot(x - x0, y - y0) for x, y in zip(w["cube.x_m"].tolist(), w["cube.y_m"].tolist()))
+    hold = [-f for t, f in zip(trial.haptic["time_s"].tolist(), trial.haptic["force_z"].tolist()) if t > 1.0]
+    press = sum(hold) / len(hold)
     ok = dz <= REST_TOLERANCE_M and dxy <= REST_TOLERANCE_M and trial.end_s >= 10.0
-    return ok, f"cube height off by at most {1e6 * dz:.1f} um, drift {1e6 * dxy:.1f} um over {trial.end_s:.1f} s, press {press:.2f} N", []
+    return ok, (f"cube height off by at most {1e6 * dz:.1f} um, drift {1e6 * dxy:.1f} um over {trial.end_s:.1f} s, "
+                f"press {press:.2f} N"), []
 
 
 REST_TOLERANCE_M = 1e-4
@@ -490,8 +321,7 @@ def check_stack(trial):
     the whole stack's weight and the press, and the light boxes are 1000x more compliant in the solver's eyes)."""
     worst, who = 0.0, ""
     for name, obj in trial.objects.items():
-        for j in range(len(trial.world["time_s"])):
-            p = [trial.world[f"{name}.{a}_m"][j] for a in "xyz"]
+        for p in trial.world.vectors(f"{name}.", "_m").tolist():
             dev = math.dist(p, obj["position_m"])
             if dev > worst:
                 worst, who = dev, name
@@ -506,11 +336,10 @@ def check_start_inside(trial):
     """Finger starting 1 cm inside a 0.5 kg cube and withdrawing: no NaN and bounded force are generic; the energy
     check says whether the start kicks the cube with energy nobody put in. Reported: the largest force in the first
     50 ms and how far the cube moved."""
-    forces = trial.force_magnitudes()
-    early = max(f for f, t in zip(forces, trial.haptic["time_s"]) if t <= 0.05)
+    forces = trial.force_magnitudes_N()
+    early = max(f for f, t in zip(forces, trial.haptic["time_s"].tolist()) if t <= 0.05)
     cube = trial.objects["cube"]
-    moved = max(math.dist([trial.world[f"cube.{a}_m"][j] for a in "xyz"], cube["position_m"])
-                for j in range(len(trial.world["time_s"])))
+    moved = max(math.dist(p, cube["position_m"]) for p in trial.world.vectors("cube.", "_m").tolist())
     return True, f"force in first 50 ms up to {early:.2f} N; cube moved {1e3 * moved:.2f} mm", []
 
 
@@ -523,19 +352,17 @@ def check_many_spheres(trial):
     had in the trial (a ball dropping off the upper layer arrives at ~0.5 m/s: 2.7 mm at h = 5 ms); a fall-through
     goes far below that. Out of the tray: a ball's centre beyond a wall's inner face (the walls are the scene's static
     boxes) at the end of the trial has been thrown over it."""
-    h = trial.world_period_s / trial.scene.get("physics", {}).get("substeps", 1)
-    walls = [o for o in trial.scene["objects"] if not o["dynamic"]]
+    h = trial.world_period_s / trial.scene.substeps
+    walls = trial.scene.static_objects
     inner_x = min(abs(w["position_m"][0]) - w["size_m"][0] / 2 for w in walls if abs(w["position_m"][0]) > 0)
     inner_y = min(abs(w["position_m"][1]) - w["size_m"][1] / 2 for w in walls if abs(w["position_m"][1]) > 0)
     deepest, fastest, escaped = math.inf, 0.0, 0
-    for name, obj in trial.objects.items():
-        if not obj.get("dynamic", False):
-            continue  # the tray
-        r = obj["radius_m"]
-        w = trial.world
-        for j, z in enumerate(w[f"{name}.z_m"]):
-            deepest = min(deepest, z - r)
-            fastest = max(fastest, math.sqrt(sum(w[f"{name}.v{a}_mps"][j] ** 2 for a in "xyz")))
+    w = trial.world
+    for ball in trial.scene.dynamic_objects:
+        name = ball["name"]
+        deepest = min(deepest, (w[f"{name}.z_m"] - ball["radius_m"]).min())
+        fastest = max(fastest, max(math.sqrt(sum(v ** 2 for v in velocity))
+                                   for velocity in w.vectors(f"{name}.v", "_mps").tolist()))
         if abs(w[f"{name}.x_m"][-1]) > inner_x or abs(w[f"{name}.y_m"][-1]) > inner_y:
             escaped += 1
     sink_allowed = max(fastest * h, RESTING_SLOP_M)
@@ -543,101 +370,84 @@ def check_many_spheres(trial):
     ok = deepest >= -sink_allowed and escaped == 0 and contact_ticks > 0
     return ok, (f"deepest ball {1e3 * deepest:+.2f} mm vs floor (allowed {1e3 * sink_allowed:.2f}: fastest ball "
                 f"{fastest:.2f} m/s), {escaped} out of the tray, finger in contact {contact_ticks} ticks, world step "
-                f"p99 {trial.summary['world']['cpu_per_step_p99_us'] / 1e3:.1f} ms"), []
+                f"p99 {trial.summary.world['cpu_per_step_p99_us'] / 1e3:.1f} ms"), []
 
 
-RESTING_SLOP_M = 1e-4  # resting penetration: micrometres here (k = ERP/(h CFM)); far below 0.1 mm, far above a fall-through
+# Resting penetration: micrometres here (k = ERP/(h CFM)); far below 0.1 mm, far above a fall-through.
+RESTING_SLOP_M = 1e-4
 
 # ---------------------------------------------------------------------------------------------------------------------
 # Case 1: stiffness sweep and theory
 
 WALL_TRAJECTORY = "press:x=0,y=0,surface_z=0,depth=0.01,standoff=0.03,speed=0.2,hold=1.5"
-DAMPING_POLICIES = {
-    # name: (description, damping as a function of K; None = the scene's default, i.e. no --damping flag)
-    "scene": ("scene default k_d = 5 N·s/m", lambda k: 5.0, False),
-    "passivity": ("passivity rule k_d = K·T (force_renderer.h)", lambda k: k * HAPTIC_PERIOD_S, True),
-    "none": ("no virtual damping, k_d = 0", lambda k: 0.0, True),
-}
+WALL_SCENE = CASES_DIR / "c01_stiff_wall.json"
 
 
-def _expm2(a, t):
-    """exp(a t) of a 2x2 matrix by scaling and squaring of its Taylor series."""
-    norm = max(abs(x) for row in a for x in row) * t
-    s = 0
-    while norm > 0.5:
-        norm /= 2
-        s += 1
-    h = t / 2 ** s
-    m = [[a[i][j] * h for j in range(2)] for i in range(2)]
-    e = [[1.0, 0.0], [0.0, 1.0]]
-    term = [[1.0, 0.0], [0.0, 1.0]]
-    for k in range(1, 20):
-        term = [[sum(term[i][l] * m[l][j] for l in range(2)) / k for j in range(2)] for i in range(2)]
-        e = [[e[i][j] + term[i][j] for j in range(2)] for i in range(2)]
-    for _ in range(s):
-        e = [[sum(e[i][l] * e[l][j] for l in range(2)) for j in range(2)] for i in range(2)]
-    return e
+def damping_policies(wall_scene):
+    """The sweep's damping policies: name -> (description, virtual damping k_d (N·s/m) as a function of K (N/m),
+    whether the trial passes it as --damping; if not, the haptic controller takes the scene's)."""
+    scene_damping_Nspm = wall_scene.haptic_damping_Nspm
+    return {
+        "scene": (f"scene default k_d = {scene_damping_Nspm:g} N·s/m", lambda k: scene_damping_Nspm, False),
+        "passivity": ("passivity rule k_d = K·T (force_renderer.h)", lambda k: k * HAPTIC_PERIOD_S, True),
+        "none": ("no virtual damping, k_d = 0", lambda k: 0.0, True),
+    }
+
+
+def expm_2x2(a, t_s):
+    """exp(a t) of a real 2x2 matrix a, in closed form. With s = tr(a)/2 and q = sqrt(s² - det a) (complex when the
+    eigenvalues s ± q are), (a - s I)² = q² I, so exp(a t) = e^(s t) (cosh(q t) I + sinh(q t)/q (a - s I)), where
+    sinh(q t)/q = t for q = 0."""
+    s = np.trace(a) / 2
+    q = np.sqrt(complex(s * s - np.linalg.det(a)))
+    sinh_over_q = t_s if q == 0 else np.sinh(q * t_s) / q
+    return (np.exp(s * t_s) * (np.cosh(q * t_s) * np.eye(2) + sinh_over_q * (a - s * np.eye(2)))).real
 
 
 def sampled_wall_radius(k, b, t=HAPTIC_PERIOD_S, m=FINGER_MASS_KG, kh=HAND_STIFFNESS_NPM, bh=HAND_DAMPING_NSPM):
     """Spectral radius of the linear sampled-data model of case 1: the finger (mass m, held by the hand's spring kh
     and damper bh) in contact with a wall rendered at period t as f_j = -k x_j - b (x_j - x_{j-1})/t, held over the
     tick (zero-order hold; the servo reads the position at the end of tick j and the device applies the force
-    during tick j+1, which is exactly how spidar_sim and the lockstep servo interact). Stable iff < 1."""
-    a = [[0.0, 1.0], [-kh / m, -bh / m]]
-    phi = _expm2(a, t)
-    det = a[0][0] * a[1][1] - a[0][1] * a[1][0]
-    ainv = [[a[1][1] / det, -a[0][1] / det], [-a[1][0] / det, a[0][0] / det]]
-    pm = [[phi[0][0] - 1, phi[0][1]], [phi[1][0], phi[1][1] - 1]]
-    bvec = (0.0, 1.0 / m)
-    pb = (pm[0][0] * bvec[0] + pm[0][1] * bvec[1], pm[1][0] * bvec[0] + pm[1][1] * bvec[1])
-    gam = (ainv[0][0] * pb[0] + ainv[0][1] * pb[1], ainv[1][0] * pb[0] + ainv[1][1] * pb[1])
-    c1, c2 = -(k + b / t), b / t
-    mm = [[phi[0][0] + gam[0] * c1, phi[0][1], gam[0] * c2],
-          [phi[1][0] + gam[1] * c1, phi[1][1], gam[1] * c2],
-          [1.0, 0.0, 0.0]]
-    tr = mm[0][0] + mm[1][1] + mm[2][2]
-    minors = ((mm[0][0] * mm[1][1] - mm[0][1] * mm[1][0]) + (mm[0][0] * mm[2][2] - mm[0][2] * mm[2][0])
-              + (mm[1][1] * mm[2][2] - mm[1][2] * mm[2][1]))
-    det3 = (mm[0][0] * (mm[1][1] * mm[2][2] - mm[1][2] * mm[2][1]) - mm[0][1] * (mm[1][0] * mm[2][2] - mm[1][2] * mm[2][0])
-            + mm[0][2] * (mm[1][0] * mm[2][1] - mm[1][1] * mm[2][0]))
-    coeffs = (1.0, -tr, minors, -det3)
-    roots = [complex(0.4, 0.9) ** n for n in range(3)]  # Durand-Kerner
-    for _ in range(300):
-        new = []
-        for i, r in enumerate(roots):
-            p = ((coeffs[0] * r + coeffs[1]) * r + coeffs[2]) * r + coeffs[3]
-            q = 1.0
-            for j, s in enumerate(roots):
-                if j != i:
-                    q *= r - s
-            new.append(r - p / q)
-        roots = new
-    return max(abs(r) for r in roots)
+    during tick j+1, which is exactly how spidar_sim and the lockstep servo interact). Stable iff < 1.
+
+    The finger's state (x, v) obeys d/dt (x, v) = A (x, v) + B f, so over one tick (x, v)_{j+1} = Φ (x, v)_j + Γ f_j
+    with Φ = exp(A t) and Γ = A^-1 (Φ - I) B; with the previous position as a third state, the loop is
+    (x_{j+1}, v_{j+1}, x_j) = M (x_j, v_j, x_{j-1})."""
+    a = np.array([[0.0, 1.0], [-kh / m, -bh / m]])
+    phi = expm_2x2(a, t)
+    gamma = np.linalg.solve(a, (phi - np.eye(2)) @ np.array([0.0, 1.0 / m]))
+    c1, c2 = -(k + b / t), b / t  # f_j = c1 x_j + c2 x_{j-1}
+    loop = np.zeros((3, 3))
+    loop[:2, :2] = phi
+    loop[:2, 0] += gamma * c1
+    loop[:2, 2] = gamma * c2
+    loop[2, 0] = 1.0
+    return np.abs(np.linalg.eigvals(loop)).max()
 
 
-def linear_limit(damping):
-    lo, hi = 1.0, 1e7
+def largest_where(holds, lo, hi, midpoint):
+    """The boundary of `holds` in [lo, hi] by 80 bisections at `midpoint(lo, hi)`, for a property that holds below
+    the boundary and fails above it: the largest value tried where it held (lo if none)."""
     for _ in range(80):
-        mid = math.sqrt(lo * hi)
-        if sampled_wall_radius(mid, damping(mid)) < 1.0:
+        mid = midpoint(lo, hi)
+        if holds(mid):
             lo = mid
         else:
             hi = mid
     return lo
+
+
+def linear_limit(damping):
+    """The largest stiffness K (N/m) at which the linear sampled-data model is stable, with k_d = damping(K)."""
+    return largest_where(lambda k: sampled_wall_radius(k, damping(k)) < 1.0, 1.0, 1e7,
+                         lambda lo, hi: math.sqrt(lo * hi))
 
 
 def colgate_brown_bound(damping):
     """Colgate & Brown (1994): the sampled wall K + virtual damper B is passive iff b > K T / 2 + |B|, b the
     physical damping in the loop, here the hand's b_h (the SPIDAR model has none of its own). Largest passive K."""
-    lo, hi = 0.0, 1e7
-    for _ in range(80):
-        mid = 0.5 * (lo + hi)
-        if HAND_DAMPING_NSPM > mid * HAPTIC_PERIOD_S / 2 + abs(damping(mid)):
-            lo = mid
-        else:
-            hi = mid
-    return lo
+    return largest_where(lambda k: HAND_DAMPING_NSPM > k * HAPTIC_PERIOD_S / 2 + abs(damping(k)), 0.0, 1e7,
+                         lambda lo, hi: 0.5 * (lo + hi))
 
 
 def sweep_grid(fine):
@@ -673,22 +483,33 @@ CASES = [
 
 
 def resolve_trajectory(spec):
+    """A case's trajectory: a file under tests/hard_cases/ if there is one of that name, else a spidar_sim spec."""
     path = CASES_DIR / spec
     return str(path) if path.exists() else spec
 
 
 def evaluate(case, out_dir):
-    cid, title, scene, trajectory, rate, check = case
-    trial = Trial(out_dir, CASES_DIR / scene)
+    """The row of the table for a case whose trial ran into out_dir: the generic checks and the case's own."""
+    cid, title, _, _, _, check = case
+    trial = Trial(out_dir)
     problems, energy = check_generic(trial)
     ok, metric, details = check(trial)
     if not ok:
         problems.append("case property failed: " + metric)
-    h = trial.summary["haptic"]
+    h = trial.summary.haptic
     return {"id": cid, "title": title, "ok": not problems, "metric": metric, "problems": problems, "details": details,
-            "energy": {k: v for k, v in energy.items() if k != "series"},
-            "clamps": h["force_clamps"], "saturations": h["saturations"], "max_force_N": h["max_force_N"],
-            "wall_s": trial.summary["config"].get("wall_time_s", 0.0)}
+            "energy": energy, "clamps": h["force_clamps"], "saturations": h["saturations"],
+            "max_force_N": h["max_force_N"], "wall_s": trial.summary.wall_time_s}
+
+
+def evaluate_sweep_point(out_dir):
+    """One point of the stiffness sweep: the wall's stability and the energy check."""
+    trial = Trial(out_dir)
+    problems, energy = check_generic(trial)
+    # "hard" problems (NaN, faults, force over the limit) make a point unstable whatever else holds.
+    hard = [p for p in problems if not p.startswith("energy")]
+    return {"wall": wall_stability(trial), "energy_ok": energy["ok"], "hard": hard, "excess_J": energy["excess_J"],
+            "problems": problems}
 
 
 def main():
@@ -698,49 +519,39 @@ def main():
     parser.add_argument("--check", action="store_true", help="exit 1 if any case fails")
     parser.add_argument("--fine", action="store_true", help="stiffness sweep in 5 %% steps (default 25 %%)")
     parser.add_argument("--cases", default="", help="comma-separated case ids (default: all)")
-    parser.add_argument("--coupling", default="impulse", choices=["impulse", "position", "local"],
+    parser.add_argument("--coupling", default="impulse", choices=COUPLINGS,
                         help="coupling every case runs with (default impulse, the paper's method)")
     args = parser.parse_args()
-    global COUPLING
-    COUPLING = args.coupling
     wanted = set(args.cases.split(",")) if args.cases else None
     cases = [c for c in CASES if wanted is None or c[0] in wanted]
     args.out.mkdir(parents=True, exist_ok=True)
     started = time.monotonic()
 
-    tasks = {}
+    tasks, out_dirs = [], {}
     for case in cases:
         cid, _, scene, trajectory, rate, _ = case
-        tasks[("case", cid)] = (args.out / f"case{cid}", CASES_DIR / scene, resolve_trajectory(trajectory), rate, ())
+        out_dirs[("case", cid)] = args.out / f"case{cid}"
+        tasks.append((("case", cid), run_case_trial, (out_dirs[("case", cid)], CASES_DIR / scene,
+                                                      resolve_trajectory(trajectory), args.coupling, rate, ())))
     sweep = wanted is None or "1" in wanted
+    policies = damping_policies(Scene(WALL_SCENE))
     if sweep:
-        for policy, (_, damping, explicit) in DAMPING_POLICIES.items():
+        for policy, (_, damping, explicit) in policies.items():
             for k in sweep_grid(args.fine):
                 flags = ["--stiffness", k] + (["--damping", damping(k)] if explicit else [])
-                tasks[("sweep", policy, k)] = (args.out / "sweep" / f"{policy}-K{int(k)}",
-                                               CASES_DIR / "c01_stiff_wall.json", WALL_TRAJECTORY, None, flags)
+                out_dirs[("sweep", policy, k)] = args.out / "sweep" / f"{policy}-K{int(k)}"
+                tasks.append((("sweep", policy, k), run_case_trial, (out_dirs[("sweep", policy, k)], WALL_SCENE,
+                                                                     WALL_TRAJECTORY, args.coupling, None, flags)))
 
     results, sweep_results, failures = {}, {}, []
-    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        futures = {pool.submit(run_trial, *task[:3], task[3], task[4]): key for key, task in tasks.items()}
-        for future in concurrent.futures.as_completed(futures):
-            key = futures[future]
-            try:
-                out_dir = future.result()
-            except RuntimeError as error:
-                failures.append((key, str(error)))
-                continue
-            if key[0] == "case":
-                case = next(c for c in cases if c[0] == key[1])
-                results[key[1]] = evaluate(case, out_dir)
-            else:
-                trial = Trial(out_dir, CASES_DIR / "c01_stiff_wall.json")
-                problems, energy = check_generic(trial)
-                s = wall_stability(trial)
-                # "hard" problems (NaN, faults, force over the limit) make a point unstable whatever else holds.
-                hard = [p for p in problems if not p.startswith("energy")]
-                sweep_results[(key[1], key[2])] = {"wall": s, "energy_ok": energy["ok"], "hard": hard,
-                                                   "excess_J": energy["excess_J"], "problems": problems}
+    for key, error in run_parallel(tasks, args.jobs):
+        if error is not None:
+            failures.append((key, str(error)))
+        elif key[0] == "case":
+            case = next(c for c in cases if c[0] == key[1])
+            results[key[1]] = evaluate(case, out_dirs[key])
+        else:
+            sweep_results[(key[1], key[2])] = evaluate_sweep_point(out_dirs[key])
     for key, error in failures:
         if key[0] == "case":
             case = next(c for c in cases if c[0] == key[1])
@@ -750,7 +561,8 @@ def main():
         else:
             sweep_results[(key[1], key[2])] = {"wall": {}, "energy_ok": False, "hard": [error], "problems": [error]}
 
-    lines = ["| case | result | key metric | max force (N) | clamps / saturations | energy: worst excess / tolerance (J) |",
+    lines = ["| case | result | key metric | max force (N) | clamps / saturations | "
+             "energy: worst excess / tolerance (J) |",
              "|---|---|---|---|---|---|"]
     for case in cases:
         r = results[case[0]]
@@ -762,7 +574,8 @@ def main():
     all_ok = all(results[c[0]]["ok"] for c in cases)
     if sweep:
         grid = sweep_grid(args.fine)
-        sweep_lines = ["", f"Stiff wall at 1 kHz, finger {FINGER_MASS_KG} kg held by {HAND_STIFFNESS_NPM:.0f} N/m and "
+        sweep_lines = ["", f"Stiff wall at {HAPTIC_RATE_HZ / 1000:g} kHz, finger {FINGER_MASS_KG} kg held by "
+                       f"{HAND_STIFFNESS_NPM:.0f} N/m and "
                        f"{HAND_DAMPING_NSPM:.0f} N·s/m, pressing the floor with ~3 N; K swept over "
                        f"{grid[0]:.0f}..{grid[-1]:.0f} N/m in {'5' if args.fine else '25'} % steps. *Stable*: no limit "
                        "cycle (contact kept and no clamp during the 1.5 s press). *Passive*: the energy check holds "
@@ -771,13 +584,14 @@ def main():
                        "largest passive K | first non-passive K | wall-alone passivity k_d > K·T/2 | "
                        "Colgate & Brown b_h > K·T/2 + k_d |", "|---|---|---|---|---|---|---|---|---|"]
         step = 1.05 if args.fine else 1.25
-        for policy, (text, damping, _) in DAMPING_POLICIES.items():
+        for policy, (text, damping, _) in policies.items():
             def limits(good):
                 bad = [k for k in grid if not good(sweep_results[(policy, k)])]
                 first_bad = min(bad) if bad else None
                 best = max((k for k in grid if good(sweep_results[(policy, k)]) and
                             (first_bad is None or k < first_bad)), default=None)
-                again = [k for k in grid if first_bad is not None and k > first_bad and good(sweep_results[(policy, k)])]
+                again = [k for k in grid
+                         if first_bad is not None and k > first_bad and good(sweep_results[(policy, k)])]
                 return best, first_bad, again
             best, first_bad, again = limits(lambda r: r["wall"].get("stable", False) and not r["hard"])
             pbest, pbad, _ = limits(lambda r: r["energy_ok"] and not r["hard"])

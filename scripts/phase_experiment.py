@@ -15,16 +15,18 @@ import pathlib
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from trials import ROOT, run_parallel, run_trial  # noqa: E402  (shared with speed_vs_error.py)
+from impetus_py import logs  # noqa: E402
+from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
+from impetus_py.parallel import run_parallel  # noqa: E402
+from impetus_py.paths import ROOT  # noqa: E402
+from impetus_py.scene import Scene  # noqa: E402
+from impetus_py.trial import run_trial  # noqa: E402
 
 
-def cube_track(out_dir, name):
-    times, xs = [], []
-    with open(out_dir / "world.csv") as f:
-        for row in csv.DictReader(f):
-            times.append(float(row["time_s"]))
-            xs.append(float(row[f"{name}.x_m"]))
-    return times, xs
+def x_track_m(trial_dir, name):
+    """Times (s) and x (m) of object `name` after each world step of the trial in trial_dir."""
+    world = logs.read_log(trial_dir / logs.WORLD)
+    return world["time_s"], world[f"{name}.x_m"]
 
 
 def main():
@@ -34,7 +36,7 @@ def main():
     parser.add_argument("--object", default="cube", help="the dynamic object whose stop position is measured")
     parser.add_argument("--trajectory", default="tap")
     parser.add_argument("--rate", type=float, default=20.0, help="world rate under test, Hz")
-    parser.add_argument("--haptic-rate", type=float, default=1000.0)
+    parser.add_argument("--haptic-rate", type=float, default=float(HAPTIC_RATE_HZ))
     parser.add_argument("--phases", type=int, default=10, help="phases spread evenly over one world period")
     parser.add_argument("--couplings", default="position,impulse")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
@@ -46,10 +48,10 @@ def main():
                         help="--check: largest allowed phase spread of the 1 kHz reference, m")
     parser.add_argument("--local-max-spread-ratio", type=float, default=0.05,
                         help="--check, when local coupling ran: largest allowed local spread / position spread "
-                             "(issue 9's goal: 5 %%)")
+                             "(the goal local coupling was built to: 5 %%)")
     parser.add_argument("--local-max-bias", type=float, default=0.05,
                         help="--check, when local coupling ran: largest allowed |bias| as a fraction of the reference "
-                             "travel (issue 9's goal: 5 %%)")
+                             "travel (the goal local coupling was built to: 5 %%)")
     parser.add_argument("--expect-overshoot", action="store_true",
                         help="--check: also require impulse coupling to stop beyond the reference (the haptic side "
                              "pushes on a plane that cannot move until the next world step, so the object receives "
@@ -75,18 +77,16 @@ def main():
         coupling = "impulse" if label == "reference" else label
         trial_dir = args.out / f"{label}-phase{phase:03d}"
         tasks.append(((label, phase, trial_dir), run_trial,
-                      (trial_dir, args.scene, args.trajectory, coupling, rate, phase, [])))
+                      (trial_dir, args.scene, args.trajectory, coupling, rate, phase)))
     for (label, phase, trial_dir), summary in run_parallel(tasks, args.jobs):
-        results[(label, phase)] = (summary["objects"][args.object]["position"][0], trial_dir,
-                                   summary["config"].get("wall_time_s", 0.0))
+        results[(label, phase)] = (summary.final_position_m(args.object)[0], trial_dir)
         done += 1
         print(f"\r{done}/{len(jobs)} trials", end="", file=sys.stderr, flush=True)
     print(file=sys.stderr)
 
     reference = [results[("reference", p)][0] for p in range(min(args.phases, 10))]
     reference_mean = sum(reference) / len(reference)
-    start = json.loads(args.scene.read_text())
-    start_x = next(o["position_m"][0] for o in start["objects"] if o["name"] == args.object)
+    start_x = Scene(args.scene).start_position_m(args.object)[0]
     rows, stats = [], {}
     for label in couplings + ["reference"]:
         label_phases = phases if label != "reference" else list(range(min(args.phases, 10)))
@@ -104,7 +104,8 @@ def main():
         writer.writerows(rows)
     lines = [f"Tap trial, world {args.rate:g} Hz vs the {args.haptic_rate:g} Hz reference "
              f"(reference stop x = {reference_mean:.4f} m, travel {reference_mean - start_x:.4f} m)", "",
-             "| coupling | phases | stop x mean (m) | phase spread (mm) | bias vs reference (mm) | bias (% of travel) |",
+             "| coupling | phases | stop x mean (m) | phase spread (mm) | bias vs reference (mm) | "
+             "bias (% of travel) |",
              "|---|---|---|---|---|---|"]
     for label, s in stats.items():
         count = len(phases) if label != "reference" else min(args.phases, 10)
@@ -124,10 +125,10 @@ def main():
         fig, axes = plt.subplots(1, len(couplings), figsize=(5 * len(couplings), 3.6), sharey=True)
         if len(couplings) == 1:
             axes = [axes]
-        ref_t, ref_x = cube_track(results[("reference", 0)][1], args.object)
+        ref_t, ref_x = x_track_m(results[("reference", 0)][1], args.object)
         for ax, label in zip(axes, couplings):
             for p in phases:
-                t, x = cube_track(results[(label, p)][1], args.object)
+                t, x = x_track_m(results[(label, p)][1], args.object)
                 ax.plot(t, x, lw=1, alpha=0.8)
             ax.plot(ref_t, ref_x, "k--", lw=1.5, label=f"{args.haptic_rate:g} Hz reference")
             ax.set_title(f"{label} coupling, world {args.rate:g} Hz, {len(phases)} phases")
@@ -154,7 +155,8 @@ def main():
                 failures.append(f"local bias {stats['local']['bias_pct_of_travel']:+.1f} % of travel exceeds "
                                 f"{100 * args.local_max_bias:.0f} %")
         if args.expect_overshoot and stats["impulse"]["bias_m"] <= 0:
-            failures.append(f"impulse coupling did not overshoot the reference (bias {stats['impulse']['bias_m']:+.4f} m)")
+            failures.append("impulse coupling did not overshoot the reference "
+                            f"(bias {stats['impulse']['bias_m']:+.4f} m)")
         if failures:
             print("CHECK FAILED: " + "; ".join(failures))
             sys.exit(1)

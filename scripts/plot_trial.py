@@ -4,17 +4,25 @@
 usage: plot_trial.py DIR [--out FILE.png]
 """
 import argparse
-import csv
-import json
-import math
 import os
 import pathlib
+import sys
+
+import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from impetus_py import logs  # noqa: E402
+from impetus_py.scene import Scene  # noqa: E402
+from impetus_py.summary import Summary  # noqa: E402
 
 
-def columns(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {key: [float(row[key]) for row in rows] for key in rows[0]} if rows else {}
+def box_half_x_m(trial_dir):
+    """Half the x size of every box in the trial's scene, by name; {} if the summary or the scene cannot be read."""
+    try:
+        scene = Scene(Summary.read(trial_dir).scene_path)
+    except (OSError, KeyError, ValueError):
+        return {}
+    return {name: obj["size_m"][0] / 2 for name, obj in scene.objects.items() if obj.get("shape") == "box"}
 
 
 def main():
@@ -25,28 +33,21 @@ def main():
     os.environ.setdefault("MPLBACKEND", "Agg")
     import matplotlib.pyplot as plt
 
-    world = columns(args.dir / "world.csv")
-    haptic = columns(args.dir / "haptic.csv")
-    objects = sorted({key.split(".")[0] for key in world if key.endswith(".x_m")})
+    world = logs.read_log(args.dir / logs.WORLD)
+    haptic = logs.read_log(args.dir / logs.HAPTIC)
+    objects = sorted(world.object_names())
     # A box's −x face is what the finger strikes: plot it instead of the centre when the scene says the size.
-    half_x = {}
-    try:
-        scene_path = json.loads((args.dir / "summary.json").read_text())["config"]["scene"]
-        for obj in json.loads(pathlib.Path(scene_path).read_text())["objects"]:
-            if obj.get("shape") == "box":
-                half_x[obj["name"]] = obj["size_m"][0] / 2
-    except (OSError, KeyError, ValueError):
-        pass
+    half_x = box_half_x_m(args.dir)
     # The finger is unknown while no device is attached (flags bit 0).
-    valid = [int(f) & 1 for f in haptic["flags"]]
-    finger_x = [x if v else math.nan for x, v in zip(haptic["finger_x"], valid)]
-    proxy_x = [x if v else math.nan for x, v in zip(haptic["proxy_x"], valid)]
+    attached = haptic["flags"].astype(int) & 1 == 1
+    finger_x = np.where(attached, haptic["finger_x"], np.nan)
+    proxy_x = np.where(attached, haptic["proxy_x"], np.nan)
 
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
     for name in objects:
         if name in half_x:
-            face = [x - half_x[name] for x in world[f"{name}.x_m"]]
-            top.plot(world["time_s"], face, lw=2, drawstyle="steps-post", label=f"{name} −x face (world steps)")
+            top.plot(world["time_s"], world[f"{name}.x_m"] - half_x[name], lw=2, drawstyle="steps-post",
+                     label=f"{name} −x face (world steps)")
         else:
             top.plot(world["time_s"], world[f"{name}.x_m"], lw=2, drawstyle="steps-post", label=f"{name} x")
     top.plot(haptic["time_s"], finger_x, lw=1, label="finger x (device)")

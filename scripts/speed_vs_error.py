@@ -42,9 +42,14 @@ import sys
 import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from trials import ROOT, ProgressBar, run_parallel, run_trial  # noqa: E402
+from impetus_py import logs  # noqa: E402
+from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
+from impetus_py.parallel import run_parallel  # noqa: E402
+from impetus_py.paths import ROOT, build_dir  # noqa: E402
+from impetus_py.progress import ProgressBar  # noqa: E402
+from impetus_py.scene import Scene  # noqa: E402
+from impetus_py.trial import COUPLINGS, run_trial  # noqa: E402
 
-HAPTIC_RATE_HZ = 1000
 FULL_RATES = [10, 20, 50, 100, 200, 500, 1000]
 QUICK_RATES = [10, 20, 100, 1000]
 # Spheres: the 24 balls drop and roll toward the centre for ~0.3 s; the finger comes down at x = -0.12 m to the balls'
@@ -64,52 +69,40 @@ def parse_list(text, kind):
     return [kind(item) for item in text.split(",") if item.strip()]
 
 
-def world_manager_couplings(build):
-    """The couplings this world_manager build accepts (from its --help), so a coupling added or missing in the build
-    at hand is handled instead of failing every one of its trials."""
-    binary = build / "world_manager/world_manager"
-    try:
-        text = subprocess.run([str(binary), "--help"], capture_output=True, text=True, timeout=10).stdout
-    except (OSError, subprocess.TimeoutExpired):
-        return None
-    line = next((line for line in text.splitlines() if "--coupling" in line), "")
-    return {word for word in ("impulse", "position", "local") if word in line} or None
-
-
 def positions_on_grid(world_csv, grid_ticks):
     """({tick: {object: [x, y, z]}}, {tick: fastest object's speed}) for the world log's rows whose world time is a
     whole multiple of grid_ticks haptic ticks. Every world rate of the sweep steps on that grid, so all trials can be
     compared at one common time; only those rows are parsed (a 1 kHz spheres log has ~3000 rows of 24 objects).
     The speed tells whether "the stop position" at that time is really a stop."""
+    def on_grid(time_s):
+        ticks = HAPTIC_RATE_HZ * time_s
+        return abs(ticks - round(ticks)) <= 1e-3 and round(ticks) % grid_ticks == 0
+
+    world = logs.read_log(world_csv, keep_time_s=on_grid)
+    names = world.object_names()
+    positions = {name: world.vectors(f"{name}.", "_m").tolist() for name in names}
+    velocities = {name: world.vectors(f"{name}.v", "_mps").tolist() for name in names}
     out, speeds = {}, {}
-    with open(world_csv) as f:
-        header = next(csv.reader([f.readline()]))
-        names = [column[:-len(".x_m")] for column in header if column.endswith(".x_m")]
-        index = {column: i for i, column in enumerate(header)}
-        for line in f:
-            t_ms = 1e3 * float(line.split(",", 1)[0])
-            tick = round(t_ms)
-            if abs(t_ms - tick) > 1e-3 or tick % grid_ticks:
-                continue
-            row = line.rstrip("\n").split(",")
-            out[tick] = {name: [float(row[index[f"{name}.{axis}_m"]]) for axis in "xyz"] for name in names}
-            speeds[tick] = max(norm([float(row[index[f"{name}.v{axis}_mps"]]) for axis in "xyz"]) for name in names)
+    for row, time_s in enumerate(world["time_s"]):
+        tick = round(HAPTIC_RATE_HZ * time_s)
+        out[tick] = {name: positions[name][row] for name in names}
+        speeds[tick] = max(norm(velocities[name][row]) for name in names)
     return out, speeds
 
 
 def one_trial(out_dir, scene, trajectory, coupling, rate, substeps, phase, grid_ticks, keep_logs):
-    """A trial, reduced to what the sweep needs. Errors are returned, not raised, so one bad trial (or a coupling the
-    build does not have yet) is reported in its cell instead of stopping the sweep."""
+    """A trial, reduced to what the sweep needs. Errors are returned, not raised, so one bad trial is reported in its
+    cell instead of stopping the sweep."""
     try:
-        summary = run_trial(out_dir, ROOT / scene, trajectory, coupling, rate, phase, ["--substeps", str(substeps)])
-        positions, speeds = positions_on_grid(out_dir / "world.csv", grid_ticks)
+        summary = run_trial(out_dir, ROOT / scene, trajectory, coupling, rate, phase, substeps)
+        positions, speeds = positions_on_grid(out_dir / logs.WORLD, grid_ticks)
         if not positions:
-            raise RuntimeError(f"no world log row on the {grid_ticks}-tick grid in {out_dir / 'world.csv'}")
+            raise RuntimeError(f"no world log row on the {grid_ticks}-tick grid in {out_dir / logs.WORLD}")
     except Exception as error:  # noqa: BLE001 — any failure of the trial belongs in the report
         return {"error": str(error)}
     finally:
         if not keep_logs:  # the logs of a 1 kHz spheres trial are ~20 MB; the summaries are kept
-            for log in ("world.csv", "haptic.csv", "device.csv"):
+            for log in logs.NAMES:
                 (out_dir / log).unlink(missing_ok=True)
     return {"summary": summary, "positions": positions, "speeds": speeds}
 
@@ -147,12 +140,12 @@ def cell_stats(trials, reference, start, eval_tick):
     spread = math.sqrt(mean([s * s for s in spreads]))
 
     def summary_mean(section, key, scale=1.0):
-        return scale * mean([t["summary"][section].get(key) for t in trials])
+        return scale * mean([getattr(t["summary"], section).get(key) for t in trials])
 
-    walls = [float(t["summary"]["config"].get("wall_time_s", "nan")) for t in trials]
-    sims = [t["summary"]["world"].get("time_s") for t in trials]
-    touched = [sum(1 for o in t["summary"]["objects"].values() if norm(o.get("impulse_Ns", [0, 0, 0])) >
-                   TOUCH_THRESHOLD_NS) for t in trials]
+    walls = [t["summary"].wall_time_s for t in trials]
+    sims = [t["summary"].world.get("time_s") for t in trials]
+    touched = [sum(1 for name in t["summary"].objects if norm(t["summary"].impulse_Ns(name)) > TOUCH_THRESHOLD_NS)
+               for t in trials]
     return {
         "touched_objects": mean(touched),
         "rms_mm": 1e3 * rms, "bias_mm": 1e3 * bias_rms, "bias_along_travel_mm": 1e3 * mean(along),
@@ -202,7 +195,8 @@ def markdown(rows, meta):
                 f"{fmt(r.get('wall_s'), 2)} | {fmt(r.get('sim_per_wall'), 1)} |")
         lines.append("")
     lines.append(f"{meta['trials']} trials, {meta['jobs']} in parallel on {os.cpu_count()} CPUs, "
-                 f"{meta['wall_s']:.0f} s in all (git {meta['revision']}; 1-min load average {meta['load_before']:.1f} before, "
+                 f"{meta['wall_s']:.0f} s in all (git {meta['revision']}; "
+                 f"1-min load average {meta['load_before']:.1f} before, "
                  f"{meta['load_after']:.1f} after). Wall times and CPU costs were measured with {meta['jobs']} trials "
                  f"sharing the machine.")
     return "\n".join(lines) + "\n"
@@ -340,7 +334,7 @@ def main():
                         help="reduced grid: tap only, rates 10,20,100,1000, 4 phases, substeps 1,10 at 20 Hz")
     parser.add_argument("--rates", help=f"world rates, Hz (default {','.join(map(str, FULL_RATES))})")
     parser.add_argument("--couplings", default="position,impulse,local",
-                        help="couplings to sweep; those the world_manager build does not accept are skipped")
+                        help=f"couplings to sweep, a subset of {','.join(COUPLINGS)}")
     parser.add_argument("--phases", type=int, help="phases per rate (default 10, --quick 4)")
     parser.add_argument("--scenes", help="subset of tap,spheres (default both, --quick tap)")
     parser.add_argument("--spheres-trajectory", default=SPHERES_TRAJECTORY)
@@ -371,7 +365,11 @@ def main():
     for scene in scenes:
         if scene not in SCENES:
             parser.error(f"--scenes: unknown scene '{scene}' (known: {', '.join(SCENES)})")
-    build = pathlib.Path(os.environ.get("IMPETUS_BUILD_DIR", ROOT / "build"))
+    couplings = parse_list(args.couplings, str)
+    for coupling in couplings:
+        if coupling not in COUPLINGS:
+            parser.error(f"--couplings: unknown coupling '{coupling}' (known: {', '.join(COUPLINGS)})")
+    build = build_dir()
     # Run every trial on a private copy of the three binaries: a rebuild of build/ during the sweep (other work on
     # the same tree) would otherwise mix versions or make trials fail while the linker rewrites a binary.
     snapshot = args.out / "bin"
@@ -382,15 +380,6 @@ def main():
         (snapshot / name).mkdir(parents=True, exist_ok=True)
         shutil.copy2(source, snapshot / name / name)
     os.environ["IMPETUS_BUILD_DIR"] = str(snapshot)  # read by run.sh in every trial
-    build = snapshot
-    known = world_manager_couplings(build)
-    couplings = []
-    for coupling in parse_list(args.couplings, str):
-        if known is not None and coupling not in known:
-            print(f"speed_vs_error: world_manager in {build} has no '{coupling}' coupling; skipping it",
-                  file=sys.stderr)
-        else:
-            couplings.append(coupling)
     scene_info = {"tap": SCENES["tap"], "spheres": (SCENES["spheres"][0], args.spheres_trajectory)}
 
     # Every rate steps on multiples of its period; their least common multiple (in ticks) is a grid all trials share.
@@ -411,9 +400,9 @@ def main():
             "revision": revision, "load_before": os.getloadavg()[0]}
     for scene in scenes:
         scene_path, trajectory = scene_info[scene]
-        scene_json = json.loads((ROOT / scene_path).read_text())
-        default_substeps = int(scene_json.get("physics", {}).get("substeps", 1))
-        start = {o["name"]: o["position_m"] for o in scene_json["objects"] if o.get("dynamic")}
+        scene_file = Scene(ROOT / scene_path)
+        default_substeps = scene_file.substeps
+        start = {obj["name"]: obj["position_m"] for obj in scene_file.dynamic_objects}
         meta["scenes"][scene] = {"scene": scene_path, "trajectory": trajectory, "default_substeps": default_substeps,
                                  "start": start, "objects": len(start)}
         wanted = [("rate", c, r, default_substeps) for c in couplings for r in rates]

@@ -8,6 +8,9 @@ import json
 import pathlib
 import sys
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from impetus_py import summary  # noqa: E402
+
 
 def load(path):
     try:
@@ -24,27 +27,22 @@ def main():
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args()
 
-    world = load(args.dir / "world.json")
-    haptic = load(args.dir / "haptic.json")
-    config = dict(world.get("config", {}))
-    for item in args.set:
-        key, _, value = item.partition("=")
-        config[key] = value
-    if "wall_start" in config and "wall_end" in config:
-        config["wall_time_s"] = float(config.pop("wall_end")) - float(config.pop("wall_start"))
-    summary = {"objects": world["objects"], "haptic": haptic["haptic"], "world": world["world"], "config": config}
-    (args.dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    entries = {key: value for key, _, value in (item.partition("=") for item in args.set)}
+    merged = summary.merge(load(args.dir / summary.WORLD_FILE_NAME), load(args.dir / summary.HAPTIC_FILE_NAME),
+                           entries)
+    (args.dir / summary.FILE_NAME).write_text(summary.to_json(merged))
 
     if args.quiet:
         return
+    config = merged["config"]
     print(f"trial: {config.get('scene')} / {config.get('trajectory')} / {config.get('coupling')} coupling, "
           f"{config.get('clock')} clock, world {config.get('world_rate_hz')} Hz, phase {config.get('phase_ticks')}")
-    for name, obj in summary["objects"].items():
+    for name, obj in merged["objects"].items():
         x, y, z = obj["position"]
         jx, jy, jz = obj["impulse_Ns"]
         print(f"  {name:12s} final position [{x:+.4f} {y:+.4f} {z:+.4f}] m   "
               f"impulse delivered [{jx:+.4f} {jy:+.4f} {jz:+.4f}] N·s")
-    h, w = summary["haptic"], summary["world"]
+    h, w = merged["haptic"], merged["world"]
     print(f"  haptic: {h['ticks']} ticks, max force {h['max_force_N']:.2f} N, faults {h['faults']}, "
           f"force clamps {h['force_clamps']}, saturations {h['saturations']}, skipped periods {h['skipped_periods']}, "
           f"lateness p50/p99/max {h['lateness_p50_ns'] / 1e3:.0f}/{h['lateness_p99_ns'] / 1e3:.0f}/"

@@ -9,14 +9,17 @@ per trial like Fig. 7, and the mean absolute deviation of the last 20 trials per
 """
 import argparse
 import csv
-import json
 import os
 import pathlib
 import random
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from trials import ROOT, run_parallel, run_trial  # noqa: E402
+from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
+from impetus_py.parallel import run_parallel  # noqa: E402
+from impetus_py.paths import ROOT  # noqa: E402
+from impetus_py.scene import Scene  # noqa: E402
+from impetus_py.trial import run_trial  # noqa: E402
 
 # The subject corrects half of the last error per trial (a cautious learner that does not chase noise), converting
 # the error in travel into a change of stroke speed through the sensitivity d travel / d speed it has learned so far:
@@ -45,15 +48,11 @@ def subject(method, args, phases):
     """Runs one subject's trials with one method; returns [(trial, speed, phase, travel)]."""
     speed = FIRST_SPEED_MPS
     outcomes = []
-    start_x = None
+    start_x = Scene(args.scene).start_position_m("cube")[0]
     for trial, phase in enumerate(phases):
         out = args.out / f"{method}-trial{trial:02d}"
-        summary = run_trial(out, args.scene, f"tap:speed={speed:.6f}", method, args.rate, phase, [])
-        x = summary["objects"]["cube"]["position"][0]
-        if start_x is None:
-            scene = json.loads(pathlib.Path(args.scene).read_text())
-            start_x = next(o["position_m"][0] for o in scene["objects"] if o["name"] == "cube")
-        travel = x - start_x
+        summary = run_trial(out, args.scene, f"tap:speed={speed:.6f}", method, args.rate, phase)
+        travel = summary.final_position_m("cube")[0] - start_x
         outcomes.append((trial, speed, phase, travel))
         error = args.target - travel
         step = CORRECTED_FRACTION * error / learned_slope(outcomes)
@@ -79,7 +78,7 @@ def main():
     args = parser.parse_args()
 
     methods = args.methods.split(",")
-    ticks_per_step = round(1000 / args.rate)
+    ticks_per_step = round(HAPTIC_RATE_HZ / args.rate)
     rng = random.Random(args.seed)
     # The same phase sequence for every method, so the methods differ only in how they couple.
     phases = [rng.randrange(ticks_per_step) for _ in range(args.trials)]
@@ -95,7 +94,8 @@ def main():
     last = min(20, args.trials)
     lines = [f"Tap task: {args.trials} trials per method, target travel {args.target:.2f} m, world {args.rate:g} Hz, "
              f"random phase per trial (seed {args.seed})", "",
-             f"| method | mean abs deviation, last {last} trials (mm) | mean travel, last {last} (m) |", "|---|---|---|"]
+             f"| method | mean abs deviation, last {last} trials (mm) | mean travel, last {last} (m) |",
+             "|---|---|---|"]
     deviations = {}
     for method in methods:
         tail = [travel for _, _, _, travel in results[method][-last:]]

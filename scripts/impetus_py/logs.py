@@ -1,0 +1,64 @@
+"""The daemons' CSV logs of one trial (DESIGN.md §4: a header row, time first, units in the column names):
+
+  world.csv   world_manager: one row per world step, the state after it; per object NAME.x_m .. NAME.z_m,
+              NAME.qw .. NAME.qz, NAME.vx_mps .., NAME.wx_radps .., and the impulses NAME.jx_Ns .., NAME.jx_total_Ns ..
+  haptic.csv  haptic_controller: one row per tick: finger_x .., proxy_x .., force_x .. (N, on the finger),
+              active_planes, flags (bit 0: a device is attached, bit 1: the force was clamped), ...
+  device.csv  spidar_sim: one row per device tick: target_x_m .., finger_x_m .., finger_vx_mps .., tensions, counts
+"""
+import csv
+
+import numpy as np
+
+WORLD = "world.csv"
+HAPTIC = "haptic.csv"
+DEVICE = "device.csv"
+NAMES = (WORLD, HAPTIC, DEVICE)
+
+
+class Log:
+    """A log's columns as float arrays, by header name."""
+
+    def __init__(self, header, rows):
+        table = np.array(rows, dtype=float).reshape(len(rows), len(header))
+        self.columns = {name: table[:, i] for i, name in enumerate(header)}
+
+    def __getitem__(self, column):
+        return self.columns[column]
+
+    def __len__(self):
+        return len(self.columns["time_s"])
+
+    @property
+    def finite(self):
+        """Whether every value is a finite number (no NaN or Inf)."""
+        return all(np.isfinite(values).all() for values in self.columns.values())
+
+    def vectors(self, prefix, suffix=""):
+        """The columns PREFIX{x,y,z}SUFFIX as one row per log row: vectors("finger_") for haptic.csv's finger,
+        vectors("cube.v", "_mps") for world.csv's velocity of the cube."""
+        return np.stack([self.columns[f"{prefix}{axis}{suffix}"] for axis in "xyz"], axis=1)
+
+    def object_names(self):
+        """The objects a world log tracks, in column order."""
+        return [column[:-len(".x_m")] for column in self.columns if column.endswith(".x_m")]
+
+    def rows(self, selected):
+        """A log of the rows `selected` (a boolean array or an index array) picks."""
+        log = Log.__new__(Log)
+        log.columns = {name: values[selected] for name, values in self.columns.items()}
+        return log
+
+
+def read_log(path, keep_time_s=None):
+    """The log at `path`. With `keep_time_s`, a predicate on a row's time (s), only the rows it accepts are kept, and
+    only those are converted to numbers: a 1 kHz world log of many objects is large."""
+    with open(path, newline="") as f:
+        reader = csv.reader(f)
+        header = next(reader)
+        rows = []
+        for line in reader:
+            if keep_time_s is not None and not keep_time_s(float(line[0])):
+                continue
+            rows.append([float(value) for value in line])
+    return Log(header, rows)
