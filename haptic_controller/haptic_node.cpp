@@ -95,6 +95,10 @@ void HapticNode::tick(std::uint64_t tick, double now_s, double dt_s, std::int64_
                 (result.world_stale ? 8u : 0u) | (result.sticking ? 16u : 0u);
     log_->push(row);
   }
+  if (result.render) {
+    stiffness_Npm_ = result.stiffness_Npm;
+    damping_Nspm_ = result.damping_Nspm;
+  }
   max_force_N_ = std::max(max_force_N_, std::sqrt(result.force_N[0] * result.force_N[0] +
                                                   result.force_N[1] * result.force_N[1] +
                                                   result.force_N[2] * result.force_N[2]));
@@ -188,6 +192,9 @@ nlohmann::json HapticNode::summary() const {
             {"world_attaches", world_.attaches()},
             {"log_rows_dropped", log_ ? log_->dropped() : 0},
             {"max_force_N", max_force_N_},
+            {"force_limit_N", device_.limits().max_force_N},
+            {"stiffness_Npm", stiffness_Npm_},
+            {"damping_Nspm", damping_Nspm_},
             {"skipped_periods", skipped_periods_},
             {"lateness_p50_ns", clock_stats_.percentile_ns(0.5)},
             {"lateness_p99_ns", clock_stats_.percentile_ns(0.99)},

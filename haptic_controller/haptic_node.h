@@ -75,6 +75,8 @@ class HapticNode {
   std::optional<RtLog<HapticLogRow>> log_;
   PlaneFrame frame_buffer_{};
   double max_force_N_ = 0.0;
+  double stiffness_Npm_ = 0.0;  // k_p and k_d of the last tick that rendered a force
+  double damping_Nspm_ = 0.0;
   LatencyHistogram clock_stats_;
   LatencyHistogram tick_cpu_ns_;  // CPU time of HapticServo::tick, per tick
   std::uint64_t skipped_periods_ = 0;

@@ -167,6 +167,8 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
       std::isnan(options_.damping_Nspm)
           ? positive_or(current_frame_.damping_Nspm, passivity_damping_Nspm(stiffness_Npm, options_.tick_period_s))
           : options_.damping_Nspm;
+  result_.stiffness_Npm = stiffness_Npm;
+  result_.damping_Nspm = damping_Nspm;
   const RenderedForce rendered =
       renderer_.render(contact.contact.proxy_m, finger_m, stiffness_Npm, damping_Nspm, dt_s);
   Eigen::Vector3d force_N = contact.contact.active_count > 0 ? rendered.force_N : Eigen::Vector3d::Zero();

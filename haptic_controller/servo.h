@@ -43,6 +43,8 @@ struct TickResult {
   bool fault = false;         // non-finite finger or force this tick: force zeroed
   bool world_stale = false;   // the newest world frame is stale (common/runtime/staleness.h): its planes hold
   bool sticking = false;      // friction holds the proxy
+  double stiffness_Npm = 0.0;  // k_p and k_d this tick (flags, else the world's, else the fallbacks above)
+  double damping_Nspm = 0.0;
   int active_planes = 0;      // constraints holding the proxy (0 free, 1 face, 2 edge, 3 corner; 4 infeasible pinch)
   double interpolation_weight = 1.0;  // w of §3.2
 };

@@ -29,8 +29,7 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from impetus_py import logs  # noqa: E402
-from impetus_py.daemon_defaults import (DEVICE_MAX_FORCE_N, FINGER_MASS_KG, HAND_DAMPING_NSPM,  # noqa: E402
-                                        HAND_STIFFNESS_NPM, HAPTIC_RATE_HZ)
+from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
 from impetus_py.energy import energy_balance  # noqa: E402
 from impetus_py.parallel import run_parallel  # noqa: E402
 from impetus_py.paths import ROOT  # noqa: E402
@@ -39,7 +38,8 @@ from impetus_py.summary import Summary  # noqa: E402
 from impetus_py.trial import COUPLINGS, run_trial  # noqa: E402
 
 CASES_DIR = ROOT / "tests/hard_cases"
-# Every trial runs at haptic_controller's default rate; the stiffness sweep's theory uses its period.
+# Every trial runs at haptic_controller's default rate; the sweep's damping policies are planned with its period (the
+# theory afterwards takes the period the trials report).
 HAPTIC_PERIOD_S = 1.0 / HAPTIC_RATE_HZ
 
 # ---------------------------------------------------------------------------------------------------------------------
@@ -92,9 +92,10 @@ def check_generic(trial):
         problems.append("NaN or Inf in a log")
     if h["faults"]:
         problems.append(f"{h['faults']} servo faults (non-finite finger or force)")
-    if not h["max_force_N"] <= DEVICE_MAX_FORCE_N + 1e-9:
-        problems.append(f"max force {h['max_force_N']:.3f} N > {DEVICE_MAX_FORCE_N} N")
-    energy = energy_balance(trial.scene, trial.device, trial.world, trial.world_period_s, trial.haptic_period_s)
+    if not h["max_force_N"] <= h["force_limit_N"] + 1e-9:
+        problems.append(f"max force {h['max_force_N']:.3f} N > {h['force_limit_N']} N")
+    energy = energy_balance(trial.scene, trial.device, trial.world, trial.summary.device, trial.world_period_s,
+                            trial.haptic_period_s)
     if not energy["ok"]:
         problems.append(f"energy grew {energy['excess_J']:.4f} J beyond the hand's work at t={energy['at_s']:.3f} s "
                         f"(tolerance {energy['tolerance_J']:.4f} J)")
@@ -112,7 +113,8 @@ def wall_stability(trial):
     mean = sum(f) / len(f)
     rms = math.sqrt(sum((x - mean) ** 2 for x in f) / len(f))
     lost = sum(1 for i in window if trial.haptic["active_planes"][i] == 0 or forces[i] == 0.0)
-    clamped = sum(1 for i in window if int(trial.haptic["flags"][i]) & 2 or forces[i] >= DEVICE_MAX_FORCE_N - 1e-9)
+    limit_N = trial.summary.haptic["force_limit_N"]
+    clamped = sum(1 for i in window if int(trial.haptic["flags"][i]) & 2 or forces[i] >= limit_N - 1e-9)
     return {"stable": lost == 0 and clamped == 0, "lost": lost, "clamped": clamped, "rms_over_mean": rms / mean}
 
 
@@ -404,15 +406,27 @@ def expm_2x2(a, t_s):
     return (np.exp(s * t_s) * (np.cosh(q * t_s) * np.eye(2) + sinh_over_q * (a - s * np.eye(2)))).real
 
 
-def sampled_wall_radius(k, b, t=HAPTIC_PERIOD_S, m=FINGER_MASS_KG, kh=HAND_STIFFNESS_NPM, bh=HAND_DAMPING_NSPM):
+class WallLoop:
+    """The loop of case 1's linear model, as a trial ran it: the haptic period t (s) and the finger (mass m, kg) held
+    by the hand's spring kh (N/m) and damper bh (N·s/m), from the trial's summary."""
+
+    def __init__(self, summary):
+        self.t = summary.haptic_period_s
+        self.m = summary.device["finger_mass_kg"]
+        self.kh = summary.device["hand_stiffness_Npm"]
+        self.bh = summary.device["hand_damping_Nspm"]
+
+
+def sampled_wall_radius(k, b, loop):
     """Spectral radius of the linear sampled-data model of case 1: the finger (mass m, held by the hand's spring kh
-    and damper bh) in contact with a wall rendered at period t as f_j = -k x_j - b (x_j - x_{j-1})/t, held over the
+    and damper bh; `loop`) in contact with a wall rendered at period t as f_j = -k x_j - b (x_j - x_{j-1})/t, held over the
     tick (zero-order hold; the servo reads the position at the end of tick j and the device applies the force
     during tick j+1, which is exactly how spidar_sim and the lockstep servo interact). Stable iff < 1.
 
     The finger's state (x, v) obeys d/dt (x, v) = A (x, v) + B f, so over one tick (x, v)_{j+1} = Φ (x, v)_j + Γ f_j
     with Φ = exp(A t) and Γ = A^-1 (Φ - I) B; with the previous position as a third state, the loop is
     (x_{j+1}, v_{j+1}, x_j) = M (x_j, v_j, x_{j-1})."""
+    t, m, kh, bh = loop.t, loop.m, loop.kh, loop.bh
     a = np.array([[0.0, 1.0], [-kh / m, -bh / m]])
     phi = expm_2x2(a, t)
     gamma = np.linalg.solve(a, (phi - np.eye(2)) @ np.array([0.0, 1.0 / m]))
@@ -437,16 +451,16 @@ def largest_where(holds, lo, hi, midpoint):
     return lo
 
 
-def linear_limit(damping):
+def linear_limit(damping, loop):
     """The largest stiffness K (N/m) at which the linear sampled-data model is stable, with k_d = damping(K)."""
-    return largest_where(lambda k: sampled_wall_radius(k, damping(k)) < 1.0, 1.0, 1e7,
+    return largest_where(lambda k: sampled_wall_radius(k, damping(k), loop) < 1.0, 1.0, 1e7,
                          lambda lo, hi: math.sqrt(lo * hi))
 
 
-def colgate_brown_bound(damping):
+def colgate_brown_bound(damping, loop):
     """Colgate & Brown (1994): the sampled wall K + virtual damper B is passive iff b > K T / 2 + |B|, b the
     physical damping in the loop, here the hand's b_h (the SPIDAR model has none of its own). Largest passive K."""
-    return largest_where(lambda k: HAND_DAMPING_NSPM > k * HAPTIC_PERIOD_S / 2 + abs(damping(k)), 0.0, 1e7,
+    return largest_where(lambda k: loop.bh > k * loop.t / 2 + abs(damping(k)), 0.0, 1e7,
                          lambda lo, hi: 0.5 * (lo + hi))
 
 
@@ -574,9 +588,14 @@ def main():
     all_ok = all(results[c[0]]["ok"] for c in cases)
     if sweep:
         grid = sweep_grid(args.fine)
-        sweep_lines = ["", f"Stiff wall at {HAPTIC_RATE_HZ / 1000:g} kHz, finger {FINGER_MASS_KG} kg held by "
-                       f"{HAND_STIFFNESS_NPM:.0f} N/m and "
-                       f"{HAND_DAMPING_NSPM:.0f} N·s/m, pressing the floor with ~3 N; K swept over "
+        # The loop the sweep's trials ran (any of them: they share the finger, hand and rate).
+        loop = next((WallLoop(Summary.read(out_dirs[key])) for key in out_dirs
+                     if key[0] == "sweep" and (out_dirs[key] / "summary.json").exists()), None)
+        if loop is None:
+            sys.exit("hard_cases: no stiffness-sweep trial ran; the sweep has nothing to report")
+        sweep_lines = ["", f"Stiff wall at {1e-3 / loop.t:g} kHz, finger {loop.m} kg held by "
+                       f"{loop.kh:.0f} N/m and "
+                       f"{loop.bh:.0f} N·s/m, pressing the floor with ~3 N; K swept over "
                        f"{grid[0]:.0f}..{grid[-1]:.0f} N/m in {'5' if args.fine else '25'} % steps. *Stable*: no limit "
                        "cycle (contact kept and no clamp during the 1.5 s press). *Passive*: the energy check holds "
                        "(the wall never gives the finger energy the hand did not put in).", "",
@@ -595,10 +614,10 @@ def main():
                 return best, first_bad, again
             best, first_bad, again = limits(lambda r: r["wall"].get("stable", False) and not r["hard"])
             pbest, pbad, _ = limits(lambda r: r["energy_ok"] and not r["hard"])
-            theory = linear_limit(damping)
-            low_freq = 2 * damping(1.0) / HAPTIC_PERIOD_S if policy == "scene" else (
+            theory = linear_limit(damping, loop)
+            low_freq = 2 * damping(1.0) / loop.t if policy == "scene" else (
                 math.inf if policy == "passivity" else 0.0)
-            bound = colgate_brown_bound(damping)
+            bound = colgate_brown_bound(damping, loop)
             # The measured onset of the limit cycle must bracket the linear model's limit within one sweep step plus
             # 10 %: the model leaves out the encoder quantisation and the one-sided contact, which shift the onset
             # a little; one extra tick of delay in the loop would lower the limit by about half.

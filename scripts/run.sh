@@ -52,7 +52,8 @@ world_args=(--scene "$scene" --coupling "$coupling" --clock "$clock" --phase "$p
 [ -n "$substeps" ] && world_args+=(--substeps "$substeps")
 haptic_args=(--clock "$clock" --duration "$duration" --shm "$shm" --log "$out/haptic.csv"
              --summary "$out/haptic.json" "${haptic_extra[@]}")
-device_args=(--clock "$clock" --trajectory "$trajectory" --shm "$shm" --log "$out/device.csv")
+device_args=(--clock "$clock" --trajectory "$trajectory" --shm "$shm" --log "$out/device.csv"
+             --summary "$out/device.json")
 
 pids=()
 stop_all() {

@@ -29,7 +29,7 @@ def main():
 
     entries = {key: value for key, _, value in (item.partition("=") for item in args.set)}
     merged = summary.merge(load(args.dir / summary.WORLD_FILE_NAME), load(args.dir / summary.HAPTIC_FILE_NAME),
-                           entries)
+                           load(args.dir / summary.DEVICE_FILE_NAME), entries)
     (args.dir / summary.FILE_NAME).write_text(summary.to_json(merged))
 
     if args.quiet:

@@ -93,4 +93,22 @@ int DeviceNode::run() {
   return 0;
 }
 
+nlohmann::json DeviceNode::summary() const {
+  const FingerParams& finger = sim_.finger().params();
+  const SpidarGeometry& geometry = sim_.hardware().geometry();
+  return {{"device",
+           {{"ticks", ticks_},
+            {"time_s", sim_.time_s()},
+            {"rejected_commands", port_.rejected_commands()},
+            {"finger_mass_kg", finger.mass_kg},
+            {"hand_stiffness_Npm", finger.hand_stiffness_Npm},
+            {"hand_damping_Nspm", finger.hand_damping_Nspm},
+            {"motor_time_constant_s", sim_.hardware().params().motor_time_constant_s},
+            {"frame_side_m", geometry.frame_side_m},
+            {"metres_per_count", geometry.metres_per_count},
+            {"tension_min_N", geometry.tension_min_N},
+            {"tension_max_N", geometry.tension_max_N},
+            {"max_force_N", geometry.max_force_N}}}};
+}
+
 }  // namespace impetus

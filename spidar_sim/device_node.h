@@ -10,6 +10,8 @@
 #include "common/link/inproc/inproc_device_port.h"
 #include "spidar_sim/device_sim.h"
 
+#include <nlohmann/json.hpp>
+
 #include <cstdint>
 #include <fstream>
 #include <optional>
@@ -27,6 +29,9 @@ class DeviceNode final : public DeviceStepper {
   int run();
   // One lockstep tick (the in-process port's turn); false once the trajectory has ended and the node detached.
   bool step_device() override;
+
+  // The device's part of summary.json: ticks, and the finger, hand and device parameters the trial ran with.
+  nlohmann::json summary() const;
 
   std::uint64_t ticks() const { return ticks_; }
   const DeviceSim& sim() const { return sim_; }

@@ -7,13 +7,14 @@
 #include "spidar_sim/device_node.h"
 #include "spidar_sim/trajectory.h"
 
-#include <unistd.h>
+#include <fstream>
 
 int main(int argc, char** argv) {
   using namespace impetus;
   std::string trajectory_spec;
   ClockMode clock = ClockMode::realtime;
   std::string log_path;
+  std::string summary_path;
   std::string shm = "impetus";
   double attach_timeout_s = 10.0;
   std::string device_spec = "spidar";
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
       ->required();
   add_clock_flag(app, clock);
   add_output_flag(app, "--log", log_path, "CSV log: time, target, finger, velocity, force, tensions, counts");
+  add_output_flag(app, "--summary", summary_path, "JSON summary written at exit (ticks, finger and device)");
   add_shm_flag(app, shm);
   app.add_option("--attach-timeout", attach_timeout_s, "seconds to wait for the haptic controller's port")
       ->check(CLI::PositiveNumber);
@@ -49,6 +51,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "spidar_sim: attached to '%s' (%s), trajectory %.3f s\n", port.name().c_str(),
                  to_string(clock), trajectory.duration_s());
     const int status = node.run();
+    if (!summary_path.empty()) {
+      std::ofstream summary(summary_path);
+      summary << node.summary().dump(2) << '\n';
+      if (!summary) throw std::runtime_error("cannot write summary '" + summary_path + "'");
+    }
     std::fprintf(stderr, "spidar_sim: detached after %llu ticks (%.3f s simulated)\n",
                  static_cast<unsigned long long>(node.ticks()), sim.time_s());
     return status;

@@ -50,6 +50,7 @@ class SpidarHardware {
   // Tensions the motors apply now (N); start at the minimum so the strings are taut from the first tick.
   const Tensions& tensions_N() const { return tension_N_; }
   const SpidarGeometry& geometry() const { return geometry_; }
+  const HardwareParams& params() const { return params_; }
 
  private:
   SpidarGeometry geometry_;

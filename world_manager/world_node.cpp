@@ -177,6 +177,7 @@ nlohmann::json WorldNode::summary() const {
             {"clock", to_string(options_.clock)},
             {"phase_ticks", options_.phase_ticks},
             {"substeps", scene_.physics.substeps},
+            {"gravity_mps2", {scene_.gravity_mps2[0], scene_.gravity_mps2[1], scene_.gravity_mps2[2]}},
             {"solver_iterations", scene_.physics.solver_iterations}}}};
 }
 

@@ -1,18 +1,10 @@
-"""C++ defaults the scripts need and that no trial output exports yet, kept here once. Each names the flag or field
-it mirrors; if that default changes in C++, change it here too.
+"""C++ defaults the scripts need before any trial has run (a trial's own values are in its summary.json: the haptic
+rate, the force limit, the finger and hand, the scene's gravity), kept here once. Each names the flag or field it
+mirrors; if that default changes in C++, change it here too.
 
 Scene keys a file leaves out take the scene parser's defaults (world_manager/scene.h); scene.py fills them in from the
 SCENE_* values below.
 """
-
-# spidar_sim's finger (FingerParams in spidar_sim/finger.h; flags --finger-mass, --hand-stiffness, --hand-damping).
-FINGER_MASS_KG = 0.1
-HAND_STIFFNESS_NPM = 300.0
-HAND_DAMPING_NSPM = 8.0
-
-# The largest force the haptic controller renders before clamping (SpidarGeometry::max_force_N,
-# common/spidar/geometry.h).
-DEVICE_MAX_FORCE_N = 10.0
 
 # haptic_controller --rate (1000). A trial's own rate is in its summary (Summary.haptic_period_s); this value is for
 # planning trials before any has run (world-clock phases are counted in haptic ticks).

@@ -4,7 +4,6 @@ import math
 
 import numpy as np
 
-from .daemon_defaults import FINGER_MASS_KG, HAND_DAMPING_NSPM, HAND_STIFFNESS_NPM
 
 # ODE contact depth allowance for the energy tolerance (see energy_balance): ODE's steady contact compliance under
 # these loads is micrometres (k = ERP/(h CFM) = 4e6 N/m at h = 5 ms); 1 mm is the transient depth v·h of a body meeting
@@ -63,9 +62,10 @@ def _initial_energy_J(obj, gravity_mps2):
         "position_m", "orientation_wxyz", "linear_velocity_mps", "angular_velocity_radps")))[0]
 
 
-def energy_balance(scene, device, world, world_period_s, haptic_period_s):
+def energy_balance(scene, device, world, finger, world_period_s, haptic_period_s):
     """Energy of finger + dynamic objects against the hand's work, from a trial's scene (scene.Scene), device and
-    world logs (logs.Log).
+    world logs (logs.Log) and the finger and hand it ran with (the summary's "device" section: finger_mass_kg,
+    hand_stiffness_Npm, hand_damping_Nspm).
 
     The system is the finger (point mass m_f) and the dynamic objects. External forces on it: the hand
     F_hand = k_h (target - x) + b_h (target_v - v), gravity (counted as potential energy), the static geometry
@@ -94,8 +94,10 @@ def energy_balance(scene, device, world, world_period_s, haptic_period_s):
     the finger and W_hand at that tick, i.e. with the impulse the world has just applied.
 
     Returns excess_J (the largest E(t) - E(0) - W_hand(t)), at_s, dE_J and W_J (at that time), tolerance_J and its
-    parts quadrature_J and contact_J, W_total_J (the hand's work over the trial) and ok (excess_J <= tolerance_J).
-    The hand's force uses spidar_sim's default finger (daemon_defaults): trials must not override it."""
+    parts quadrature_J and contact_J, W_total_J (the hand's work over the trial) and ok (excess_J <= tolerance_J)."""
+    finger_mass_kg = finger["finger_mass_kg"]
+    hand_stiffness_Npm = finger["hand_stiffness_Npm"]
+    hand_damping_Nspm = finger["hand_damping_Nspm"]
     gravity = scene.gravity_mps2
     g = math.sqrt(sum(x * x for x in gravity))
     dynamic = scene.dynamic_objects
@@ -109,7 +111,7 @@ def energy_balance(scene, device, world, world_period_s, haptic_period_s):
     ticks = np.arange(len(times))
     before, after = np.maximum(ticks - 1, 0), np.minimum(ticks + 1, len(times) - 1)
     target_velocity = (target[after] - target[before]) / (times[after] - times[before])[:, None]
-    hand_force = HAND_STIFFNESS_NPM * (target - position) + HAND_DAMPING_NSPM * (target_velocity - velocity)
+    hand_force = hand_stiffness_Npm * (target - position) + hand_damping_Nspm * (target_velocity - velocity)
     power = _dot3(hand_force, velocity)
     # W_hand by the trapezoid rule at the log's step h, and at 2h for the quadrature tolerance.
     work = np.concatenate(([0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(times))))
@@ -117,7 +119,7 @@ def energy_balance(scene, device, world, world_period_s, haptic_period_s):
     work_coarse = np.cumsum((power[even] + power[even - 2]) * 0.5 * (times[even] - times[even - 2]))
     quadrature = float(np.abs(work[even] - work_coarse).max(initial=0.0))
 
-    finger_kinetic = 0.5 * FINGER_MASS_KG * _dot3(velocity, velocity)
+    finger_kinetic = 0.5 * finger_mass_kg * _dot3(velocity, velocity)
     e0 = float(finger_kinetic[0])
     for obj in dynamic:
         e0 += _initial_energy_J(obj, gravity)

@@ -5,9 +5,13 @@ summarize_trial.py merge it from the daemons' own summaries; every other script 
                       "angular_impulse_Nms"}},                      world_manager: each dynamic object at the end
    "world":   {"steps", "time_s", "period_s", "cpu_per_step_mean_us", "cpu_per_step_p99_us", "cpu_per_simulated_s",
                "skipped_periods", "rejected_reports", ...},          world_manager
-   "haptic":  {"rate_hz", "ticks", "max_force_N", "faults", "force_clamps", "saturations", "infeasible_contacts",
-               "cpu_per_tick_mean_ns", "cpu_per_tick_p99_ns", "lateness_*_ns", ...},   haptic_controller
-   "config":  {"scene", "coupling", "world_rate_hz", "substeps", "phase_ticks", "clock", ...,  world_manager
+   "haptic":  {"rate_hz", "ticks", "max_force_N", "force_limit_N", "stiffness_Npm", "damping_Nspm", "faults",
+               "force_clamps", "saturations", "infeasible_contacts", "cpu_per_tick_mean_ns", "cpu_per_tick_p99_ns",
+               "lateness_*_ns", ...},                                haptic_controller
+   "device":  {"ticks", "finger_mass_kg", "hand_stiffness_Npm", "hand_damping_Nspm", "metres_per_count",
+               "tension_min_N", "tension_max_N", "max_force_N", ...},   spidar_sim
+   "config":  {"scene", "coupling", "world_rate_hz", "substeps", "gravity_mps2", "phase_ticks", "clock", ...,
+                                                                     world_manager
                "trajectory", "rate", "substeps_override", "duration_s", "wall_time_s"}}  run.sh (strings but the last)
 """
 import json
@@ -16,17 +20,19 @@ import math
 FILE_NAME = "summary.json"
 WORLD_FILE_NAME = "world.json"    # world_manager --summary: "objects", "world", "config"
 HAPTIC_FILE_NAME = "haptic.json"  # haptic_controller --summary: "haptic"
+DEVICE_FILE_NAME = "device.json"  # spidar_sim --summary: "device"
 
 
-def merge(world, haptic, config_entries):
-    """The summary of a trial from world_manager's and haptic_controller's --summary documents and run.sh's config
-    entries ({key: string}; they override the world's config). run.sh's wall_start and wall_end (Unix time, s) become
+def merge(world, haptic, device, config_entries):
+    """The summary of a trial from world_manager's, haptic_controller's and spidar_sim's --summary documents and
+    run.sh's config entries ({key: string}; they override the world's config). run.sh's wall_start and wall_end (Unix time, s) become
     wall_time_s, the trial's wall-clock duration."""
     config = dict(world.get("config", {}))
     config.update(config_entries)
     if "wall_start" in config and "wall_end" in config:
         config["wall_time_s"] = float(config.pop("wall_end")) - float(config.pop("wall_start"))
-    return {"objects": world["objects"], "haptic": haptic["haptic"], "world": world["world"], "config": config}
+    return {"objects": world["objects"], "haptic": haptic["haptic"], "device": device["device"], "world": world["world"],
+            "config": config}
 
 
 def to_json(summary):
@@ -42,6 +48,7 @@ class Summary:
         self.objects = document["objects"]
         self.world = document["world"]
         self.haptic = document["haptic"]
+        self.device = document["device"]
         self.config = document["config"]
 
     @classmethod
