@@ -71,6 +71,17 @@ std::array<Eigen::Vector3d, kMaxActiveConstraints + 1> split_by_normals(const Pl
 ImpulseAccumulator::ImpulseAccumulator(std::uint64_t haptic_session) { report_.haptic_session = haptic_session; }
 
 void ImpulseAccumulator::on_plane_frame(const PlaneFrame& frame) {
+  if (frame.world_session != report_.world_session) {
+    // A new world: what the last one did not apply is abandoned, and the totals count against this one from zero.
+    for (std::uint32_t e = 0; e < report_.entry_count; ++e) {
+      for (int a = 0; a < 3; ++a) abandoned_Ns_[a] += report_.entries[e].impulse_Ns[a];
+      report_.entries[e] = ObjectImpulse{};
+    }
+    for (int a = 0; a < 3; ++a) abandoned_Ns_[a] += report_.static_impulse_Ns[a];
+    report_.entry_count = 0;
+    report_.static_impulse_Ns = {};
+    report_.world_session = frame.world_session;
+  }
   applied_this_session_ = frame.report_session_applied == report_.haptic_session;
   applied_tick_ = applied_this_session_ ? frame.report_tick_applied : 0;
 }

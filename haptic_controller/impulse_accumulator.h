@@ -19,7 +19,13 @@
 // use, an entry whose last_tick ≤ the world's report_tick_applied (for this haptic session) is final — the world has
 // applied all of it — and is reused for the new object with a new epoch (a session-wide counter, so an object's epoch
 // changes at every re-allocation). If no entry is final the share is kept in a dropped total and counted; nothing
-// throws or allocates. Invariant: Σ entries + static + evicted + dropped == Σ −f·Δt rendered.
+// throws or allocates.
+//
+// The totals count against one world session (report().world_session, DESIGN.md §6: impulse rendered == impulse
+// applied across a restart of either side). A frame of another world session — a restarted world — starts them
+// afresh: every entry and the static total are moved to the abandoned total, so the new world, which starts from its
+// scene, is given only what is rendered against its own frames. Invariant:
+//     Σ entries + static + evicted + dropped + abandoned == Σ −f·Δt rendered.
 //
 // Each entry also carries the first moments Σ impulse_k·t_k (t_k = report().haptic_time_s, which the servo sets before
 // add()), so the world can place the impulse in time (local coupling, world.h). The shares of the last add() are kept
@@ -50,7 +56,8 @@ class ImpulseAccumulator {
  public:
   explicit ImpulseAccumulator(std::uint64_t haptic_session);
 
-  // Learns how far the world has applied our reports (eviction rule).
+  // Learns how far the world has applied our reports (eviction rule), and starts the totals afresh for a frame of a
+  // new world session.
   void on_plane_frame(const PlaneFrame& frame);
 
   // Adds the reaction of one tick: `force_on_finger_N` rendered for `dt_s` at haptic tick `tick` (≥ 1). With no
@@ -64,6 +71,8 @@ class ImpulseAccumulator {
   const Eigen::Vector3d& total_impulse_Ns() const { return total_Ns_; }      // Σ −f·Δt rendered
   const Eigen::Vector3d& evicted_impulse_Ns() const { return evicted_Ns_; }  // totals of entries reused since
   const Eigen::Vector3d& dropped_impulse_Ns() const { return dropped_Ns_; }  // never reported (table full)
+  // Rendered against a world session that ended before applying it (objects and static geometry).
+  const Eigen::Vector3d& abandoned_impulse_Ns() const { return abandoned_Ns_; }
   std::uint64_t dropped_shares() const { return dropped_shares_; }
 
   // The shares of the last add(), one per active constraint (empty when nothing was pushed).
@@ -80,6 +89,7 @@ class ImpulseAccumulator {
   Eigen::Vector3d total_Ns_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d evicted_Ns_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d dropped_Ns_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d abandoned_Ns_ = Eigen::Vector3d::Zero();
   std::uint64_t dropped_shares_ = 0;
   std::array<ImpulseShare, kMaxActiveConstraints + 1> last_shares_{};
   int last_share_count_ = 0;

@@ -68,7 +68,12 @@ const PlaneFrame& World::step(const HapticReport* report) {
 
   // Step 2: the coupling.
   applied_.begin_step();
-  if (report != nullptr) take_report(*report);
+  // Only totals counted against this world's own frames: a report counted against another world session (a world
+  // that died, or none yet) carries impulse this world never showed, and its objects started afresh from the scene.
+  const HapticReport* applied_report =
+      report != nullptr && report->world_session == options_.world_session ? report : nullptr;
+  if (report != nullptr && applied_report == nullptr) ++foreign_reports_;
+  if (applied_report != nullptr) take_report(*applied_report);
   coupling_->before_step(finger_, features_);
 
   // Step 3: the engine, with the coupling's forces before every substep.
@@ -80,7 +85,7 @@ const PlaneFrame& World::step(const HapticReport* report) {
 
   // Step 4: planes and publication.
   features_.index(states_, period_s_);
-  publish(report);
+  publish(applied_report);
   return frame_;
 }
 
@@ -138,11 +143,11 @@ void World::refresh_states() {
   }
 }
 
-void World::publish(const HapticReport* report) {
+void World::publish(const HapticReport* applied_report) {
   frame_.frame_index = steps_taken_ - 1;
-  if (report != nullptr) {
-    frame_.report_tick_applied = report->tick;
-    frame_.report_session_applied = report->haptic_session;
+  if (applied_report != nullptr) {
+    frame_.report_tick_applied = applied_report->tick;
+    frame_.report_session_applied = applied_report->haptic_session;
   }
   frame_.world_time_s = time_s_;
   frame_.stiffness_Npm = scene_.haptic.stiffness_Npm;

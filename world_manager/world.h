@@ -49,7 +49,7 @@ class World {
   World& operator=(const World&) = delete;
 
   // One world step (DESIGN.md §1.1): read `report` (nullptr: none yet; the transport has validated it), hand its new
-  // impulses to the coupling, advance the engine by T_w in `substeps` substeps, extract the planes around the finger
+  // impulses to the coupling (only if it counts against this world's session), advance the engine by T_w in `substeps` substeps, extract the planes around the finger
   // and return the frame. The reference stays valid until the next step.
   const PlaneFrame& step(const HapticReport* report);
 
@@ -71,6 +71,9 @@ class World {
   const Eigen::Vector3d& total_static_impulse_Ns() const { return total_static_impulse_Ns_; }
   // Report entries ignored because their object id was out of range or their numbers not finite.
   std::uint64_t rejected_entries() const { return rejected_entries_; }
+  // Reports whose totals count against another world session (HapticReport::world_session): their finger is used,
+  // their impulses are not.
+  std::uint64_t foreign_reports() const { return foreign_reports_; }
 
   // Kinetic + gravitational potential energy of the dynamic objects (J), potential measured from the origin.
   double mechanical_energy_J() const;
@@ -78,7 +81,7 @@ class World {
  private:
   void take_report(const HapticReport& report);
   void refresh_states();
-  void publish(const HapticReport* report);
+  void publish(const HapticReport* applied_report);
 
   Scene scene_;
   WorldOptions options_;
@@ -97,6 +100,7 @@ class World {
   std::unique_ptr<CouplingStrategy> coupling_;
   Eigen::Vector3d total_static_impulse_Ns_ = Eigen::Vector3d::Zero();
   std::uint64_t rejected_entries_ = 0;
+  std::uint64_t foreign_reports_ = 0;
 
   FingerState finger_;     // the sampled finger: position coupling's penetration
   ReachQuery plane_query_;  // where planes are extracted: the proxy, reach widened to cover the finger

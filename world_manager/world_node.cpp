@@ -161,6 +161,7 @@ nlohmann::json WorldNode::summary() const {
             {"period_s", world_.world_period_s()},
             {"skipped_periods", stats_.skipped_periods},
             {"rejected_reports", stats_.rejected_frames},
+            {"foreign_reports", world_.foreign_reports()},
             {"lateness_p50_ns", stats_.lateness_p50_ns},
             {"lateness_p99_ns", stats_.lateness_p99_ns},
             {"lateness_max_ns", stats_.lateness_max_ns},

@@ -123,6 +123,10 @@ struct HapticReport {
   std::uint64_t tick = 0;           // haptic tick j of this session
   std::uint64_t haptic_session = 0; // nonzero; changes when the haptic controller restarts
   EndpointId endpoint = 0;          // the finger this report is about
+  // The world session whose frames the totals below were rendered against (0: no frame seen yet). A world applies
+  // only reports of its own session: when a restarted world's first frame arrives the haptic side starts its totals
+  // afresh (ImpulseAccumulator), so nothing rendered against the dead world is applied to the new one.
+  std::uint64_t world_session = 0;
   double haptic_time_s = 0.0;       // session time at this tick
   Vec3 finger_m{};                  // C_j
   Vec3 finger_velocity_mps{};

@@ -63,6 +63,7 @@ void bench_step() {
     impetus::World world(scene, impetus::WorldOptions{});
     impetus::HapticReport report{};
     report.haptic_session = 1;
+    report.world_session = impetus::WorldOptions{}.world_session;
     report.finger_valid = 1;
     report.finger_m = {0.0, 0.0, 0.05};
     const int steps = count >= 2000 ? 40 : 200;

@@ -164,3 +164,42 @@ TEST_CASE("a full table evicts only entries the world has applied, else counts t
   push(1003, 103);
   REQUIRE(accumulator.dropped_shares() == 3);
 }
+
+TEST_CASE("a frame of a new world session starts the totals afresh; what the old world did not apply is abandoned") {
+  ContactPlane cube_top = make_plane({0, 0, 0.05}, {0, 0, 1}, 1, true);
+  cube_top.com_m = Vector3d(0, 0, 0.025);
+  const PlaneSet planes = make_set({make_plane({0, 0, 0}, {0, 0, 1}, 0, false), cube_top});
+  GodObject god;
+  const GodObjectResult& contact = god.solve(planes, Vector3d(0.0, 0.0, 0.045), 1e-3);
+  const Vector3d force_N(0.0, 0.0, 10.0);
+
+  ImpulseAccumulator accumulator(kSession);
+  PlaneFrame frame;
+  frame.world_session = 5;
+  frame.world_period_s = 0.05;
+  accumulator.on_plane_frame(frame);
+  CHECK(accumulator.report().world_session == 5);
+  for (std::uint64_t tick = 1; tick <= 30; ++tick) accumulator.add(planes, contact.contact, force_N, 1e-3, tick);
+  const Vector3d before_restart_Ns = sum_of_entries(accumulator.report());
+  REQUIRE(before_restart_Ns.z() == Approx(-0.3));
+
+  frame.frame_index = 1;  // the same world again: nothing changes
+  accumulator.on_plane_frame(frame);
+  CHECK(sum_of_entries(accumulator.report()) == before_restart_Ns);
+
+  frame.world_session = 6;  // a restarted world
+  frame.frame_index = 0;
+  accumulator.on_plane_frame(frame);
+  const HapticReport& report = accumulator.report();
+  CHECK(report.world_session == 6);
+  CHECK(report.entry_count == 0);
+  CHECK(to_eigen(report.static_impulse_Ns) == Vector3d::Zero());
+  CHECK(accumulator.abandoned_impulse_Ns() == before_restart_Ns);
+  for (std::uint64_t tick = 31; tick <= 40; ++tick) accumulator.add(planes, contact.contact, force_N, 1e-3, tick);
+  CHECK(sum_of_entries(report).z() == Approx(-0.1));  // only what was rendered against the new world
+  // Nothing lost: every rendered impulse is in an entry, the static total or the abandoned total.
+  const Vector3d accounted = sum_of_entries(report) + to_eigen(report.static_impulse_Ns) +
+                             accumulator.abandoned_impulse_Ns() + accumulator.evicted_impulse_Ns() +
+                             accumulator.dropped_impulse_Ns();
+  CHECK((accounted - accumulator.total_impulse_Ns()).norm() < 1e-15);
+}

@@ -20,9 +20,10 @@ struct Daemons {
   std::filesystem::path dir;
   std::string shm;
   std::string scene = std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json";
+  std::string coupling = "impulse";
 
   pid_t world(const std::string& tag) const {
-    return test::spawn({test::binary("world_manager"), "--scene", scene, "--shm", shm, "--log",
+    return test::spawn({test::binary("world_manager"), "--scene", scene, "--coupling", coupling, "--shm", shm, "--log",
                         (dir / ("world" + tag + ".csv")).string(), "--summary", (dir / ("world" + tag + ".json")).string()},
                        dir / ("world" + tag + ".out"));
   }
@@ -87,6 +88,46 @@ TEST_CASE("killing the world manager mid-contact: the haptic controller keeps th
   const auto second = test::read_json(daemons.dir / "world2.json");
   CHECK(second["objects"]["cube"]["impulse_Ns"][2].get<double>() < -0.1);
   CHECK_FALSE(daemons.segments_left());
+}
+
+TEST_CASE("a world restarted mid-press applies only what was rendered after it attached") {
+  // Pressing the cube from above, under each coupling that applies the haptic side's impulses. The finger's running
+  // total on the cube reaches several N·s against the first world; the restarted world's cube starts at rest on the
+  // floor and must stay there (applied at once, that total threw it off at hundreds of m/s under local coupling).
+  for (const char* coupling : {"impulse", "local"}) {
+    INFO(coupling);
+    Daemons daemons = make_daemons(std::string("restartworld-") + coupling);
+    daemons.coupling = coupling;
+    pid_t world = daemons.world("1");
+    const pid_t haptic = daemons.haptic("");
+    const pid_t device = daemons.device("", kPress + "3");
+    sleep_s(1.5);  // about 1 s of pressing
+    kill(world, SIGKILL);
+    CHECK(test::wait_for(world, 5.0) == -1);
+    sleep_s(0.3);
+    world = daemons.world("2");
+    CHECK(test::wait_for(device, 30.0) == 0);
+    stop_like_a_user(haptic, world);
+    INFO(test::read_text(daemons.dir / "haptic.out"));
+
+    const auto haptic_summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
+    CHECK(haptic_summary["world_attaches"] == 2);
+    CHECK(haptic_summary["abandoned_impulse_Ns"][2].get<double>() < -0.5);  // the first world's share, not re-applied
+    const auto world_log = test::read_csv_columns(daemons.dir / "world2.csv");
+    const auto& vx = world_log.at("cube.vx_mps");
+    const auto& vy = world_log.at("cube.vy_mps");
+    const auto& vz = world_log.at("cube.vz_mps");
+    REQUIRE(vz.size() > 10);
+    double fastest_mps = 0.0;
+    for (std::size_t k = 0; k < vz.size(); ++k) {
+      fastest_mps = std::max(fastest_mps, std::sqrt(vx[k] * vx[k] + vy[k] * vy[k] + vz[k] * vz[k]));
+    }
+    // A cube pressed onto the floor by a still finger: any speed a hand could give it is far above what it may reach.
+    CHECK(fastest_mps < 0.1);
+    const auto second = test::read_json(daemons.dir / "world2.json");
+    CHECK(second["objects"]["cube"]["impulse_Ns"][2].get<double>() < -0.1);  // the finger went on pressing it
+    CHECK_FALSE(daemons.segments_left());
+  }
 }
 
 TEST_CASE("killing the haptic controller: the world keeps stepping and a restarted controller causes no burst") {

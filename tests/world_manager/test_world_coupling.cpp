@@ -140,6 +140,29 @@ TEST_CASE("entries on static geometry or unknown ids move nothing") {
   CHECK(close(world->total_static_impulse_Ns(), Vector3d(1.0, 0.0, -0.5)));
 }
 
+TEST_CASE("a report counted against another world session moves nothing, but its finger still brings planes") {
+  // A 1 kg cube in free space. The report's totals were rendered against a world that is gone (a restart), or
+  // before any frame: this world must not apply them, neither now nor later.
+  const json cube{{"name", "cube"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", true},
+                  {"mass_kg", 1.0}, {"position_m", {0.03, 0.0, 0.025}}};
+  auto world = make_world(impetus::parse_scene(impetus::test::free_body_document(cube), "free.json"));
+  HapticReport report = make_report(4, 50, {0.0, 0.0, 0.025}, true);
+  report.world_session = WorldOptions{}.world_session + 1;
+  add_entry(report, 0, 1, {0.5, 0.0, 0.0});
+  const impetus::PlaneFrame& frame = world->step(&report);
+  CHECK(world->total_impulse_Ns(0).norm() == 0.0);
+  CHECK(world->states()[0].velocity_mps.norm() == 0.0);
+  CHECK(world->foreign_reports() == 1);
+  CHECK(frame.plane_count > 0);            // the finger is still where the planes come from
+  CHECK(frame.report_session_applied == 0);  // and nothing counts as applied
+  // The haptic side adopts this world (its totals restart from zero, a new epoch); from then on it is applied.
+  report.world_session = WorldOptions{}.world_session;
+  report.entries[0].epoch = 2;
+  report.entries[0].impulse_Ns = {0.25, 0.0, 0.0};
+  world->step(&report);
+  CHECK(close(world->total_impulse_Ns(0), Vector3d(0.25, 0.0, 0.0)));
+}
+
 TEST_CASE("position coupling pushes with k_p times the penetration, held for the world period") {
   // A 1 kg cube at rest in free space; the finger is 4 mm inside its −x face and still.
   const json cube{{"name", "cube"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", true},

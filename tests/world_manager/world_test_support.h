@@ -34,11 +34,13 @@ inline nlohmann::json free_body_document(const nlohmann::json& object) {
   return nlohmann::json{{"gravity_mps2", {0, 0, 0}}, {"floor", nullptr}, {"objects", {object}}};
 }
 
-// A report from `session` at `tick` with the finger at `finger_m` (valid) and no impulse entries.
+// A report from `session` at `tick` with the finger at `finger_m` (valid) and no impulse entries, counted against
+// the world session WorldOptions gives a test world by default.
 inline HapticReport make_report(std::uint64_t session, std::uint64_t tick, const Vec3& finger_m = {0, 0, 0},
                                 bool finger_valid = false) {
   HapticReport report{};
   report.haptic_session = session;
+  report.world_session = WorldOptions{}.world_session;
   report.tick = tick;
   report.finger_m = finger_m;
   report.finger_valid = finger_valid ? 1u : 0u;

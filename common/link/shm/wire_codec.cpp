@@ -92,6 +92,7 @@ void visit_report_header(A& a, B& b, F&& f) {
   f(a.tick, b.tick);
   f(a.haptic_session, b.haptic_session);
   f(a.endpoint, b.endpoint);
+  f(a.world_session, b.world_session);
   f(a.haptic_time_s, b.haptic_time_s);
   f(a.finger_m, b.finger_m);
   f(a.finger_velocity_mps, b.finger_velocity_mps);

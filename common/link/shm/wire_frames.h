@@ -77,6 +77,7 @@ struct HapticReport {
   std::uint64_t haptic_session = 0;
   EndpointId endpoint = 0;
   std::uint32_t reserved = 0;
+  std::uint64_t world_session = 0;
   double haptic_time_s = 0.0;
   Vec3 finger_m{};
   Vec3 finger_velocity_mps{};
