@@ -7,8 +7,6 @@
 #include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/haptic_node.h"
 
-#include <fstream>
-
 int main(int argc, char** argv) {
   using namespace impetus;
   HapticNodeOptions options;
@@ -48,11 +46,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "haptic_controller: %.0f Hz, %s clock, world at %.1f Hz, device port '%s'\n",
                  options.rate_hz, to_string(options.clock), world.info().world_rate_hz, port.name().c_str());
     const int status = node.run();
-    if (!summary_path.empty()) {
-      std::ofstream summary(summary_path);
-      summary << node.summary().dump(2) << '\n';
-      if (!summary) throw std::runtime_error("cannot write summary '" + summary_path + "'");
-    }
+    write_summary(summary_path, node.summary());
     const ServoCounters& counters = node.servo().counters();
     std::fprintf(stderr, "haptic_controller: %llu ticks, %llu faults, %llu force clamps, %llu saturations\n",
                  static_cast<unsigned long long>(counters.ticks), static_cast<unsigned long long>(counters.faults),

@@ -7,8 +7,6 @@
 #include "spidar_sim/device_node.h"
 #include "spidar_sim/trajectory.h"
 
-#include <fstream>
-
 int main(int argc, char** argv) {
   using namespace impetus;
   std::string trajectory_spec;
@@ -51,11 +49,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "spidar_sim: attached to '%s' (%s), trajectory %.3f s\n", port.name().c_str(),
                  to_string(clock), trajectory.duration_s());
     const int status = node.run();
-    if (!summary_path.empty()) {
-      std::ofstream summary(summary_path);
-      summary << node.summary().dump(2) << '\n';
-      if (!summary) throw std::runtime_error("cannot write summary '" + summary_path + "'");
-    }
+    write_summary(summary_path, node.summary());
     std::fprintf(stderr, "spidar_sim: detached after %llu ticks (%.3f s simulated)\n",
                  static_cast<unsigned long long>(node.ticks()), sim.time_s());
     return status;

@@ -6,8 +6,6 @@
 #include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world_node.h"
 
-#include <fstream>
-
 int main(int argc, char** argv) {
   using namespace impetus;
   WorldNodeOptions options;
@@ -46,11 +44,7 @@ int main(int argc, char** argv) {
     const std::string warnings = node.warnings();
     if (!warnings.empty()) std::fprintf(stderr, "world_manager: warning: %s\n", warnings.c_str());
     const int status = node.run();
-    if (!summary_path.empty()) {
-      std::ofstream summary(summary_path);
-      summary << node.summary().dump(2) << '\n';
-      if (!summary) throw std::runtime_error("cannot write summary '" + summary_path + "'");
-    }
+    write_summary(summary_path, node.summary());
     std::fprintf(stderr, "world_manager: %llu steps, %.3f s simulated\n",
                  static_cast<unsigned long long>(node.world().steps_taken()), node.world().time_s());
     return status;

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <stdexcept>
 
 namespace impetus {
 
@@ -27,6 +29,13 @@ void add_shm_flag(CLI::App& app, std::string& shm) {
 
 void add_output_flag(CLI::App& app, const std::string& flag, std::string& path, const std::string& description) {
   app.add_option(flag, path, description)->check(CLI::Validator(check_writable_path, "WRITABLE"));
+}
+
+void write_summary(const std::string& path, const nlohmann::json& summary) {
+  if (path.empty()) return;
+  std::ofstream out(path);
+  out << summary.dump(2) << '\n';
+  if (!out) throw std::runtime_error("cannot write summary '" + path + "'");
 }
 
 }  // namespace impetus

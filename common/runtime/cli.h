@@ -7,6 +7,7 @@
 #include "common/runtime/process.h"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <exception>
@@ -27,6 +28,10 @@ std::string check_writable_path(const std::string& path);
 void add_clock_flag(CLI::App& app, ClockMode& clock);
 void add_shm_flag(CLI::App& app, std::string& shm);
 void add_output_flag(CLI::App& app, const std::string& flag, std::string& path, const std::string& description);
+
+// Writes a node's half of summary.json to `path` (nothing if it is empty); throws std::runtime_error naming the path
+// if it cannot be written.
+void write_summary(const std::string& path, const nlohmann::json& summary);
 
 // Runs a node's body after the flags were parsed: installs the stop handlers, and turns an exception into
 // "NAME: error: WHAT" on stderr and exit status 1.

@@ -62,20 +62,28 @@ void sleep_s(double seconds) { std::this_thread::sleep_for(std::chrono::duration
 // Pressing down on the cube's top face (z = 0.05) 1 cm deep: the finger stays in contact for the whole hold.
 const std::string kPress = "press:x=0.03,surface_z=0.05,depth=0.01,hold=";
 
+// A 3 s press; after `press_s` the world manager is killed (SIGKILL) and after `gap_s` a new one is started on the
+// same link (logs world1.*, world2.*). Returns when the press is over and both survivors were stopped like a user.
+void restart_world_mid_press(const Daemons& daemons, double press_s, double gap_s) {
+  pid_t world = daemons.world("1");
+  const pid_t haptic = daemons.haptic("");
+  const pid_t device = daemons.device("", kPress + "3");
+  sleep_s(press_s);
+  kill(world, SIGKILL);
+  CHECK(test::wait_for(world, 5.0) == -1);  // killed, not exited
+  sleep_s(gap_s);
+  world = daemons.world("2");
+  CHECK(test::wait_for(device, 30.0) == 0);
+  stop_like_a_user(haptic, world);
+}
+
 }  // namespace
 
 TEST_CASE("killing the world manager mid-contact: the haptic controller keeps the last planes and re-attaches") {
   const Daemons daemons = make_daemons("killworld");
-  pid_t world = daemons.world("1");
-  const pid_t haptic = daemons.haptic("");
-  const pid_t device = daemons.device("", kPress + "3");
-  sleep_s(1.2);  // the press reaches the cube after ~0.4 s
-  kill(world, SIGKILL);
-  CHECK(test::wait_for(world, 5.0) == -1);  // killed, not exited
-  sleep_s(0.5);  // ten world periods without a world: the servo must call its planes stale and keep them
-  world = daemons.world("2");
-  CHECK(test::wait_for(device, 30.0) == 0);
-  stop_like_a_user(haptic, world);
+  // The press reaches the cube after ~0.4 s; 0.5 s without a world is ten world periods: the servo must call its
+  // planes stale and keep them.
+  restart_world_mid_press(daemons, 1.2, 0.5);
   INFO(test::read_text(daemons.dir / "haptic.out"));
 
   const auto summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
@@ -98,16 +106,7 @@ TEST_CASE("a world restarted mid-press applies only what was rendered after it a
     INFO(coupling);
     Daemons daemons = make_daemons(std::string("restartworld-") + coupling);
     daemons.coupling = coupling;
-    pid_t world = daemons.world("1");
-    const pid_t haptic = daemons.haptic("");
-    const pid_t device = daemons.device("", kPress + "3");
-    sleep_s(1.5);  // about 1 s of pressing
-    kill(world, SIGKILL);
-    CHECK(test::wait_for(world, 5.0) == -1);
-    sleep_s(0.3);
-    world = daemons.world("2");
-    CHECK(test::wait_for(device, 30.0) == 0);
-    stop_like_a_user(haptic, world);
+    restart_world_mid_press(daemons, 1.5, 0.3);  // about 1 s of pressing against the first world
     INFO(test::read_text(daemons.dir / "haptic.out"));
 
     const auto haptic_summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
