@@ -73,14 +73,26 @@ start=$(date +%s.%N)
 "$build/haptic_controller/haptic_controller" "${haptic_args[@]}" 2>"$out/haptic.err" & haptic=$!; pids+=("$haptic")
 "$build/spidar_sim/spidar_sim" "${device_args[@]}" 2>"$out/device.err" & device=$!; pids+=("$device")
 
-status=0
 # The trial lasts as long as the trajectory (its final hold lets the objects come to rest), capped by --duration.
 # Then the haptic controller and the world are stopped like a user would, and must exit cleanly.
-wait "$device" || { echo "run.sh: spidar_sim failed:" >&2; cat "$out/device.err" >&2; status=1; }
+device_status=0 haptic_status=0 world_status=0
+wait "$device" || device_status=$?
 kill -TERM "$haptic" 2>/dev/null || true
-wait "$haptic" || { echo "run.sh: haptic_controller failed:" >&2; cat "$out/haptic.err" >&2; status=1; }
+wait "$haptic" || haptic_status=$?
 kill -TERM "$world" 2>/dev/null || true
-wait "$world" || { echo "run.sh: world_manager failed:" >&2; cat "$out/world.err" >&2; status=1; }
+wait "$world" || world_status=$?
+# Failures upstream first: a bad scene stops the world, and the others' errors (no world link, no device port) follow
+# from it.
+status=0
+for name in world haptic device; do
+  var="${name}_status"
+  if ((${!var} != 0)); then
+    case "$name" in world) bin=world_manager ;; haptic) bin=haptic_controller ;; device) bin=spidar_sim ;; esac
+    echo "run.sh: $bin failed (exit ${!var}):" >&2
+    cat "$out/$name.err" >&2
+    status=1
+  fi
+done
 end=$(date +%s.%N)
 trap - INT TERM
 for segment in "/dev/shm/$shm.world" "/dev/shm/$shm.device"; do

@@ -28,15 +28,21 @@ int main(int argc, char** argv) {
   add_output_flag(app, "--summary", summary_path, "JSON summary written at exit (ticks, finger and device)");
   add_shm_flag(app, shm);
   app.add_option("--attach-timeout", attach_timeout_s, "seconds to wait for the haptic controller's port")
+      ->check(finite_number())
       ->check(CLI::PositiveNumber);
   app.add_option("--device", device_spec,
                  "spidar (the built-in geometry) or spidar:FILE.json; must match the haptic controller's");
   app.add_option("--hand-stiffness", finger.hand_stiffness_Npm, "hand impedance stiffness, N/m (300)")
+      ->check(finite_number())
       ->check(CLI::PositiveNumber);
   app.add_option("--hand-damping", finger.hand_damping_Nspm, "hand impedance damping, N·s/m (8)")
+      ->check(finite_number())
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--finger-mass", finger.mass_kg, "finger point mass, kg (0.1)")->check(CLI::PositiveNumber);
+  app.add_option("--finger-mass", finger.mass_kg, "finger point mass, kg (0.1)")
+      ->check(finite_number())
+      ->check(CLI::PositiveNumber);
   app.add_option("--motor-lag", hardware.motor_time_constant_s, "motor time constant, s (0 = ideal)")
+      ->check(finite_number())
       ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 

@@ -14,8 +14,9 @@ int main(int argc, char** argv) {
   CLI::App app{"world_manager: the ODE world of Impetus. Steps a scene at the world rate, applies the haptic "
                "controller's impulses and publishes the planes near the finger."};
   app.add_option("--scene", options.scene_path, "scene file (JSON, see scenes/)")->required()->check(CLI::ExistingFile);
-  app.add_option("--rate", options.rate_hz, "world rate in Hz (default: the scene's physics.world_rate_hz)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--rate", options.rate_hz, "world rate in Hz, 0.1 to 10000 (default: the scene's world_rate_hz)")
+      ->check(finite_number())
+      ->check(CLI::Range(0.1, 10000.0));
   app.add_option("--substeps", options.substeps, "ODE steps per world period (default: the scene's physics.substeps)")
       ->check(CLI::Range(1, 10000));
   app.add_option("--coupling", options.coupling, "impulse (paper §2.2), position (the previous method) or local")
@@ -24,12 +25,14 @@ int main(int argc, char** argv) {
   app.add_option("--phase", options.phase_ticks, "lockstep: world step i happens at haptic tick i*n + PHASE")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--duration", options.duration_s, "seconds of world time to run (default: until stopped)")
+      ->check(finite_number())
       ->check(CLI::PositiveNumber);
   add_output_flag(app, "--log", options.log_path, "CSV log of every dynamic object per step");
   add_output_flag(app, "--summary", summary_path, "JSON summary written at exit (objects, loop statistics)");
   add_shm_flag(app, shm);
   app.add_option("--haptic-rate", options.haptic_rate_hz, "haptic rate the lockstep phase is counted in (1000)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_number())
+      ->check(CLI::Range(100.0, 20000.0));
   CLI11_PARSE(app, argc, argv);
 
   return run_node("world_manager", [&] {

@@ -381,12 +381,69 @@ Scene load_scene(const std::string& path) {
   return parse_scene_text(text.str(), path);
 }
 
+namespace {
+
+// Finds where JSON text first fails to parse, for errors nlohmann reports without a position (a number too large for
+// a double, "1e999", throws out_of_range 406): a SAX pass that accepts everything and stops at the first error.
+class ErrorLocator final : public nlohmann::json::json_sax_t {
+ public:
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return true; }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return true; }
+  bool start_array(std::size_t) override { return true; }
+  bool end_array() override { return true; }
+  bool parse_error(std::size_t bytes_read, const std::string& token, const nlohmann::detail::exception&) override {
+    token_ = token;
+    offset_ = bytes_read >= token.size() ? bytes_read - token.size() : 0;  // the parser has read past the token
+    found_ = true;
+    return false;
+  }
+  bool found() const { return found_; }
+  const std::string& token() const { return token_; }
+  std::size_t offset() const { return offset_; }
+
+ private:
+  bool found_ = false;
+  std::string token_;
+  std::size_t offset_ = 0;
+};
+
+// "line L, column C" of byte `offset` of `text` (both from 1).
+std::string line_and_column(std::string_view text, std::size_t offset) {
+  std::size_t line = 1;
+  std::size_t column = 1;
+  for (std::size_t k = 0; k < offset && k < text.size(); ++k) {
+    if (text[k] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+}  // namespace
+
 Scene parse_scene_text(std::string_view text, const std::string& source_name) {
   nlohmann::json document;
   try {
     document = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::out_of_range& error) {
+    // A number too large for a double ("1e999"): nlohmann gives no position, so find the offending token.
+    ErrorLocator locator;
+    nlohmann::json::sax_parse(text, &locator);
+    const std::string where = locator.found() ? " at " + line_and_column(text, locator.offset()) : "";
+    throw SceneError(source_name + ": not valid JSON" + where + ": number '" + locator.token().substr(0, 40) +
+                     "' is out of range for a double");
   } catch (const nlohmann::json::exception& error) {
-    // Not only parse_error: a number too large for a double ("1e400") throws out_of_range (406) from the parser.
     throw SceneError(source_name + ": not valid JSON: " + error.what());
   }
   return parse_scene(document, source_name);

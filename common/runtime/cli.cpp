@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -10,12 +12,25 @@ namespace impetus {
 
 std::string check_writable_path(const std::string& path) {
   namespace fs = std::filesystem;
+  if (path.empty()) return "the path is empty";
   const fs::path parent = fs::absolute(fs::path(path)).parent_path();
   std::error_code error;
   if (!fs::is_directory(parent, error)) return "directory '" + parent.string() + "' does not exist";
   if (access(parent.c_str(), W_OK) != 0) return "directory '" + parent.string() + "' is not writable";
   if (fs::is_directory(fs::path(path), error)) return "'" + path + "' is a directory";
   return "";
+}
+
+CLI::Validator finite_number() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(input.c_str(), &end);
+        if (input.empty() || end == input.c_str() || *end != '\0') return "'" + input + "' is not a number";
+        if (!std::isfinite(value)) return "must be a finite number, not '" + input + "'";
+        return "";
+      },
+      "FINITE");
 }
 
 void add_clock_flag(CLI::App& app, ClockMode& clock) {

@@ -22,8 +22,11 @@ inline const std::map<std::string, ClockMode> kClockNames{{"realtime", ClockMode
 inline const std::map<std::string, Coupling> kCouplingNames{
     {"impulse", Coupling::impulse}, {"position", Coupling::position}, {"local", Coupling::local}};
 
-// A CLI11 validator for file paths we will write: the directory must exist and be writable.
+// A CLI11 validator for file paths we will write: not empty, the directory must exist and be writable.
 std::string check_writable_path(const std::string& path);
+
+// A CLI11 validator for numeric flags: the value must be a finite number (CLI11's range checks let NaN through).
+CLI::Validator finite_number();
 
 void add_clock_flag(CLI::App& app, ClockMode& clock);
 void add_shm_flag(CLI::App& app, std::string& shm);

@@ -145,6 +145,17 @@ TEST_CASE("scene error: non-finite number") {
   require_error(rate, "/physics/world_rate_hz", "finite");
 }
 
+TEST_CASE("scene error: a number too large for a double names its line and column") {
+  const std::string text = "{\"description\": \"1e999\",\n  \"gravity_mps2\": [0, 0,\n    1e999]}";
+  try {
+    impetus::parse_scene_text(text, "huge.json");
+    FAIL("a number out of range was accepted");
+  } catch (const impetus::SceneError& error) {
+    CHECK_THAT(error.what(), Catch::Contains("huge.json") && Catch::Contains("line 3, column 5") &&
+                                 Catch::Contains("1e999"));
+  }
+}
+
 TEST_CASE("scene error: duplicate name") {
   json second = cube();
   second["position_m"] = {0.2, 0.0, 0.025};
