@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Stability suite ("hard cases"): ten scenes and trajectories under tests/hard_cases/, each run through the
+"""Stability suite ("hard cases"): the scenes and trajectories under tests/hard_cases/, each run through the
 real processes (scripts/run.sh, lockstep clock), each checked for
 
   * no NaN or Inf in any log (device, haptic, world) and no servo fault;
@@ -317,6 +317,30 @@ def check_press_hold(trial):
 REST_TOLERANCE_M = 1e-4
 
 
+def check_static_push(trial):
+    """A steady sideways push well below what friction holds, held 10 s (case 11's trajectories reach their push at
+    2 s): the object must not creep. Creep is the horizontal distance the object moves from PUSH_SETTLED_S to the end;
+    REST_TOLERANCE_M (0.1 mm) is what the 1 kHz truth and position coupling (a force) hold to, with ODE's contact
+    compliance. The case's premise is checked too: the push must be a real fraction of mu*m*g (between 10 and 90 %,
+    mu the contact's combined dynamic coefficient, the one ODE's friction uses), else the case tests nothing."""
+    (name, obj), = trial.objects.items()
+    w = trial.world
+    settled = w["time_s"] >= PUSH_SETTLED_S
+    xs, ys = w[f"{name}.x_m"][settled], w[f"{name}.y_m"][settled]
+    creep = max(math.hypot(x - xs[0], y - ys[0]) for x, y in zip(xs.tolist(), ys.tolist()))
+    h = trial.haptic.rows(trial.haptic["time_s"] >= PUSH_SETTLED_S)
+    push = float(np.mean(np.hypot(h["force_x"], h["force_y"])))
+    mu = math.sqrt(obj["dynamic_friction"] * trial.scene.floor_dynamic_friction)
+    holdable = mu * obj["mass_kg"] * abs(trial.scene.gravity_mps2[2])
+    ratio = push / holdable
+    ok = creep <= REST_TOLERANCE_M and 0.1 <= ratio <= 0.9 and trial.end_s >= PUSH_SETTLED_S + 9.0
+    return ok, (f"crept {1e6 * creep:.1f} um over {trial.end_s - PUSH_SETTLED_S:.1f} s under a {push:.2f} N push "
+                f"({100 * ratio:.0f} % of mu m g = {holdable:.2f} N)"), []
+
+
+PUSH_SETTLED_S = 2.5
+
+
 def check_stack(trial):
     """Stack with 1000:1 mass ratios pressed from above: every box stays at its rest pose within
     STACK_TOLERANCE_M (a collapsing or sinking stack moves by centimetres; 1 mm is 40x ODE's steady compliance under
@@ -493,6 +517,12 @@ CASES = [
      check_start_inside),
     ("10", "10 Hz world, 200 balls stirred", "c10_many_spheres.json",
      "circle:radius=0.04,period=1,cx=0,cy=0,cz=0.012,turns=3", 10, check_many_spheres),
+    ("11a", "static friction: 1 N on a 1 kg cube, 10 s", "c11a_static_push.json", "c11a_static_push.csv", None,
+     check_static_push),
+    ("11b", "static friction: yawed light cube, 10 Hz world", "c11b_static_push_yawed.json",
+     "c11b_static_push_yawed.csv", 10, check_static_push),
+    ("11c", "static friction: 2 kg box, 1 kHz world (reference)", "c11c_static_push_heavy.json",
+     "c11c_static_push_heavy.csv", 1000, check_static_push),
 ]
 
 

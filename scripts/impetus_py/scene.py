@@ -9,7 +9,8 @@ from . import daemon_defaults
 
 class Scene:
     """One parsed scene file. `objects` maps each object's name to its JSON object (file order) with the optional
-    keys the scripts read filled in: orientation_wxyz, linear_velocity_mps, angular_velocity_radps, static_friction."""
+    keys the scripts read filled in: orientation_wxyz, linear_velocity_mps, angular_velocity_radps, static_friction,
+    dynamic_friction."""
 
     def __init__(self, path):
         self.path = pathlib.Path(path)
@@ -37,6 +38,15 @@ class Scene:
         return None if floor is None else floor.get("static_friction", daemon_defaults.SCENE_FRICTION)
 
     @property
+    def floor_dynamic_friction(self):
+        """The floor's dynamic friction coefficient (its static one when only that is given), or None without a
+        floor."""
+        floor = self.data.get("floor", {})
+        if floor is None:
+            return None
+        return floor.get("dynamic_friction", floor.get("static_friction", daemon_defaults.SCENE_FRICTION))
+
+    @property
     def substeps(self):
         """ODE steps per world period when world_manager gets no --substeps."""
         return int(self.data.get("physics", {}).get("substeps", daemon_defaults.SCENE_SUBSTEPS))
@@ -62,4 +72,5 @@ def _with_defaults(obj):
     filled.setdefault("linear_velocity_mps", [0.0, 0.0, 0.0])
     filled.setdefault("angular_velocity_radps", [0.0, 0.0, 0.0])
     filled.setdefault("static_friction", daemon_defaults.SCENE_FRICTION)
+    filled.setdefault("dynamic_friction", filled["static_friction"])  # one coefficient given: both
     return filled

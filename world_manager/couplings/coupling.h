@@ -3,7 +3,8 @@
 // --coupling. The World hands each strategy the new impulse the ledger found per dynamic object, lets it add forces
 // before every engine substep, and lets it annotate the frame it publishes.
 //
-//   impulse   (paper §2.2, §3.5)  the impulse as an instantaneous velocity change, once per world step
+//   impulse   (paper §2.2, §3.5)  the impulse as a velocity change at the step's start, but for the part the
+//                                  object's contacts can hold by friction, held as a force over the step
 //   position  (the paper's previous method, §2.3)  a penalty force from the sampled finger, held over the step
 //   local     (paper §6.3)  each impulse placed at the time it was rendered; frames carry contacts for the model
 
@@ -93,6 +94,8 @@ class CouplingStrategy : public SubstepHook {
   // a force over a substep), with the inertia at the current orientation: Δω = I_world⁻¹·L. Wakes the body.
   void apply_velocity_change(std::size_t id, const Eigen::Vector3d& impulse_Ns,
                              const Eigen::Vector3d& angular_impulse_Nms);
+  // The velocity change alone; the caller records the impulse in context_.applied.
+  void change_velocity(std::size_t id, const Eigen::Vector3d& impulse_Ns, const Eigen::Vector3d& angular_impulse_Nms);
 
   CouplingContext context_;
 };

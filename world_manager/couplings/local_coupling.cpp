@@ -1,5 +1,7 @@
 #include "world_manager/couplings/local_coupling.h"
 
+#include "world_manager/couplings/substep_spread.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -26,6 +28,9 @@ void LocalCoupling::schedule(std::size_t id, const ImpulseDelta& delta, const Im
   const double period_s = context_.world_period_s;
   const double h = period_s / substeps;
   const double scale = period_s / window.length_s;  // lockstep: 1; real time: the window mapped onto this step
+  // A body touching something gets its impulse within the substeps, where its contacts see it (apply_slot); a free
+  // body may also take some at the window's end, as a velocity change after the last substep.
+  const int slot_count = context_.engine.contacts().touching(static_cast<std::int32_t>(id)) ? substeps : substeps + 1;
   auto place = [&](double amount, double first_moment, int axis, std::vector<Eigen::Vector3d>& slots) {
     // Moment about the window's start, mapped onto this step: Σ J_k·c_k with c_k ∈ [0, T_w].
     const double moment_about_start = (first_moment - window.start_s * amount) * scale;
@@ -35,11 +40,8 @@ void LocalCoupling::schedule(std::size_t id, const ImpulseDelta& delta, const Im
     }
     const double c = amount != 0.0 ? moment_about_start / amount : -1.0;
     if (c >= 0.0 && c <= period_s) {
-      const double position = c / h;
-      const int k = std::min(static_cast<int>(std::floor(position)), substeps);
-      const double alpha = k < substeps ? position - k : 0.0;
-      slots[static_cast<std::size_t>(k)][axis] += (1.0 - alpha) * amount;
-      if (alpha > 0.0) slots[static_cast<std::size_t>(k + 1)][axis] += alpha * amount;
+      spread_over_slots(c / h, slot_count,
+                        [&](int slot, double weight) { slots[static_cast<std::size_t>(slot)][axis] += weight * amount; });
     } else if (amount != 0.0 || moment_about_start != 0.0) {
       // The impulse changed sign within the window (its centroid lies outside it, or it summed to zero): split it
       // between the window's ends, b at T_w and a = J − b at 0, with b·T_w = Σ J_k·c_k: still exact in momentum and

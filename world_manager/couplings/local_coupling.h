@@ -7,13 +7,18 @@
 // J_k·(t_end − t_k)/m by the end of the window. The engine's semi-implicit Euler step gives a force held during
 // substep s (length h) exactly the effect of an impulse at time s·h (v changes at the end of the substep, x then
 // integrates the new v), so the world reproduces both the momentum Σ J_k and the displacement Σ J_k·(t_end − t_k)/m by
-// putting each axis's impulse at its centroid time
+// giving each axis's impulse the centroid time
 //     c = (Σ J_k·t_k − t_start·Σ J_k) / Σ J_k      (from the report's first moments, contract/frames.h)
-// split between the two substeps around c: (1 − α) at ⌊c/h⌋ and α at ⌊c/h⌋ + 1, α = frac(c/h). Slot `substeps` is
-// the end of the window (an impulse in the very last tick). The world's next state then agrees with what the finger
-// felt exactly for a free body (up to h·J/m for an impulse at the very end); with contacts, up to how friction sees the
-// impulse compressed to its centroid (it only acts while the object slides: ≈ 0.3 mm at the start of a tap, while
-// the contact itself is blended, local_dynamics.h).
+// spread over the substeps as a ramp with that centroid (substep_spread.h): any non-negative spread with centroid c
+// has the same end state for a free body, and a spread one lets contact friction meet a steady push as the force it
+// was (a push concentrated in one substep meets that substep's friction budget only, and a resting object creeps).
+// Slot `substeps` is the end of the window (an impulse in the very last tick); a body touching something is spread
+// over the substeps only (c clamped to the last one). The world's next state then agrees with what the finger felt
+// exactly for a free body (up to h·J/m for an impulse at the very end); with contacts, up to how friction sees the
+// spread (it only acts while the object slides; the contact itself is blended, local_dynamics.h).
+//
+// Limit: with one haptic tick per world step (a world as fast as the haptic loop) the centroid is that tick's instant,
+// the window's end, and the impulse goes into one substep; a steady push then meets one substep's friction budget.
 
 #include "world_manager/couplings/coupling.h"
 

@@ -2,6 +2,7 @@
 
 #include <ode/ode.h>
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -40,11 +41,38 @@ struct OdeEngine::Handles {
   unsigned long random_state = 0;   // ODE's generator state between this engine's steps
   bool record_contacts = false;
   ContactGraph contact_graph;
+  // The contacts of the recording substep, kept until the step has computed their forces.
+  struct RecordedContact {
+    dJointID joint;
+    std::int32_t id_a, id_b;  // kStatic for a side without a body
+    Eigen::Vector3d normal;   // pushes a out of b
+    double friction;
+  };
+  std::vector<RecordedContact> recorded;
+  std::vector<dJointFeedback> feedback;  // one per recorded contact; sized before the step so the addresses hold
 
   ~Handles() {
     if (contacts != nullptr) dJointGroupDestroy(contacts);
     if (space != nullptr) dSpaceDestroy(space);  // destroys the geoms it holds (cleanup mode on)
     if (world != nullptr) dWorldDestroy(world);  // destroys the bodies
+  }
+
+  // The recorded contacts into the graph, each with the normal force the step found: |f·n| of the force the joint put
+  // on its first body (the normal component is the same, opposite, on the other; friction is perpendicular to n).
+  void record_graph() {
+    contact_graph.reset(scene->objects.size());
+    for (std::size_t c = 0; c < recorded.size(); ++c) {
+      const RecordedContact& contact = recorded[c];
+      const dReal* f = feedback[c].f1;
+      const double normal_force_N = std::abs(contact.normal.dot(Eigen::Vector3d(f[0], f[1], f[2])));
+      if (contact.id_a != ContactGraph::kStatic) {
+        contact_graph.add(contact.id_a, contact.id_b, contact.normal, contact.friction, normal_force_N);
+      }
+      if (contact.id_b != ContactGraph::kStatic) {
+        contact_graph.add(contact.id_b, contact.id_a, -contact.normal, contact.friction, normal_force_N);
+      }
+    }
+    contact_graph.finish();
   }
 
   // ODE's near callback: contact joints with the two materials combined (scene.h combine_*).
@@ -78,14 +106,9 @@ struct OdeEngine::Handles {
         const dReal* n = contacts[i].geom.normal;
         const Eigen::Vector3d normal(n[0], n[1], n[2]);
         if (!(normal.squaredNorm() > 0.0) || !normal.allFinite()) continue;
-        const auto id_a = static_cast<std::int32_t>(data_to_id(dGeomGetData(a)));
-        const auto id_b = static_cast<std::int32_t>(data_to_id(dGeomGetData(b)));
-        if (body_a != nullptr) {
-          self->contact_graph.add(id_a, body_b != nullptr ? id_b : ContactGraph::kStatic, normal, surface.mu);
-        }
-        if (body_b != nullptr) {
-          self->contact_graph.add(id_b, body_a != nullptr ? id_a : ContactGraph::kStatic, -normal, surface.mu);
-        }
+        const auto id_a = body_a != nullptr ? static_cast<std::int32_t>(data_to_id(dGeomGetData(a))) : ContactGraph::kStatic;
+        const auto id_b = body_b != nullptr ? static_cast<std::int32_t>(data_to_id(dGeomGetData(b))) : ContactGraph::kStatic;
+        self->recorded.push_back({joint, id_a, id_b, normal, surface.mu});
       }
     }
   }
@@ -216,15 +239,20 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
   for (int substep = 0; substep < substeps; ++substep) {
     hook.before_substep(substep);
     ode.record_contacts = record_contacts && substep + 1 == substeps;
-    if (ode.record_contacts) ode.contact_graph.reset(scene.objects.size());
+    const bool recording = ode.record_contacts;
+    if (recording) ode.recorded.clear();
     dSpaceCollide(ode.space, &ode, &Handles::near_callback);
-    if (ode.record_contacts) ode.contact_graph.finish();
     ode.record_contacts = false;
+    if (recording) {
+      ode.feedback.resize(ode.recorded.size());
+      for (std::size_t c = 0; c < ode.recorded.size(); ++c) dJointSetFeedback(ode.recorded[c].joint, &ode.feedback[c]);
+    }
     if (scene.physics.solver == PhysicsParams::Solver::direct) {
       dWorldStep(ode.world, substep_s);
     } else {
       dWorldQuickStep(ode.world, substep_s);
     }
+    if (recording) ode.record_graph();
     dJointGroupEmpty(ode.contacts);
   }
   ode.random_state = dRandGetSeed();

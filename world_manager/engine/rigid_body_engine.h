@@ -40,8 +40,9 @@ class RigidBodyEngine {
   virtual void add_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m) = 0;
 
   // Advances `substeps` substeps of `substep_s` each, calling hook.before_substep(s) first in each. With
-  // `record_contacts` the contacts of the last substep replace contacts(). Reproducible: the same calls from the same
-  // state give the same bits, whatever other engines in the process do.
+  // `record_contacts` the contacts of the last substep, each with the normal force the substep found for it, replace
+  // contacts() once that substep is done. Reproducible: the same calls from the same state give the same bits,
+  // whatever other engines in the process do.
   virtual void step(int substeps, double substep_s, bool record_contacts, SubstepHook& hook) = 0;
 
   // The contacts recorded by the last step that recorded them.

@@ -23,11 +23,13 @@ void ContactGraph::reset(std::size_t body_count) {
   if (visited_.size() != body_count) visited_.assign(body_count, 0);
 }
 
-void ContactGraph::add(std::int32_t body, std::int32_t other, const Eigen::Vector3d& normal, double friction) {
+void ContactGraph::add(std::int32_t body, std::int32_t other, const Eigen::Vector3d& normal, double friction,
+                       double normal_force_N) {
   if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return;
   if (other != kStatic && (other < 0 || static_cast<std::size_t>(other) >= body_count_)) return;
   if (!(normal.squaredNorm() > 0.0) || !normal.allFinite() || !std::isfinite(friction)) return;
-  pending_.push_back({body, {other, normal.normalized(), std::max(0.0, friction)}});
+  const double force_N = std::isfinite(normal_force_N) ? std::max(0.0, normal_force_N) : 0.0;
+  pending_.push_back({body, {other, normal.normalized(), std::max(0.0, friction), force_N}});
 }
 
 void ContactGraph::finish() {
@@ -38,6 +40,14 @@ void ContactGraph::finish() {
   edges_.resize(pending_.size());
   cursor_.assign(first_edge_.begin(), first_edge_.end() - 1);
   for (const PendingEdge& p : pending_) edges_[cursor_[static_cast<std::size_t>(p.body)]++] = p.edge;
+}
+
+double ContactGraph::friction_capacity_N(std::int32_t body) const {
+  if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return 0.0;
+  const auto b = static_cast<std::size_t>(body);
+  double capacity_N = 0.0;
+  for (std::size_t e = first_edge_[b]; e < first_edge_[b + 1]; ++e) capacity_N += edges_[e].friction * edges_[e].normal_force_N;
+  return capacity_N;
 }
 
 bool ContactGraph::holds(std::int32_t body, const Eigen::Vector3d& direction) {

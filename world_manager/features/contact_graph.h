@@ -33,8 +33,10 @@ class ContactGraph {
   // Forget the contacts; bodies are 0 … body_count − 1.
   void reset(std::size_t body_count);
 
-  // One contact point: `normal` (unit) pushes `body` out of `other` (a body id or kStatic); `friction` is the pair's μ.
-  void add(std::int32_t body, std::int32_t other, const Eigen::Vector3d& normal, double friction);
+  // One contact point: `normal` (unit) pushes `body` out of `other` (a body id or kStatic); `friction` is the pair's μ;
+  // `normal_force_N` what the contact pushed with in its substep (≥ 0; 0 when unknown).
+  void add(std::int32_t body, std::int32_t other, const Eigen::Vector3d& normal, double friction,
+           double normal_force_N = 0.0);
 
   // After the last add(): index the contacts by body.
   void finish();
@@ -50,6 +52,10 @@ class ContactGraph {
            first_edge_[static_cast<std::size_t>(body) + 1] > first_edge_[static_cast<std::size_t>(body)];
   }
 
+  // Σ μ·N over `body`'s contacts (N: each contact's normal force in the recorded substep): the most tangential force
+  // its contacts' friction can hold (N). 0 for a body without contacts or with unknown forces.
+  double friction_capacity_N(std::int32_t body) const;
+
   // Whether `body`, pushed along `direction` (unit), is held by a chain of contacts to static geometry (header).
   bool holds(std::int32_t body, const Eigen::Vector3d& direction);
 
@@ -58,6 +64,7 @@ class ContactGraph {
     std::int32_t other;
     Eigen::Vector3d normal;
     double friction;
+    double normal_force_N;
   };
   struct PendingEdge {
     std::int32_t body;

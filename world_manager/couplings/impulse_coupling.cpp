@@ -1,0 +1,45 @@
+#include "world_manager/couplings/impulse_coupling.h"
+
+#include <algorithm>
+
+namespace impetus {
+
+ImpulseCoupling::ImpulseCoupling(const CouplingContext& context)
+    : CouplingStrategy(context),
+      force_N_(context.scene.objects.size(), Eigen::Vector3d::Zero()),
+      torque_Nm_(context.scene.objects.size(), Eigen::Vector3d::Zero()) {
+  held_.reserve(context.scene.objects.size());
+}
+
+void ImpulseCoupling::take_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta&, bool,
+                                   const RenderWindow&) {
+  const double period_s = context_.world_period_s;
+  const double holdable_Ns = context_.engine.contacts().friction_capacity_N(static_cast<std::int32_t>(id)) * period_s;
+  const double magnitude_Ns = delta.impulse_Ns.norm();
+  const double held_share = !(holdable_Ns > 0.0) ? 0.0 : magnitude_Ns > holdable_Ns ? holdable_Ns / magnitude_Ns : 1.0;
+  if (held_share < 1.0) {
+    change_velocity(id, (1.0 - held_share) * delta.impulse_Ns, (1.0 - held_share) * delta.angular_impulse_Nms);
+  }
+  if (held_share > 0.0) {
+    if (force_N_[id].isZero(0.0) && torque_Nm_[id].isZero(0.0)) held_.push_back(id);
+    force_N_[id] += held_share * delta.impulse_Ns / period_s;
+    torque_Nm_[id] += held_share * delta.angular_impulse_Nms / period_s;
+    context_.engine.wake(id);
+  }
+  context_.applied.add(id, delta.impulse_Ns, delta.angular_impulse_Nms);
+}
+
+void ImpulseCoupling::before_substep(int) {
+  // The engine clears forces after every substep: hand them in again each time.
+  for (const std::size_t id : held_) context_.engine.add_force(id, force_N_[id], torque_Nm_[id]);
+}
+
+void ImpulseCoupling::after_step() {
+  for (const std::size_t id : held_) {
+    force_N_[id].setZero();
+    torque_Nm_[id].setZero();
+  }
+  held_.clear();
+}
+
+}  // namespace impetus
