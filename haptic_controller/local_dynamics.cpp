@@ -102,6 +102,7 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
       body.velocity_mps = to_eigen(plane.velocity_mps);
       body.angular_velocity_radps = to_eigen(plane.angular_velocity_radps);
       body.contact_count = std::min(plane.local_contact_count, kMaxLocalContacts);
+      body.sphere_radius_m = (plane.flags & kPlaneSphere) != 0 && plane.extent_m > 0.0 ? plane.extent_m : 0.0;
       for (std::uint32_t c = 0; c < body.contact_count; ++c) {
         body.contact_normal[c] = to_eigen(plane.local_contacts[c].normal);
         body.contact_friction[c] = plane.local_contacts[c].friction;
@@ -157,11 +158,29 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
   for (std::uint32_t c = 0; c < body.contact_count; ++c) {
     if (!(normal_impulse[c] > 0.0)) continue;
     const Eigen::Vector3d& n = body.contact_normal[c];
+    const double limit = body.contact_friction[c] * normal_impulse[c];
+    if (body.sphere_radius_m > 0.0 && body.inverse_mass_per_kg > 0.0) {
+      // At the contact point (header): an impulse |j| against the slip lowers it by k·|j|,
+      // k = 1 + m·t·((I⁻¹(c × t)) × c), the sphere's effective inverse mass along t at c (7/2 for a solid ball).
+      Eigen::Vector3d& w = body.angular_velocity_radps;
+      const Eigen::Vector3d lever = -body.sphere_radius_m * n;
+      const Eigen::Vector3d point_velocity = v + w.cross(lever);
+      const Eigen::Vector3d slip = point_velocity - point_velocity.dot(n) * n;
+      const double slip_mps = slip.norm();
+      if (!(slip_mps > 0.0)) continue;
+      const Eigen::Vector3d t = slip / slip_mps;
+      const Eigen::Matrix3d spin_per_impulse = body.inverse_inertia_world / body.inverse_mass_per_kg;  // m·I⁻¹
+      const double k = 1.0 + t.dot((spin_per_impulse * lever.cross(t)).cross(lever));
+      const Eigen::Vector3d j = -std::min(slip_mps / k, limit) * t;
+      v += j;
+      w += spin_per_impulse * lever.cross(j);
+      continue;
+    }
     const Eigen::Vector3d slip = v - v.dot(n) * n;
     const double slip_mps = slip.norm();
-    if (slip_mps > 0.0) v -= std::min(slip_mps, body.contact_friction[c] * normal_impulse[c]) / slip_mps * slip;
+    if (slip_mps > 0.0) v -= std::min(slip_mps, limit) / slip_mps * slip;
   }
-  // Rotation is left free: supports do not stop a ball rolling, and where they would stop a box tipping the model
+  // Rotation is otherwise left free: supports do not stop a ball rolling, and where they would stop a box tipping the model
   // over-predicts the surface's motion, the passive error. Stopping it would let the finger's friction spin a ball
   // in the world far past rolling with the finger, since the model would see its surface still.
 }

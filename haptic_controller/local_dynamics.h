@@ -18,6 +18,11 @@
 //       most the weight it carries, P ≤ max(0, −g·n)·h: it holds the body up but yields to the finger's push
 //       v_t = v − (v·n)·n;  v ← v − min(|v_t|, μ·P)·v_t/|v_t|   ... and their Coulomb friction (cube on a floor:
 //                                                                μ·g·Δt of speed per tick, as in the world)
+//       a sphere's friction acts at its contact point c = −r·n from the centre: the slip is that point's velocity,
+//       s = (v + ω × c)_t, and the friction impulse j (per unit mass, against s, |j| ≤ μ·P, at most what stops the
+//       slip) changes both: v ← v + j, ω ← ω + m·I⁻¹·(c × j). A rolling ball (s = 0) keeps its speed, as in the
+//       world; a sliding one spins up to rolling. Without it the model would brake a rolling ball at μ·g and the
+//       world's ball would arrive where the model's was not yet (an object that comes to the finger).
 //     ω free (supports act on v only: a rolling ball keeps its spin; a box's tipping is over-predicted, passively)
 //   each tick, before the planes are rendered:
 //     u ← u + v·Δt                                              CoM displacement since the frame
@@ -88,6 +93,7 @@ struct LocalBody {
   std::array<double, kMaxLocalContacts> contact_friction{};
   std::array<bool, kMaxLocalContacts> contact_holds{};  // kContactHolds: the other side holds the finger's push
   std::uint32_t contact_count = 0;
+  double sphere_radius_m = 0.0;  // > 0 for a sphere (kPlaneSphere): its supports touch it at com − r·n
   bool touched = false;       // the finger pushed it in the last tick
   Eigen::Vector3d pushed_Ns = Eigen::Vector3d::Zero();  // Σ J since the frame (diagnostics, tests)
 

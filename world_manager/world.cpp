@@ -153,7 +153,9 @@ void World::publish(const HapticReport* applied_report) {
   frame_.stiffness_Npm = scene_.haptic.stiffness_Npm;
   frame_.damping_Nspm = scene_.haptic.damping_Nspm;
   // Without a finger there is nothing to be near: no planes until a device reports one.
-  frame_.plane_count = finger_.valid ? features_.extract(plane_query_, states_, period_s_, frame_.planes) : 0;
+  plane_faces_.begin_step(states_.size());
+  frame_.plane_count =
+      finger_.valid ? features_.extract(plane_query_, states_, period_s_, frame_.planes, &plane_faces_) : 0;
   if (!finger_.valid) frame_.planes.fill(Plane{});
   coupling_->annotate(frame_);
 }

@@ -96,6 +96,7 @@ class World {
   std::uint64_t last_report_session_ = 0;
   double last_report_time_s_ = 0.0;
   FeatureExtractor features_;
+  FeatureMemory plane_faces_;  // the face of each object the plane query (the proxy) met, step to step
   AppliedImpulses applied_;
   std::unique_ptr<CouplingStrategy> coupling_;
   Eigen::Vector3d total_static_impulse_Ns_ = Eigen::Vector3d::Zero();

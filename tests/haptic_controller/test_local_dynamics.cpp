@@ -281,3 +281,39 @@ TEST_CASE("local dynamics: a spinning ball's plane does not sweep into a finger 
   }
   REQUIRE(closest_m == Approx(0.0002).margin(1e-9));
 }
+
+namespace {
+
+// A ball of radius 1 cm resting on the floor (support +z, friction 0.5) and moving at `velocity`, spinning at `spin`.
+Plane ball_on_floor(const Vector3d& velocity_mps, const Vector3d& spin_radps) {
+  Plane plane = spinning_ball(Vector3d(0.0, 0.0, 0.01), spin_radps);
+  plane.flags |= impetus::kPlaneSphere;
+  plane.extent_m = 0.01;
+  plane.velocity_mps = to_vec3(velocity_mps);
+  add_support(plane, Vector3d::UnitZ(), 0.5);
+  return plane;
+}
+
+}  // namespace
+
+TEST_CASE("local dynamics: a ball rolling on the floor keeps its speed; a sliding one spins up to rolling at 5/7") {
+  // The floor's friction acts at the contact point, as in the world: braking a rolling ball at μ·g would leave the
+  // model's ball behind the world's when it comes to the finger.
+  SECTION("rolling without slipping: v = ω × (r·z)") {
+    LocalDynamics model;
+    model.on_plane_frame(grounded_frame(ball_on_floor(Vector3d(1.0, 0, 0), Vector3d(0, 100.0, 0))), nullptr,
+                         Vector3d(-0.1, 0, 0.01));
+    for (int tick = 0; tick < 50; ++tick) model.advance(kTick_s);
+    CHECK(model.find(5)->velocity_mps.x() == Approx(1.0).epsilon(1e-12));
+    CHECK(model.find(5)->angular_velocity_radps.y() == Approx(100.0).epsilon(1e-12));
+  }
+  SECTION("sliding without spin: friction slows it and spins it up until it rolls, at 5/7 of its speed") {
+    LocalDynamics model;
+    model.on_plane_frame(grounded_frame(ball_on_floor(Vector3d(1.0, 0, 0), Vector3d::Zero())), nullptr,
+                         Vector3d(-0.1, 0, 0.01));
+    for (int tick = 0; tick < 100; ++tick) model.advance(kTick_s);  // rolling after 2v/(7μg) = 58 ms
+    const double v = model.find(5)->velocity_mps.x();
+    CHECK(v == Approx(5.0 / 7.0).epsilon(1e-9));
+    CHECK(model.find(5)->angular_velocity_radps.y() * 0.01 == Approx(v).epsilon(1e-9));
+  }
+}

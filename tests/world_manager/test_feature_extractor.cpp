@@ -155,3 +155,129 @@ TEST_CASE("planes carry the object's state, friction and the floor") {
   CHECK(floor.point_m[2] == 0.0);
   CHECK(frame.stiffness_Npm == 2000.0);
 }
+
+TEST_CASE("a query an object moved onto keeps the face it met, for every shape and orientation; without memory it "
+          "gets the far face") {
+  // An object sweeps along -x onto a still query point, 0.6 of its x extent per step (faster than half its size in
+  // one world period), starting just clear of the query. The face the query met is the one it stays on.
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 200; ++trial) {
+    Scene scene;
+    scene.floor.present = false;
+    SceneObject object;
+    object.name = "o";
+    object.shape.kind = static_cast<ShapeKind>(trial % 4);
+    object.shape.box_size_m = {0.05, 0.04, 0.03};
+    object.shape.radius_m = 0.02;
+    object.shape.length_m = 0.04;
+    object.dynamic = true;
+    object.mass_kg = 0.5;
+    scene.objects.push_back(object);
+    std::vector<ObjectState> states(1);
+    states[0].pose.orientation = Eigen::Quaterniond::UnitRandom();
+    // Start with the object's -x extreme 1 mm beyond the query (world bounds are tight for every shape).
+    const Vector3d query(0.0, 0.0, 0.0);
+    const double reach_minus_x_m = -impetus::world_bounds(object.shape, states[0].pose).min().x();
+    states[0].pose.position_m = Vector3d(reach_minus_x_m + 0.001, 0.0, 0.0);
+    states[0].velocity_mps = Vector3d(-1.0, 0.0, 0.0);
+    FeatureExtractor extractor(scene);
+    impetus::FeatureMemory memory;
+    ReachQuery finger;
+    finger.position_m = query;
+    std::vector<ReachCandidate> found;
+    memory.begin_step(1);
+    extractor.index(states, kPeriod_s);
+    extractor.within_reach(finger, states, kPeriod_s, found, &memory);
+    REQUIRE(found.size() == 1);
+    const Vector3d met_normal = found[0].surface.normal;
+    INFO("trial " << trial << " shape " << impetus::to_string(object.shape.kind));
+    // Now sweep the object onto the query in steps; the query is inside from the second step on.
+    const double width_m = 2.0 * reach_minus_x_m;
+    for (int step = 1; step <= 3; ++step) {
+      states[0].pose.position_m.x() -= 0.3 * width_m;
+      memory.begin_step(1);
+      extractor.index(states, kPeriod_s);
+      extractor.within_reach(finger, states, kPeriod_s, found, &memory);
+      REQUIRE(found.size() == 1);
+      const impetus::SurfacePoint& kept = found[0].surface;
+      const impetus::SurfacePoint nearest = impetus::nearest_surface_point(object.shape, states[0].pose, query);
+      if (nearest.signed_distance_m < 0.0 && step >= 2) {
+        // Past the middle (the object moved 0.6 of its width onto the query): the face is still on the side the
+        // query came from, behind the query, while the nearest face has turned to the other side. A box keeps the
+        // very face it met; a curved surface a normal on the same side (within 90°).
+        if (object.shape.kind == ShapeKind::box) CHECK(kept.normal.dot(met_normal) > 0.99);
+        CHECK(kept.normal.dot(met_normal) > 0.0);
+        CHECK(kept.signed_distance_m < 0.0);
+        CHECK(kept.normal.x() < 0.0);
+      }
+      if (step == 2 && object.shape.kind == ShapeKind::box) CHECK(nearest.normal.x() > 0.0);  // the far face
+    }
+  }
+}
+
+TEST_CASE("a query that goes round an object takes the nearest face again, and a step without a query clears the "
+          "memory") {
+  Scene scene;
+  scene.floor.present = false;
+  SceneObject cube;
+  cube.name = "cube";
+  cube.shape.kind = ShapeKind::box;
+  cube.shape.box_size_m = {0.05, 0.05, 0.05};
+  cube.dynamic = true;
+  cube.mass_kg = 1.0;
+  scene.objects.push_back(cube);
+  std::vector<ObjectState> states(1);
+  FeatureExtractor extractor(scene);
+  impetus::FeatureMemory memory;
+  ReachQuery finger;
+  std::vector<ReachCandidate> found;
+  auto query_at = [&](const Vector3d& p) {
+    finger.position_m = p;
+    memory.begin_step(1);
+    extractor.index(states, kPeriod_s);
+    extractor.within_reach(finger, states, kPeriod_s, found, &memory);
+    REQUIRE(found.size() == 1);
+    return found[0].surface;
+  };
+  CHECK(query_at(Vector3d(-0.03, 0, 0)).normal.x() == Approx(-1.0));  // outside, -x face
+  CHECK(query_at(Vector3d(0.01, 0, 0)).normal.x() == Approx(-1.0));   // inside past the middle: kept
+  CHECK(query_at(Vector3d(-0.03, 0, 0)).normal.x() == Approx(-1.0));  // back out in front
+  CHECK(query_at(Vector3d(-0.03, 0.03, 0)).normal.y() > 0.0);         // round the edge, outside: the edge's normal
+  CHECK(query_at(Vector3d(0.0, 0.03, 0)).normal.y() == Approx(1.0));  // on to the +y face: the nearest again
+  memory.begin_step(1);                                               // a step without a query
+  CHECK(query_at(Vector3d(0.0, -0.01, 0)).normal.y() == Approx(-1.0));  // inside, nothing kept: the nearest face
+}
+
+TEST_CASE("an object that swept over the query within one step, faster than its own size, keeps the face it met") {
+  Scene scene;
+  scene.floor.present = false;
+  SceneObject cube;
+  cube.name = "cube";
+  cube.shape.kind = ShapeKind::box;
+  cube.shape.box_size_m = {0.04, 0.04, 0.04};
+  cube.dynamic = true;
+  cube.mass_kg = 0.2;
+  scene.objects.push_back(cube);
+  std::vector<ObjectState> states(1);
+  FeatureExtractor extractor(scene);
+  impetus::FeatureMemory memory;
+  ReachQuery finger;  // at the origin
+  std::vector<ReachCandidate> found;
+  auto step_to = [&](double x_m, impetus::FeatureMemory* with) {
+    states[0].pose.position_m = Vector3d(x_m, 0, 0);
+    states[0].velocity_mps = Vector3d(-1.2, 0, 0);
+    if (with != nullptr) with->begin_step(1);
+    extractor.index(states, kPeriod_s);
+    extractor.within_reach(finger, states, kPeriod_s, found, with);
+    REQUIRE(found.size() == 1);
+    return found[0].surface;
+  };
+  // 1 cm clear of the query on its -x side, then 6 cm further: its centre 3 cm past the query, the query 1 cm
+  // beyond its trailing face, outside both times.
+  CHECK(step_to(0.03, &memory).normal.x() == Approx(-1.0));
+  const impetus::SurfacePoint kept = step_to(-0.03, &memory);
+  CHECK(kept.normal.x() == Approx(-1.0));
+  CHECK(kept.signed_distance_m == Approx(-0.05));  // the leading face is 5 cm beyond the query
+  // Without memory the trailing face is the nearest, 1 cm away: the query would have passed through.
+  CHECK(step_to(-0.03, nullptr).normal.x() == Approx(1.0));
+}

@@ -13,10 +13,11 @@ PositionCoupling::PositionCoupling(const CouplingContext& context, double stiffn
 
 void PositionCoupling::before_step(const FingerState& finger, const FeatureExtractor& features) {
   for (auto& force : force_N_) force.setZero();
+  finger_faces_.begin_step(context_.scene.objects.size());
   if (!finger.valid) return;
   // Only the objects near the finger can be penetrated, so the feature index narrows the search.
   touching_.clear();
-  features.within_reach(finger.finger, context_.states, 0.0, touching_);
+  features.within_reach(finger.finger, context_.states, 0.0, touching_, &finger_faces_);
   const double period_s = context_.world_period_s;
   for (const ReachCandidate& candidate : touching_) {
     const auto id = static_cast<std::size_t>(candidate.object_id);

@@ -2,7 +2,8 @@
 // Position coupling, the paper's previous method (§2.3, fig. 3 "d"): the world samples the finger once per step, and
 // the finger's penetration d into each dynamic object gives a penalty force k_p·d + k_d·ḋ along the inward normal,
 // held for the whole world period. The report's impulses still advance the ledger (so its counters stay in step) but
-// move nothing.
+// move nothing. The finger keeps the face it met while an object moves onto it (feature_memory.h), so an object that
+// arrives faster than half its size per period is pushed back by its near face, not pulled through by its far one.
 
 #include "world_manager/couplings/coupling.h"
 
@@ -27,6 +28,7 @@ class PositionCoupling final : public CouplingStrategy {
   std::vector<Eigen::Vector3d> force_N_;  // per object, held during the step
   std::vector<Eigen::Vector3d> point_m_;  // where it acts
   std::vector<ReachCandidate> touching_;  // reused between steps
+  FeatureMemory finger_faces_;            // the face of each object the finger met, step to step
 };
 
 }  // namespace impetus

@@ -91,6 +91,63 @@ SurfacePoint nearest_surface_point(const Shape& shape, const BodyPose& pose, con
   return {pose.orientation * body.point_m + pose.position_m, pose.orientation * body.normal, body.signed_distance_m};
 }
 
+SurfacePoint supporting_plane(const Shape& shape, const BodyPose& pose, const Eigen::Vector3d& query_m,
+                              const Eigen::Vector3d& normal_body) {
+  const Eigen::Vector3d& n = normal_body;
+  double support_m = 0.0;  // h(n) about the body origin
+  switch (shape.kind) {
+    case ShapeKind::sphere:
+      support_m = shape.radius_m;
+      break;
+    case ShapeKind::box:
+      support_m = 0.5 * (to_eigen(shape.box_size_m).array() * n.array().abs()).sum();
+      break;
+    case ShapeKind::capsule:  // the axis segment's support plus the radius
+      support_m = 0.5 * shape.length_m * std::abs(n.z()) + shape.radius_m;
+      break;
+    case ShapeKind::cylinder:  // a cap's rim: the disc's support plus the half length along the axis
+      support_m = 0.5 * shape.length_m * std::abs(n.z()) + shape.radius_m * std::hypot(n.x(), n.y());
+      break;
+  }
+  const Eigen::Vector3d query_body_m = pose.orientation.conjugate() * (query_m - pose.position_m);
+  const double signed_distance_m = n.dot(query_body_m) - support_m;
+  // The query projected onto the plane; for a sphere its support point r·n instead, since a sphere's plane carries
+  // the centre as point − r·normal (contract/frames.h kPlaneSphere).
+  const Eigen::Vector3d point_body_m =
+      shape.kind == ShapeKind::sphere ? Eigen::Vector3d(support_m * n) : Eigen::Vector3d(query_body_m - signed_distance_m * n);
+  return {pose.orientation * point_body_m + pose.position_m, pose.orientation * n, signed_distance_m};
+}
+
+bool segment_enters_body(const Shape& shape, const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m) {
+  auto distance_at = [&](double t) { return nearest_surface_point_body(shape, from_m + t * (to_m - from_m)).signed_distance_m; };
+  if (distance_at(0.0) < 0.0 || distance_at(1.0) < 0.0) return true;
+  // Golden-section search for the least distance on [0, 1]; 60 iterations shrink the bracket by 0.618^60 ≈ 3e-13.
+  constexpr double kInverseGolden = 0.6180339887498949;
+  double lo = 0.0;
+  double hi = 1.0;
+  double a = hi - kInverseGolden * (hi - lo);
+  double b = lo + kInverseGolden * (hi - lo);
+  double fa = distance_at(a);
+  double fb = distance_at(b);
+  for (int i = 0; i < 60; ++i) {
+    if (fa < 0.0 || fb < 0.0) return true;
+    if (fa < fb) {
+      hi = b;
+      b = a;
+      fb = fa;
+      a = hi - kInverseGolden * (hi - lo);
+      fa = distance_at(a);
+    } else {
+      lo = a;
+      a = b;
+      fa = fb;
+      b = lo + kInverseGolden * (hi - lo);
+      fb = distance_at(b);
+    }
+  }
+  return fa < 0.0 || fb < 0.0;
+}
+
 double plane_extent_m(const Shape& shape) {
   switch (shape.kind) {
     case ShapeKind::box:

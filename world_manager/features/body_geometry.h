@@ -33,6 +33,20 @@ SurfacePoint nearest_surface_point_body(const Shape& shape, const Eigen::Vector3
 // The same for a body in the world: query, result point and normal in the world frame.
 SurfacePoint nearest_surface_point(const Shape& shape, const BodyPose& pose, const Eigen::Vector3d& query_m);
 
+// The shape's supporting plane with outward unit normal `normal_body` (body frame), taken at the query: the plane
+// {x : n·x = h(n)}, h(n) = max over the shape of n·x (its support function), in the world; the result's point is the
+// query projected onto that plane (for a sphere, the support point r·n, so that point − r·normal stays the centre),
+// its normal n in the world, its signed distance n·query − h(n). For a box and a face
+// normal this is the face's plane, whichever face is nearest to the query. Used to keep the face a query point met
+// while an object moves onto it (feature_memory.h).
+SurfacePoint supporting_plane(const Shape& shape, const BodyPose& pose, const Eigen::Vector3d& query_m,
+                              const Eigen::Vector3d& normal_body);
+
+// Whether the segment from `from_m` to `to_m` (body frame) passes through the shape's interior: the least signed
+// distance along it is negative. The shapes are convex, so the signed distance along a segment is a convex function
+// of the position on it and a golden-section search finds its least value.
+bool segment_enters_body(const Shape& shape, const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m);
+
 // How far from its point a plane of the shape still describes it (link_types.h Plane::extent_m): the radius of a
 // sphere, capsule or cylinder (a tangent plane one radius from its point is beside the body, no longer on it), the
 // space diagonal of a box (no two points of the box are farther apart, so a face has ended by then).

@@ -51,7 +51,8 @@ void FeatureExtractor::index(std::span<const ObjectState> states, double world_p
 }
 
 void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const ObjectState> states,
-                                    double world_period_s, std::vector<ReachCandidate>& out) const {
+                                    double world_period_s, std::vector<ReachCandidate>& out,
+                                    FeatureMemory* memory) const {
   out.clear();
   const double finger_speed_mps = finger.velocity_mps.norm();
   const double base_reach_m = scene_.haptic.reach_radius_m + finger.reach_extra_m;
@@ -62,13 +63,38 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
 
   for (std::int32_t id : candidate_ids_) {
     const ObjectState& state = states[static_cast<std::size_t>(id)];
-    const SurfacePoint surface =
-        nearest_surface_point(scene_.objects[static_cast<std::size_t>(id)].shape, state.pose, finger.position_m);
+    const Shape& shape = scene_.objects[static_cast<std::size_t>(id)].shape;
+    SurfacePoint surface = nearest_surface_point(shape, state.pose, finger.position_m);
+    // The frame the face is remembered in: the body's, so a face turns with it; a sphere's surface does not change
+    // when it spins (a rolling ball turns half a revolution in a period), so a sphere's is the world's axes about its
+    // centre.
+    BodyPose frame = state.pose;
+    if (shape.kind == ShapeKind::sphere) frame.orientation = Eigen::Quaterniond::Identity();
+    const Eigen::Vector3d query_local_m = frame.orientation.conjugate() * (finger.position_m - frame.position_m);
+    if (memory != nullptr) {
+      // Inside, or swept over within the step: keep the face of the last step, if the query is behind it
+      // (feature_memory.h).
+      if (const FeatureMemory::Face* kept = memory->previous(id); kept != nullptr) {
+        const SurfacePoint face = supporting_plane(shape, frame, finger.position_m, kept->normal_body);
+        // Past the middle: the query is beyond the object's centre along the kept normal, where the nearest face is
+        // the far one. Inside a box any other face than the one it met is a face the object brought over the query
+        // (its faces are discrete); a curved surface turns continuously under a query that slides over it, so there
+        // only past the middle is the far side. Swept over: outside now, past the middle, through the object since.
+        const bool past_middle = kept->normal_body.dot(query_local_m) < 0.0;
+        const bool inside = surface.signed_distance_m < 0.0 && (shape.kind == ShapeKind::box || past_middle);
+        const bool swept = surface.signed_distance_m >= 0.0 && past_middle &&
+                           segment_enters_body(shape, kept->query_body_m, query_local_m);
+        if (face.signed_distance_m < 0.0 && face.point_m.allFinite() && face.normal.allFinite() && (inside || swept)) {
+          surface = face;
+        }
+      }
+    }
     // DESIGN.md §1 step 4: reach = base radius + (finger speed + object speed)·T_w.
     const double reach_m = base_reach_m + (finger_speed_mps + state.velocity_mps.norm()) * world_period_s;
     // A NaN distance fails this test: a broken object gives no plane rather than a frame the haptic side rejects.
     if (surface.signed_distance_m <= reach_m && surface.point_m.allFinite() && surface.normal.allFinite()) {
       out.push_back({id, surface});
+      if (memory != nullptr) memory->remember(id, {frame.orientation.conjugate() * surface.normal, query_local_m});
     }
   }
 
@@ -120,8 +146,9 @@ Plane FeatureExtractor::make_plane(const ReachCandidate& candidate, std::span<co
 }
 
 std::uint32_t FeatureExtractor::extract(const ReachQuery& finger, std::span<const ObjectState> states,
-                                        double world_period_s, std::array<Plane, kMaxPlanes>& planes) const {
-  within_reach(finger, states, world_period_s, reach_scratch_);
+                                        double world_period_s, std::array<Plane, kMaxPlanes>& planes,
+                                        FeatureMemory* memory) const {
+  within_reach(finger, states, world_period_s, reach_scratch_, memory);
   // Sorted nearest first, so a crowded neighbourhood keeps the kMaxPlanes planes the finger can touch soonest.
   const std::size_t count = std::min<std::size_t>(reach_scratch_.size(), kMaxPlanes);
   for (std::size_t i = 0; i < count; ++i) planes[i] = make_plane(reach_scratch_[i], states);

@@ -12,6 +12,7 @@
 #include "common/contract/frames.h"
 #include "world_manager/scene.h"
 #include "world_manager/features/body_geometry.h"
+#include "world_manager/features/feature_memory.h"
 #include "world_manager/object_state.h"
 #include "world_manager/features/spatial_grid.h"
 
@@ -48,12 +49,15 @@ class FeatureExtractor {
   void index(std::span<const ObjectState> states, double world_period_s);
 
   // Every object (and the floor) within reach, nearest first (ties by id). `states` must be those last indexed.
+  // With `memory` (feature_memory.h), a query inside an object that had a face in memory's previous step keeps that
+  // face; every object within reach is remembered with the face it got.
   void within_reach(const ReachQuery& finger, std::span<const ObjectState> states, double world_period_s,
-                    std::vector<ReachCandidate>& out) const;
+                    std::vector<ReachCandidate>& out, FeatureMemory* memory = nullptr) const;
 
   // Fills planes[0..count) with the nearest kMaxPlanes objects within reach and returns count (paper §3.1).
+  // `memory` as for within_reach.
   std::uint32_t extract(const ReachQuery& finger, std::span<const ObjectState> states, double world_period_s,
-                        std::array<Plane, kMaxPlanes>& planes) const;
+                        std::array<Plane, kMaxPlanes>& planes, FeatureMemory* memory = nullptr) const;
 
   // For tests and benchmarks: how many objects the last query tested exactly.
   std::size_t last_candidate_count() const { return candidate_ids_.size(); }
