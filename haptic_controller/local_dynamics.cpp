@@ -103,6 +103,7 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
       body.angular_velocity_radps = to_eigen(plane.angular_velocity_radps);
       body.contact_count = std::min(plane.local_contact_count, kMaxLocalContacts);
       body.sphere_radius_m = (plane.flags & kPlaneSphere) != 0 && plane.extent_m > 0.0 ? plane.extent_m : 0.0;
+      body.turns = (plane.flags & kPlaneFlat) != 0;
       for (std::uint32_t c = 0; c < body.contact_count; ++c) {
         body.contact_normal[c] = to_eigen(plane.local_contacts[c].normal);
         body.contact_friction[c] = plane.local_contacts[c].friction;
@@ -199,9 +200,17 @@ void LocalDynamics::advance(double dt_s) {
   }
   if (chunks == kMaxDriftChunksPerTick) next_drift_s_ = elapsed_s_ + h_s;  // a long gap: do not replay it
   elapsed_s_ += dt_s;
-  // Planes are carried by the CoM's displacement only (local_dynamics.h "Planes translate"); ω is kept for the
-  // surface velocity that friction sees and is reconciled by the next frame.
-  for (std::uint32_t b = 0; b < body_count_; ++b) bodies_[b].displacement_m += bodies_[b].velocity_mps * dt_s;
+  // Curved planes are carried by the CoM's displacement only, flat faces also turned (local_dynamics.h); ω also gives
+  // the surface velocity that friction sees, and is reconciled by the next frame.
+  for (std::uint32_t b = 0; b < body_count_; ++b) {
+    LocalBody& body = bodies_[b];
+    body.displacement_m += body.velocity_mps * dt_s;
+    const double angle = body.angular_velocity_radps.norm() * dt_s;
+    if (body.turns && angle > 0.0 && std::isfinite(angle)) {
+      body.turn = (Eigen::Quaterniond(Eigen::AngleAxisd(angle, body.angular_velocity_radps.normalized())) * body.turn)
+                      .normalized();
+    }
+  }
 }
 
 void LocalDynamics::apply_impulse(std::int32_t object_id, const Eigen::Vector3d& impulse_Ns,
@@ -245,7 +254,8 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
         // blend never pushes the finger out. Signed distance of the proxy to the plane as a function of w_n:
         //     d(w_n) = d_P + (1 − w_n)·|offset_normal|,   d_P = its distance to the plane with the gap closed.
         const double gap_m = -offset_normal_m;
-        const double d_closed_m = target_normal.dot(proxy_m - body->carry_point(target_point + tangential));
+        const double d_closed_m =
+            body->carry_normal(target_normal).dot(proxy_m - body->carry_point(target_point + tangential));
         if (d_closed_m < 0.0) normal_weight = std::min(normal_weight, std::max(blend.normal_weight, 1.0 + d_closed_m / gap_m));
       }
       blend.normal_weight = normal_weight;
@@ -256,7 +266,7 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
 
     if (body) {
       plane.point_m = body->carry_point(point);
-      plane.normal = normal;  // translated, not rotated: see the header
+      plane.normal = body->carry_normal(normal);  // turned for a flat face only: see the header
       plane.com_m = body->com_m();
       plane.velocity_mps = body->velocity_mps;
       plane.angular_velocity_radps = body->angular_velocity_radps;

@@ -34,14 +34,16 @@
 // x ↦ x + u, normal unchanged. Frame i's plane is therefore extrapolated with the model, not interpolated from i−1
 // (which would lag a period behind the object the finger is pushing).
 //
-// Planes translate, they do not rotate. A plane is §3.1's first-order picture of the surface at the nearest point p
-// to the finger; it holds near p only. Carrying it rigidly about the CoM (x ↦ com + u + R·(x − com), n ↦ R·n) is
-// right for a flat face but not for a curved surface: a sphere's surface does not move when it spins, yet its
-// rotated tangent plane sweeps the finger's position at ω·L, L = the finger's distance from p along the plane (up to
-// the finger's travel in a period, 25 mm at 10 Hz). With small, fast-spinning bodies this is an active wall: 3 g balls
-// (I = 1.2e-7 kg·m²) roll at ~20 rad/s in the world, and a friction share at L = 1 cm adds ~200 rad/s per 10 N·ms, so
-// the swept plane strikes the finger, the reaction at lever L spins the ball faster, and the swept planes pinch the
-// proxy into infeasible sets (docs/hard_cases.md, case 10). The
+// Curved planes translate, they do not rotate. A plane is §3.1's first-order picture of the surface at the nearest
+// point p to the finger; it holds near p only. Carrying it rigidly about the CoM (x ↦ com + u + R·(x − com), n ↦ R·n)
+// is right for a flat face, and a box's faces (kPlaneFlat) are carried so, R the model's turn since the frame from ω:
+// an off-centre push turns the face away from the finger as in the world, where a face held square would take the
+// push too long and over-spin the box. It is not right for a curved surface: a sphere's surface does not move when it
+// spins, yet its rotated tangent plane sweeps the finger's position at ω·L, L = the finger's distance from p along the
+// plane (up to the finger's travel in a period, 25 mm at 10 Hz). With small, fast-spinning bodies this is an active
+// wall: 3 g balls (I = 1.2e-7 kg·m²) roll at ~20 rad/s in the world, and a friction share at L = 1 cm adds ~200 rad/s
+// per 10 N·ms, so the swept plane strikes the finger, the reaction at lever L spins the ball faster, and the swept
+// planes pinch the proxy into infeasible sets (docs/hard_cases.md, case 10). For curved surfaces the
 // rotation within a period is not lost: the world integrates the angular impulses, and its next frame brings the
 // rotated face, blended in like §3.2's interpolation (the lag impulse coupling has for every plane). ω is still
 // integrated: it gives the surface velocity friction sees (a sphere's plane is taken again at the proxy each tick
@@ -97,9 +99,18 @@ struct LocalBody {
   bool touched = false;       // the finger pushed it in the last tick
   Eigen::Vector3d pushed_Ns = Eigen::Vector3d::Zero();  // Σ J since the frame (diagnostics, tests)
 
+  bool turns = false;  // its planes are flat faces (kPlaneFlat): they turn with it (header)
+  Eigen::Quaterniond turn = Eigen::Quaterniond::Identity();  // R, the model's rotation since the frame (turning bodies)
+
   Eigen::Vector3d com_m() const { return com_frame_m + displacement_m; }
-  // Where the model has carried a point of the frame's planes: translated with the CoM (header, "Planes translate").
-  Eigen::Vector3d carry_point(const Eigen::Vector3d& x_m) const { return x_m + displacement_m; }
+  // Where the model has carried a point of the frame's planes: with the CoM, and turned about it for a flat-faced
+  // body (header, "Curved planes translate").
+  Eigen::Vector3d carry_point(const Eigen::Vector3d& x_m) const {
+    return turns ? Eigen::Vector3d(com_m() + turn * (x_m - com_frame_m)) : Eigen::Vector3d(x_m + displacement_m);
+  }
+  Eigen::Vector3d carry_normal(const Eigen::Vector3d& normal) const {
+    return turns ? Eigen::Vector3d(turn * normal) : normal;
+  }
 };
 
 class LocalDynamics final : public PlaneMotion {

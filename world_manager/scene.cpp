@@ -168,7 +168,8 @@ Floor parse_floor(const Node& node) {
 
 PhysicsParams parse_physics(const Node& node) {
   node.expect_keys(
-      {"world_rate_hz", "substeps", "solver", "solver_iterations", "erp", "cfm", "auto_disable", "seed"});
+      {"world_rate_hz", "substeps", "solver", "solver_iterations", "erp", "cfm", "max_correcting_velocity_mps",
+       "auto_disable", "seed"});
   PhysicsParams physics;
   if (node.has("world_rate_hz")) {
     const Node rate = node.child("world_rate_hz");
@@ -191,6 +192,9 @@ PhysicsParams parse_physics(const Node& node) {
   if (node.has("solver_iterations")) physics.solver_iterations = node.child("solver_iterations").positive_int();
   if (node.has("erp")) physics.erp = node.child("erp").in_unit_interval();
   if (node.has("cfm")) physics.cfm = node.child("cfm").non_negative();
+  if (node.has("max_correcting_velocity_mps")) {
+    physics.max_correcting_velocity_mps = node.child("max_correcting_velocity_mps").positive();
+  }
   if (node.has("auto_disable")) physics.auto_disable = node.child("auto_disable").boolean();
   if (node.has("seed")) {
     const Node seed = node.child("seed");

@@ -35,6 +35,10 @@ inline constexpr std::uint32_t kPlaneDynamic = 1u << 0;  // the object moves; im
 // A sphere's tangent plane: the centre is point_m − extent_m·normal and the radius extent_m. The haptic side takes the
 // tangent plane again at its proxy every tick (haptic_controller/sphere_planes.h), as the world does every step.
 inline constexpr std::uint32_t kPlaneSphere = 1u << 1;
+// A face of a polyhedron (a box): flat, so it turns rigidly with the body about its centre of mass (the haptic side's
+// local model carries it so, haptic_controller/local_dynamics.h). Curved surfaces do not set it: their tangent plane
+// does not turn with a spin.
+inline constexpr std::uint32_t kPlaneFlat = 1u << 2;
 
 // LocalContact flags.
 // The other side holds a push along −normal: static geometry, or a body joined to static geometry by a chain of

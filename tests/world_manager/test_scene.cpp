@@ -194,6 +194,15 @@ TEST_CASE("scene error: bad physics settings") {
                 "positive");
   require_error(json{{"objects", json::array()}, {"physics", {{"solver", "magic"}}}}, "/physics/solver",
                 "\"quickstep\" or \"direct\"");
+  require_error(json{{"objects", json::array()}, {"physics", {{"max_correcting_velocity_mps", 0}}}},
+                "/physics/max_correcting_velocity_mps", "positive");
+}
+
+TEST_CASE("the penetration correction is uncapped unless the scene caps it") {
+  CHECK(std::isinf(impetus::parse_scene(json{{"objects", json::array()}}, "test.json").physics
+                       .max_correcting_velocity_mps));
+  const json document{{"objects", json::array()}, {"physics", {{"max_correcting_velocity_mps", 0.005}}}};
+  CHECK(impetus::parse_scene(document, "test.json").physics.max_correcting_velocity_mps == 0.005);
 }
 
 TEST_CASE("the direct solver is chosen by the scene and QuickStep is the default") {

@@ -123,6 +123,9 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   dWorldSetGravity(ode.world, scene.gravity_mps2[0], scene.gravity_mps2[1], scene.gravity_mps2[2]);
   dWorldSetERP(ode.world, scene.physics.erp);
   dWorldSetCFM(ode.world, scene.physics.cfm);
+  if (std::isfinite(scene.physics.max_correcting_velocity_mps)) {
+    dWorldSetContactMaxCorrectingVel(ode.world, scene.physics.max_correcting_velocity_mps);
+  }
   dWorldSetQuickStepNumIterations(ode.world, scene.physics.solver_iterations);
   dWorldSetAutoDisableFlag(ode.world, scene.physics.auto_disable ? 1 : 0);
 

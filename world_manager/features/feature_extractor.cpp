@@ -133,6 +133,7 @@ Plane FeatureExtractor::make_plane(const ReachCandidate& candidate, std::span<co
   const SceneObject& object = scene_.objects[static_cast<std::size_t>(candidate.object_id)];
   plane.flags = object.dynamic ? kPlaneDynamic : 0u;
   if (object.shape.kind == ShapeKind::sphere) plane.flags |= kPlaneSphere;
+  if (object.shape.kind == ShapeKind::box) plane.flags |= kPlaneFlat;
   plane.extent_m = plane_extent_m(object.shape);
   plane.com_m = to_vec3(state.pose.position_m);
   plane.velocity_mps = to_vec3(state.velocity_mps);
