@@ -108,6 +108,8 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
         body.contact_normal[c] = to_eigen(plane.local_contacts[c].normal);
         body.contact_friction[c] = plane.local_contacts[c].friction;
         body.contact_holds[c] = (plane.local_contacts[c].flags & kContactHolds) != 0;
+        body.neighbour_velocity_mps[c] = to_eigen(plane.local_contacts[c].other_velocity_mps);
+        body.neighbour_inverse_mass_per_kg[c] = std::max(0.0, plane.local_contacts[c].other_inverse_mass_per_kg);
       }
       body.touched = was_touched(plane.object_id);
     }
@@ -181,9 +183,25 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
     const double slip_mps = slip.norm();
     if (slip_mps > 0.0) v -= std::min(slip_mps, limit) / slip_mps * slip;
   }
+  share_with_neighbours(body);
   // Rotation is otherwise left free: supports do not stop a ball rolling, and where they would stop a box tipping the model
   // over-predicts the surface's motion, the passive error. Stopping it would let the finger's friction spin a ball
   // in the world far past rolling with the finger, since the model would see its surface still.
+}
+
+void LocalDynamics::share_with_neighbours(LocalBody& body) {
+  if (!(body.inverse_mass_per_kg > 0.0)) return;
+  for (std::uint32_t c = 0; c < body.contact_count; ++c) {
+    const double neighbour_inverse_mass = body.neighbour_inverse_mass_per_kg[c];
+    if (body.contact_holds[c] || !(neighbour_inverse_mass > 0.0)) continue;
+    const Eigen::Vector3d& n = body.contact_normal[c];
+    Eigen::Vector3d& neighbour_velocity = body.neighbour_velocity_mps[c];
+    const double approach_mps = (body.velocity_mps - neighbour_velocity).dot(n);
+    if (!(approach_mps < 0.0)) continue;
+    const double impulse_Ns = -approach_mps / (body.inverse_mass_per_kg + neighbour_inverse_mass);
+    body.velocity_mps += body.inverse_mass_per_kg * impulse_Ns * n;
+    neighbour_velocity -= neighbour_inverse_mass * impulse_Ns * n;
+  }
 }
 
 void LocalDynamics::advance(double dt_s) {
@@ -220,6 +238,7 @@ void LocalDynamics::apply_impulse(std::int32_t object_id, const Eigen::Vector3d&
   // Paper §3.5 at the haptic rate: Δv = J/m, Δω = I⁻¹·L.
   body->velocity_mps += body->inverse_mass_per_kg * impulse_Ns;
   body->angular_velocity_radps += body->inverse_inertia_world * angular_impulse_Nms;
+  share_with_neighbours(*body);
   body->pushed_Ns += impulse_Ns;
   body->touched = true;
 }

@@ -18,6 +18,12 @@
 //       most the weight it carries, P ≤ max(0, −g·n)·h: it holds the body up but yields to the finger's push
 //       v_t = v − (v·n)·n;  v ← v − min(|v_t|, μ·P)·v_t/|v_t|   ... and their Coulomb friction (cube on a floor:
 //                                                                μ·g·Δt of speed per tick, as in the world)
+//       a loose contact with a dynamic neighbour (LocalContact other_velocity_mps, other_inverse_mass_per_kg) is also
+//       a mass the body cannot pass through: moving into it, (v − v_o)·n < 0, the two share a perfectly inelastic
+//       impulse J = −(v − v_o)·n / (1/m + 1/m_o): v ← v + J/m·n, v_o ← v_o − J/m_o·n (also after each tick's push).
+//       The neighbour is a free mass here (its own supports are not modelled), so the model gives way at most as
+//       much as the world, the passive side; without it a 0.2 kg cube driven into the finger by a 2 kg box would be
+//       sent back through the box by the finger's push while in the world both come on together.
 //       a sphere's friction acts at its contact point c = −r·n from the centre: the slip is that point's velocity,
 //       s = (v + ω × c)_t, and the friction impulse j (per unit mass, against s, |j| ≤ μ·P, at most what stops the
 //       slip) changes both: v ← v + j, ω ← ω + m·I⁻¹·(c × j). A rolling ball (s = 0) keeps its speed, as in the
@@ -94,6 +100,10 @@ struct LocalBody {
   std::array<Eigen::Vector3d, kMaxLocalContacts> contact_normal{};
   std::array<double, kMaxLocalContacts> contact_friction{};
   std::array<bool, kMaxLocalContacts> contact_holds{};  // kContactHolds: the other side holds the finger's push
+  // A loose contact's dynamic neighbour as the model carries it: its velocity (from the frame, then changed by what
+  // the body shares with it) and inverse mass (0: none, static or unknown).
+  std::array<Eigen::Vector3d, kMaxLocalContacts> neighbour_velocity_mps{};
+  std::array<double, kMaxLocalContacts> neighbour_inverse_mass_per_kg{};
   std::uint32_t contact_count = 0;
   double sphere_radius_m = 0.0;  // > 0 for a sphere (kPlaneSphere): its supports touch it at com − r·n
   bool touched = false;       // the finger pushed it in the last tick
@@ -172,6 +182,8 @@ class LocalDynamics final : public PlaneMotion {
  private:
   LocalBody* find_mutable(std::int32_t object_id);
   void apply_drift(LocalBody& body, double h_s) const;
+  // The inelastic share with moving loose neighbours (header): after the drift and after each push.
+  static void share_with_neighbours(LocalBody& body);
 
   struct PlaneBlend {
     Eigen::Vector3d from_point_m = Eigen::Vector3d::Zero();  // C

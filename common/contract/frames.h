@@ -51,6 +51,10 @@ inline constexpr std::uint32_t kContactHolds = 1u << 0;
 struct LocalContact {
   Vec3 normal{};          // unit; the direction the contact pushes the object (out of the other body)
   double friction = 0.0;  // Coulomb coefficient of the pair, dimensionless, >= 0
+  // The other body, when it is a dynamic one: the velocity of its centre of mass (m/s, world frame) and its inverse
+  // mass (1/kg). Zero inverse mass: static geometry, or nothing known; the model then gives it no inertia.
+  Vec3 other_velocity_mps{};
+  double other_inverse_mass_per_kg = 0.0;
   std::uint32_t flags = 0;  // kContactHolds
 };
 

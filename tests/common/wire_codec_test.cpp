@@ -71,6 +71,11 @@ TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {
   CHECK(rejected([](PlaneFrame& f) { f.coupling = static_cast<Coupling>(9); }) == FrameError::bad_coupling);
   CHECK(rejected([](PlaneFrame& f) { f.planes[0].dynamic_friction = 0.9; }) == FrameError::bad_friction);
   CHECK(rejected([](PlaneFrame& f) { f.reach_radius_m = -0.05; }) == FrameError::bad_reach);
+  CHECK(rejected([](PlaneFrame& f) {
+          f.planes[0].local_contact_count = 1;
+          f.planes[0].local_contacts[0].normal = {0, 0, 1};
+          f.planes[0].local_contacts[0].other_inverse_mass_per_kg = -1.0;
+        }) == FrameError::bad_mass);
   CHECK(rejected([&](PlaneFrame& f) { f.reach_radius_m = nan; }) == FrameError::not_finite);
   // Planes past the count are not looked at: garbage there is harmless.
   CHECK(rejected([&](PlaneFrame& f) { f.planes[5].point_m[0] = nan; }) == FrameError::ok);

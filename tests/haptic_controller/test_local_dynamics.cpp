@@ -49,8 +49,11 @@ PlaneFrame grounded_frame(const Plane& plane) {
 }
 
 void add_support(Plane& plane, const Vector3d& normal, double friction, bool holds = true) {
-  plane.local_contacts[plane.local_contact_count++] = {to_vec3(normal.normalized()), friction,
-                                                       holds ? impetus::kContactHolds : 0u};
+  impetus::LocalContact& contact = plane.local_contacts[plane.local_contact_count++];
+  contact = impetus::LocalContact{};
+  contact.normal = to_vec3(normal.normalized());
+  contact.friction = friction;
+  contact.flags = holds ? impetus::kContactHolds : 0u;
 }
 
 
@@ -130,6 +133,41 @@ TEST_CASE("local dynamics: a loose neighbour gives way to the push but carries t
   REQUIRE(planes.planes[0].point_m.x() > 0.0);
   REQUIRE(model.find(1)->velocity_mps.x() <= 0.1);
   REQUIRE(model.find(1)->velocity_mps.x() >= 0.1 - 10 * 0.05 * 9.81 * 0.005);
+}
+
+TEST_CASE("local dynamics: a loose neighbour with a mass shares the push; one that comes on keeps driving the body") {
+  // A 1 kg cube touching a 3 kg neighbour on its +x side (contact normal −x on the cube), no gravity, no friction.
+  SECTION("pushed into a resting neighbour: the two move off together, momentum shared") {
+    Plane face = cube_face();
+    add_support(face, -Vector3d::UnitX(), 0.0, false);
+    face.local_contacts[0].other_inverse_mass_per_kg = 1.0 / 3.0;
+    LocalDynamics model;
+    model.on_plane_frame(local_frame({face}), nullptr, Vector3d::Zero());
+    model.apply_impulse(1, Vector3d(0.4, 0, 0), Vector3d::Zero());
+    CHECK(model.find(1)->velocity_mps.x() == Approx(0.1));  // 0.4 N·s over 4 kg
+    CHECK(model.find(1)->neighbour_velocity_mps[0].x() == Approx(0.1));
+  }
+  SECTION("a heavy neighbour coming on at 0.5 m/s: a push back on the cube cannot send it through the neighbour") {
+    Plane face = cube_face();
+    face.velocity_mps = {-0.5, 0, 0};
+    add_support(face, -Vector3d::UnitX(), 0.0, false);
+    face.local_contacts[0].other_velocity_mps = {-0.5, 0, 0};
+    face.local_contacts[0].other_inverse_mass_per_kg = 1.0 / 3.0;
+    LocalDynamics model;
+    model.on_plane_frame(local_frame({face}), nullptr, Vector3d::Zero());
+    model.apply_impulse(1, Vector3d(1.0, 0, 0), Vector3d::Zero());  // enough to stop the cube alone twice over
+    // Cube and neighbour: 4 kg at −0.5 m/s plus 1 N·s: both at −0.25 m/s, still coming on.
+    CHECK(model.find(1)->velocity_mps.x() == Approx(-0.25));
+    CHECK(model.find(1)->neighbour_velocity_mps[0].x() == Approx(-0.25));
+  }
+  SECTION("without a mass (static or unknown) a loose neighbour gives way as before") {
+    Plane face = cube_face();
+    add_support(face, -Vector3d::UnitX(), 0.0, false);
+    LocalDynamics model;
+    model.on_plane_frame(local_frame({face}), nullptr, Vector3d::Zero());
+    model.apply_impulse(1, Vector3d(0.4, 0, 0), Vector3d::Zero());
+    CHECK(model.find(1)->velocity_mps.x() == Approx(0.4));
+  }
 }
 
 TEST_CASE("servo, local coupling: the pushed cube gives way between frames and the reported impulse is the one "

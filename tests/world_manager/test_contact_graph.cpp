@@ -33,11 +33,11 @@ TEST_CASE("contact graph: a stack on the floor holds a press from above; four co
   graph.finish();
 
   std::array<LocalContact, impetus::kMaxLocalContacts> contacts{};
-  REQUIRE(graph.local_contacts(1, contacts) == 1);
+  REQUIRE(graph.local_contacts(1, {}, contacts) == 1);
   REQUIRE(impetus::to_eigen(contacts[0].normal).isApprox(Vector3d::UnitZ()));
   REQUIRE((contacts[0].flags & kContactHolds) != 0);
   // Box 0 has the floor below (holds) and box 1 above: pushing box 1 up is not held by anything.
-  REQUIRE(graph.local_contacts(0, contacts) == 2);
+  REQUIRE(graph.local_contacts(0, {}, contacts) == 2);
   for (int c = 0; c < 2; ++c) {
     const bool below = impetus::to_eigen(contacts[c].normal).z() > 0.0;
     REQUIRE(((contacts[c].flags & kContactHolds) != 0) == below);
@@ -64,7 +64,7 @@ TEST_CASE("contact graph: a loose row of balls gives way sideways; the same row 
   REQUIRE(!graph.holds(1, -Vector3d::UnitX()));  // away from it
 
   std::array<LocalContact, impetus::kMaxLocalContacts> contacts{};
-  REQUIRE(graph.local_contacts(0, contacts) == 2);
+  REQUIRE(graph.local_contacts(0, {}, contacts) == 2);
   for (std::uint32_t c = 0; c < 2; ++c) REQUIRE((contacts[c].flags & kContactHolds) != 0);
 }
 
@@ -93,7 +93,29 @@ TEST_CASE("contact graph: bad input is ignored, and a cycle of contacts ends") {
   graph.finish();
   REQUIRE(!graph.holds(0, -Vector3d::UnitZ()));
   std::array<LocalContact, impetus::kMaxLocalContacts> contacts{};
-  REQUIRE(graph.local_contacts(0, contacts) == 1);
+  REQUIRE(graph.local_contacts(0, {}, contacts) == 1);
   REQUIRE((contacts[0].flags & kContactHolds) == 0);
-  REQUIRE(graph.local_contacts(9, contacts) == 0);
+  REQUIRE(graph.local_contacts(9, {}, contacts) == 0);
+}
+
+TEST_CASE("contact graph: a contact with a dynamic body carries its velocity and inverse mass, the floor none; the "
+          "friction capacity is the sum of mu times each contact's normal force") {
+  ContactGraph graph;
+  graph.reset(2);
+  graph.add(0, kStatic, Vector3d::UnitZ(), 0.5, 9.81);        // body 0 on the floor, weight 9.81 N
+  graph.add(0, 1, -Vector3d::UnitX(), 0.2, 2.0);              // body 1 presses on its +x side with 2 N
+  graph.add(1, 0, Vector3d::UnitX(), 0.2, 2.0);
+  graph.finish();
+  std::vector<impetus::ObjectState> states(2);
+  states[1].velocity_mps = Vector3d(-0.3, 0.0, 0.0);
+  states[1].inverse_mass_per_kg = 0.5;
+  std::array<LocalContact, impetus::kMaxLocalContacts> contacts{};
+  REQUIRE(graph.local_contacts(0, states, contacts) == 2);
+  for (int c = 0; c < 2; ++c) {
+    const bool floor = impetus::to_eigen(contacts[c].normal).z() > 0.5;
+    CHECK(contacts[c].other_inverse_mass_per_kg == (floor ? 0.0 : 0.5));
+    CHECK(contacts[c].other_velocity_mps[0] == (floor ? 0.0 : -0.3));
+  }
+  CHECK(graph.friction_capacity_N(0) == Approx(0.5 * 9.81 + 0.2 * 2.0));
+  CHECK(graph.friction_capacity_N(1) == Approx(0.2 * 2.0));
 }

@@ -143,7 +143,7 @@ TEST_CASE("planes carry the object's state, friction and the floor") {
   REQUIRE(frame.plane_count == 2);
   const impetus::Plane& cube = frame.planes[0].object_id == 0 ? frame.planes[0] : frame.planes[1];
   const impetus::Plane& floor = frame.planes[0].object_id == 0 ? frame.planes[1] : frame.planes[0];
-  CHECK(cube.flags == impetus::kPlaneDynamic);
+  CHECK(cube.flags == (impetus::kPlaneDynamic | impetus::kPlaneFlat));  // a box: its faces are flat
   CHECK(cube.normal[0] == Approx(-1.0));
   CHECK(cube.point_m[0] == Approx(0.005).margin(1e-4));  // the −x face (the cube has barely settled)
   CHECK(cube.inverse_mass_per_kg == Approx(1.0));

@@ -102,7 +102,7 @@ void LocalCoupling::annotate(PlaneFrame& frame) {
     Plane& plane = frame.planes[k];
     plane.local_contact_count = 0;
     if ((plane.flags & kPlaneDynamic) == 0 || plane.object_id < 0) continue;
-    plane.local_contact_count = contacts.local_contacts(plane.object_id, plane.local_contacts);
+    plane.local_contact_count = contacts.local_contacts(plane.object_id, context_.states, plane.local_contacts);
   }
 }
 

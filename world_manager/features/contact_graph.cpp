@@ -78,7 +78,8 @@ bool ContactGraph::holds(std::int32_t body, const Eigen::Vector3d& direction) {
   return false;
 }
 
-std::uint32_t ContactGraph::local_contacts(std::int32_t body, std::array<LocalContact, kMaxLocalContacts>& out) {
+std::uint32_t ContactGraph::local_contacts(std::int32_t body, std::span<const ObjectState> states,
+                                          std::array<LocalContact, kMaxLocalContacts>& out) {
   if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return 0;
   const auto b = static_cast<std::size_t>(body);
   std::uint32_t count = 0;
@@ -86,17 +87,29 @@ std::uint32_t ContactGraph::local_contacts(std::int32_t body, std::array<LocalCo
     const Edge& edge = edges_[e];
     // This body pushes the other side along −n.
     const bool held = edge.other == kStatic || holds(edge.other, -edge.normal);
+    Vec3 other_velocity_mps{};
+    double other_inverse_mass_per_kg = 0.0;
+    if (edge.other != kStatic && static_cast<std::size_t>(edge.other) < states.size()) {
+      const ObjectState& other = states[static_cast<std::size_t>(edge.other)];
+      other_velocity_mps = to_vec3(other.velocity_mps);
+      other_inverse_mass_per_kg = other.inverse_mass_per_kg;
+    }
     bool merged = false;
     for (std::uint32_t c = 0; c < count && !merged; ++c) {
       LocalContact& known = out[c];
       if (to_eigen(known.normal).dot(edge.normal) > kSameContactCosine) {
         known.friction = std::max(known.friction, edge.friction);
         if (held) known.flags |= kContactHolds;
+        if (other_inverse_mass_per_kg < known.other_inverse_mass_per_kg) {  // the heavier body
+          known.other_inverse_mass_per_kg = other_inverse_mass_per_kg;
+          known.other_velocity_mps = other_velocity_mps;
+        }
         merged = true;
       }
     }
     if (!merged && count < kMaxLocalContacts) {
-      out[count++] = {to_vec3(edge.normal), edge.friction, held ? kContactHolds : 0u};
+      out[count++] = {to_vec3(edge.normal), edge.friction, other_velocity_mps, other_inverse_mass_per_kg,
+                      held ? kContactHolds : 0u};
     }
   }
   return count;

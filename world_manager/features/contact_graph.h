@@ -17,11 +17,13 @@
 // error (local_dynamics.h, frame boundaries).
 
 #include "common/contract/frames.h"
+#include "world_manager/object_state.h"
 
 #include <Eigen/Core>
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace impetus {
@@ -44,7 +46,10 @@ class ContactGraph {
   // `body`'s contacts for the local model: merged by direction (normals within kSameContactCosine are one constraint,
   // e.g. the four corners of a box on the floor), at most kMaxLocalContacts, kContactHolds set where the other side
   // holds. Returns the count.
-  std::uint32_t local_contacts(std::int32_t body, std::array<LocalContact, kMaxLocalContacts>& out);
+  // A contact with a dynamic body carries that body's velocity and inverse mass from `states` (its inertia in the
+  // local model); merged contacts carry the heaviest of their bodies.
+  std::uint32_t local_contacts(std::int32_t body, std::span<const ObjectState> states,
+                               std::array<LocalContact, kMaxLocalContacts>& out);
 
   // Whether `body` had any contact (after finish()).
   bool touching(std::int32_t body) const {

@@ -37,6 +37,8 @@ template <class A, class B, class F>
 void visit_contact(A& a, B& b, F&& f) {
   f(a.normal, b.normal);
   f(a.friction, b.friction);
+  f(a.other_velocity_mps, b.other_velocity_mps);
+  f(a.other_inverse_mass_per_kg, b.other_inverse_mass_per_kg);
   f(a.flags, b.flags);
 }
 
@@ -127,6 +129,7 @@ const char* to_string(FrameError error) {
     case FrameError::bad_coupling: return "unknown coupling";
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
     case FrameError::bad_reach: return "reach radius or plane extent is negative";
+    case FrameError::bad_mass: return "a local contact's inverse mass is negative";
   }
   return "unknown frame error";
 }
@@ -164,7 +167,11 @@ FrameError validate(const wire::PlaneFrame& frame) {
     if (plane.local_contact_count > kMaxLocalContacts) return FrameError::count_out_of_range;
     for (std::uint32_t c = 0; c < plane.local_contact_count; ++c) {
       const wire::LocalContact& contact = plane.local_contacts[c];
-      if (!all_finite(contact.normal) || !finite(contact.friction)) return FrameError::not_finite;
+      if (!all_finite(contact.normal) || !finite(contact.friction) || !all_finite(contact.other_velocity_mps) ||
+          !finite(contact.other_inverse_mass_per_kg)) {
+        return FrameError::not_finite;
+      }
+      if (contact.other_inverse_mass_per_kg < 0.0) return FrameError::bad_mass;
       const double length = std::sqrt(contact.normal[0] * contact.normal[0] + contact.normal[1] * contact.normal[1] +
                                       contact.normal[2] * contact.normal[2]);
       if (std::fabs(length - 1.0) > kUnitNormalTolerance) return FrameError::normal_not_unit;

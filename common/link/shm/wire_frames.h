@@ -20,6 +20,8 @@ namespace wire {
 struct LocalContact {
   Vec3 normal{};
   double friction = 0.0;
+  Vec3 other_velocity_mps{};
+  double other_inverse_mass_per_kg = 0.0;
   std::uint32_t flags = 0;
   std::uint32_t reserved = 0;  // keeps the layout in whole 64-bit words (checksum)
 };
@@ -121,6 +123,7 @@ enum class FrameError : std::uint32_t {
   bad_coupling,
   bad_friction,
   bad_reach,
+  bad_mass,
 };
 const char* to_string(FrameError error);
 
