@@ -69,6 +69,20 @@ std::set<std::int32_t> brute_force_within_reach(const RandomWorld& world, const 
   return ids;
 }
 
+// A scene of one dynamic cube of edge `size_m` and `mass_kg` at the origin, no floor.
+Scene lone_cube(double size_m, double mass_kg) {
+  Scene scene;
+  scene.floor.present = false;
+  SceneObject cube;
+  cube.name = "cube";
+  cube.shape.kind = ShapeKind::box;
+  cube.shape.box_size_m = {size_m, size_m, size_m};
+  cube.dynamic = true;
+  cube.mass_kg = mass_kg;
+  scene.objects.push_back(cube);
+  return scene;
+}
+
 }  // namespace
 
 TEST_CASE("the feature query returns exactly the objects within reach, checked against brute force") {
@@ -217,15 +231,7 @@ TEST_CASE("a query an object moved onto keeps the face it met, for every shape a
 
 TEST_CASE("a query that goes round an object takes the nearest face again, and a step without a query clears the "
           "memory") {
-  Scene scene;
-  scene.floor.present = false;
-  SceneObject cube;
-  cube.name = "cube";
-  cube.shape.kind = ShapeKind::box;
-  cube.shape.box_size_m = {0.05, 0.05, 0.05};
-  cube.dynamic = true;
-  cube.mass_kg = 1.0;
-  scene.objects.push_back(cube);
+  const Scene scene = lone_cube(0.05, 1.0);
   std::vector<ObjectState> states(1);
   FeatureExtractor extractor(scene);
   impetus::FeatureMemory memory;
@@ -249,15 +255,7 @@ TEST_CASE("a query that goes round an object takes the nearest face again, and a
 }
 
 TEST_CASE("an object that swept over the query within one step, faster than its own size, keeps the face it met") {
-  Scene scene;
-  scene.floor.present = false;
-  SceneObject cube;
-  cube.name = "cube";
-  cube.shape.kind = ShapeKind::box;
-  cube.shape.box_size_m = {0.04, 0.04, 0.04};
-  cube.dynamic = true;
-  cube.mass_kg = 0.2;
-  scene.objects.push_back(cube);
+  const Scene scene = lone_cube(0.04, 0.2);
   std::vector<ObjectState> states(1);
   FeatureExtractor extractor(scene);
   impetus::FeatureMemory memory;
