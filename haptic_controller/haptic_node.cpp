@@ -54,7 +54,7 @@ HapticNode::HapticNode(const HapticNodeOptions& options, WorldLinkClient& world,
   }
   if (!options.log_path.empty()) {
     log_.emplace(options.log_path, kLogHeader, format_row, kLogRows,
-                 options.clock == ClockMode::lockstep ? LogOverflow::wait : LogOverflow::drop);
+                 options.clock == ClockMode::lockstep ? LogOverflow::wait : LogOverflow::drop, "haptic_controller");
   }
 }
 
@@ -156,7 +156,7 @@ int HapticNode::run() {
   }
   publish_stats(nullptr);
   if (log_) log_->close();
-  return 0;
+  return log_ && log_->failed() ? 1 : 0;  // a failed log write was reported when it happened (rt_log.h)
 }
 
 void HapticNode::publish_stats(const RealtimeClock* clock) {

@@ -23,6 +23,7 @@ DeviceNode::DeviceNode(DeviceSim& sim, DevicePortClient& port, const std::string
   if (!log_path.empty()) {
     log_.emplace(log_path);
     if (!*log_) throw std::runtime_error("cannot open log file '" + log_path + "' for writing");
+    log_watch_.emplace("spidar_sim", log_path);
     DeviceSim::write_log_header(*log_);
   }
 }
@@ -36,7 +37,10 @@ void DeviceNode::tick(double dt_s) {
   DeviceState state = sim_.tick(tensions, dt_s);
   state.device_session = session_;
   port_.publish_state(state);
-  if (log_) sim_.write_log_row(*log_);
+  if (log_) {
+    sim_.write_log_row(*log_);
+    if (!log_->good()) log_watch_->check(*log_);  // at once, while errno is this write's (once: WriteWatch)
+  }
   ++ticks_;
 }
 
@@ -47,7 +51,10 @@ bool DeviceNode::step_device() {
     return false;
   }
   tick(port_.haptic_period_s());
-  if (ticks_ % kCheckEveryTicks == 0) publish_stats(nullptr);
+  if (ticks_ % kCheckEveryTicks == 0) {
+    publish_stats(nullptr);
+    check_log();
+  }
   return true;
 }
 
@@ -84,13 +91,25 @@ int DeviceNode::run() {
       if (timing.index % kCheckEveryTicks == 0) host_alive = port_.host_alive();
       // After a host stall the finger is advanced by the real elapsed time, capped so one tick stays a tick.
       tick(std::min(timing.elapsed_s, DeviceSim::kMaxTick_s));
-      if (timing.index % kCheckEveryTicks == 0) publish_stats(&clock);
+      if (timing.index % kCheckEveryTicks == 0) {
+        publish_stats(&clock);
+        check_log();
+      }
     }
     publish_stats(&clock);
     port_.detach();
   }
   if (log_) log_->flush();
-  return 0;
+  check_log();
+  return log_watch_ && log_watch_->failed() ? 1 : 0;
+}
+
+void DeviceNode::check_log() {
+  // The row of each tick goes into the stream's buffer; flushed and looked at every kCheckEveryTicks (0.1 s), a full
+  // disk is found within a fraction of a second.
+  if (!log_ || !log_watch_ || log_watch_->failed()) return;
+  log_->flush();  // so the stream's state, and errno, are this write's
+  log_watch_->check(*log_);
 }
 
 nlohmann::json DeviceNode::summary() const {

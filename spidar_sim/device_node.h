@@ -6,6 +6,7 @@
 //
 // Owns the simulation's log and statistics.
 
+#include "common/runtime/write_watch.h"
 #include "common/link/device_port.h"
 #include "common/link/inproc/inproc_device_port.h"
 #include "spidar_sim/device_sim.h"
@@ -39,11 +40,13 @@ class DeviceNode final : public DeviceStepper {
  private:
   void tick(double dt_s);
   void publish_stats(const class RealtimeClock* clock);
+  void check_log();  // a failed log write, reported when noticed (WriteWatch)
 
   DeviceSim& sim_;
   DevicePortClient& port_;
   std::uint64_t session_;
   std::optional<std::ofstream> log_;
+  std::optional<WriteWatch> log_watch_;  // reports a failed log write when it is noticed
   std::uint64_t ticks_ = 0;
 };
 

@@ -5,6 +5,7 @@
 //
 // Owns its World, log and statistics; its summary is the world half of summary.json (DESIGN.md §4).
 
+#include "common/runtime/write_watch.h"
 #include "common/link/inproc/inproc_world_link.h"
 #include "common/link/world_link.h"
 #include "common/runtime/loop_stats.h"
@@ -64,6 +65,7 @@ class WorldNode final : public WorldStepper {
   World world_;
   WorldLinkServer* link_ = nullptr;
   std::optional<std::ofstream> log_file_;
+  std::optional<WriteWatch> log_watch_;  // reports a failed log write when it happens
   std::optional<WorldLog> log_;
   HapticReport report_{};
   bool have_report_ = false;

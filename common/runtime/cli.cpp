@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 
@@ -50,7 +52,8 @@ void write_summary(const std::string& path, const nlohmann::json& summary) {
   if (path.empty()) return;
   std::ofstream out(path);
   out << summary.dump(2) << '\n';
-  if (!out) throw std::runtime_error("cannot write summary '" + path + "'");
+  out.flush();  // a full disk shows on the flush, not on the buffered write
+  if (!out) throw std::runtime_error("cannot write summary '" + path + "' (" + std::strerror(errno) + ")");
 }
 
 }  // namespace impetus

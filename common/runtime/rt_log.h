@@ -4,6 +4,11 @@
 //
 // Overflow policy: in real time a full ring drops the row and counts it (the loop must not wait on the disk); in
 // lockstep the producer waits for space instead, because a lockstep log must be complete to be reproducible.
+//
+// A failed write (disk full) is reported by the drain thread when it happens (write_watch.h) and failed() says so; the
+// drain keeps emptying the ring, so a lockstep producer never waits on a file that cannot take the rows.
+
+#include "common/runtime/write_watch.h"
 
 #include <atomic>
 #include <chrono>
@@ -29,9 +34,10 @@ class RtLog {
   using Formatter = std::function<void(std::ostream&, const Row&)>;
 
   // Opens `path` (throws std::runtime_error naming the path if it cannot), writes `header` and starts the drain thread.
+  // `program` names the writer in the message of a failed write.
   RtLog(const std::string& path, const std::string& header, Formatter format, std::size_t capacity,
-        LogOverflow overflow)
-      : file_(path), format_(std::move(format)), rows_(capacity), overflow_(overflow) {
+        LogOverflow overflow, const std::string& program = "log")
+      : file_(path), format_(std::move(format)), rows_(capacity), overflow_(overflow), watch_(program, path) {
     if (!file_) throw std::runtime_error("cannot open log file '" + path + "' for writing");
     file_ << header << '\n';
     drainer_ = std::thread([this] { drain_loop(); });
@@ -55,6 +61,8 @@ class RtLog {
   }
 
   std::uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
+  // Whether a write to the file failed (reported on stderr when it happened).
+  bool failed() const { return watch_.failed(); }
 
   // Drains what is left, stops the thread and flushes the file. Idempotent.
   void close() {
@@ -62,6 +70,7 @@ class RtLog {
     stopping_.store(true, std::memory_order_release);
     drainer_.join();
     file_.flush();
+    watch_.check(file_);
   }
 
  private:
@@ -70,8 +79,13 @@ class RtLog {
       const bool stopping = stopping_.load(std::memory_order_acquire);
       std::uint64_t tail = tail_.load(std::memory_order_relaxed);
       const std::uint64_t head = head_.load(std::memory_order_acquire);
+      const bool wrote = tail != head;
       for (; tail != head; ++tail) format_(file_, rows_[tail % rows_.size()]);
       tail_.store(tail, std::memory_order_release);
+      if (wrote && !watch_.failed()) {
+        file_.flush();  // so a full disk is noticed now, not at exit
+        watch_.check(file_);
+      }
       if (stopping && tail == head_.load(std::memory_order_acquire)) return;
       // 2 ms keeps the ring far from full at 1 kHz with any sane capacity while costing almost no CPU.
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -86,6 +100,7 @@ class RtLog {
   std::atomic<std::uint64_t> tail_{0};
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<bool> stopping_{false};
+  WriteWatch watch_;
   std::thread drainer_;
 };
 

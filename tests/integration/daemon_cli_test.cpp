@@ -108,3 +108,56 @@ TEST_CASE("a device started with another geometry than the haptic controller's i
 }
 
 }  // namespace impetus
+
+namespace impetus {
+
+TEST_CASE("a log or summary that cannot be written (a full disk) is reported and the exit status is non-zero") {
+  // /dev/full accepts the open and fails every write with ENOSPC. Each daemon in turn writes there, in a lockstep
+  // trial of the others.
+  struct Case {
+    std::string daemon;
+    std::string flag;
+  };
+  const Case cases[] = {{"world_manager", "--log"}, {"haptic_controller", "--log"}, {"spidar_sim", "--log"},
+                        {"haptic_controller", "--summary"}};
+  for (const Case& c : cases) {
+    INFO(c.daemon << " " << c.flag);
+    const std::string name = "full-" + c.daemon + c.flag.substr(2);
+    const auto dir = test::out_dir(name);
+    const std::string shm = "impetus_test_full_" + std::to_string(getpid());
+    auto extra = [&](const std::string& daemon) {
+      return daemon == c.daemon ? std::vector<std::string>{c.flag, "/dev/full"} : std::vector<std::string>{};
+    };
+    auto command = [&](std::vector<std::string> argv, const std::string& daemon) {
+      for (const std::string& arg : extra(daemon)) argv.push_back(arg);
+      return argv;
+    };
+    const pid_t world = test::spawn(command({test::binary("world_manager"), "--scene", std::string(IMPETUS_SOURCE_DIR) +
+                                             "/scenes/tap.json", "--clock", "lockstep", "--shm", shm}, "world_manager"),
+                                    dir / "world.out");
+    const pid_t haptic = test::spawn(command({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm},
+                                             "haptic_controller"),
+                                     dir / "haptic.out");
+    const pid_t device = test::spawn(command({test::binary("spidar_sim"), "--clock", "lockstep", "--shm", shm,
+                                              "--attach-timeout", "5", "--trajectory", "tap"}, "spidar_sim"),
+                                     dir / "device.out");
+    const int device_status = test::wait_for(device, 30);
+    kill(haptic, SIGTERM);
+    const int haptic_status = test::wait_for(haptic, 10);
+    kill(world, SIGTERM);
+    const int world_status = test::wait_for(world, 10);
+    const int status = c.daemon == "world_manager" ? world_status
+                       : c.daemon == "haptic_controller" ? haptic_status
+                                                         : device_status;
+    const std::string out = test::read_text(dir / (c.daemon == "world_manager" ? "world.out"
+                                                   : c.daemon == "haptic_controller" ? "haptic.out"
+                                                                                      : "device.out"));
+    INFO(out);
+    CHECK(status != 0);
+    CHECK(status != -1);  // exited by itself, not killed after a hang
+    CHECK_THAT(out, Catch::Contains("/dev/full"));
+    CHECK_FALSE(segments_left(shm));
+  }
+}
+
+}  // namespace impetus
