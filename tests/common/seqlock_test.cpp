@@ -85,4 +85,29 @@ TEST_CASE("seqlock reader reports nothing new until the writer publishes again")
   CHECK(copy.counter == 8);
 }
 
+TEST_CASE("seqlock: an odd sequence word at rest (a stray write, a writer killed mid-write) is repaired by the next "
+          "write") {
+  SeqlockChannel<TestFrame> channel;
+  channel.reset();
+  TestFrame frame{};
+  frame.counter = 1;
+  REQUIRE(channel.write(frame));
+  std::uint64_t last = 0;
+  TestFrame copy{};
+  REQUIRE(channel.try_read(copy, last));
+  // A stray odd value in the sequence word, as a scribble into the shared segment would leave (the word is the
+  // channel's first member). Readers now take the frame as mid-write.
+  reinterpret_cast<std::atomic<std::uint64_t>*>(&channel)->store(1001);
+  CHECK_FALSE(channel.try_read(copy, last));
+  frame.counter = 2;
+  CHECK_FALSE(channel.write(frame));  // found odd: repaired
+  REQUIRE(channel.try_read(copy, last));
+  CHECK(copy.counter == 2);
+  CHECK(channel.sequence() % 2 == 0);
+  frame.counter = 3;
+  CHECK(channel.write(frame));  // settled again
+  REQUIRE(channel.try_read(copy, last));
+  CHECK(copy.counter == 3);
+}
+
 }  // namespace impetus

@@ -7,7 +7,7 @@
 // lives in atomic 64-bit words so the concurrent copy is not a data race in the C++ memory model.
 //
 // Ordering without fences (ThreadSanitizer does not model atomic_thread_fence): the odd bump is an acq_rel
-// read-modify-write, so no payload store moves before it; payload words are stored with release and loaded with
+// read-modify-write (an exchange), so no payload store moves before it; payload words are stored with release and loaded with
 // acquire, so a reader that sees any word of a newer write also sees that write's odd sequence on its second look.
 // On x86 these are plain moves (one locked add per write), the same cost as the relaxed-plus-fences form.
 //
@@ -29,9 +29,17 @@ class SeqlockChannel {
  public:
   static constexpr std::size_t kWords = (sizeof(T) + 7) / 8;
 
-  // Publishes a frame. Wait-free.
-  void write(const T& frame) {
-    const std::uint64_t seq = sequence_.fetch_add(1, std::memory_order_acq_rel);  // now odd: a write is under way
+  // Publishes a frame. Wait-free. Returns false if it found the sequence word odd at rest and repaired it.
+  //
+  // At rest the word is even; only this writer changes it. An odd word at rest is a write that never finished (a
+  // writer killed mid-write) or a stray write into the segment: readers would take every frame as mid-write and the
+  // channel would be dead for good. So the writer starts from the next even value: the channel recovers at its next
+  // write.
+  bool write(const T& frame) {
+    std::uint64_t seq = sequence_.load(std::memory_order_relaxed);
+    const bool settled = (seq & 1u) == 0;
+    seq += settled ? 0 : 1;
+    sequence_.exchange(seq + 1, std::memory_order_acq_rel);  // now odd: a write is under way
     const auto* bytes = reinterpret_cast<const unsigned char*>(&frame);
     for (std::size_t w = 0; w < kWords; ++w) {
       std::uint64_t word = 0;
@@ -39,6 +47,7 @@ class SeqlockChannel {
       payload_[w].store(word, std::memory_order_release);
     }
     sequence_.store(seq + 2, std::memory_order_release);
+    return settled;
   }
 
   // The current sequence number: even and > 0 once something was written; compare with a previous value to see
