@@ -74,8 +74,13 @@ int DeviceNode::run() {
         break;
       }
       if (result != TurnResult::ok) {
-        std::fprintf(stderr, "spidar_sim: %s\n",
-                     g_stop_requested.load() ? "stopped" : "the haptic controller went away");
+        if (g_stop_requested.load()) {
+          std::fprintf(stderr, "spidar_sim: stopped\n");
+        } else {
+          std::fprintf(stderr, "spidar_sim: error: the haptic controller went away mid-trajectory (lockstep); the "
+                               "trial is incomplete\n");
+          cut_short_ = true;
+        }
         break;
       }
       const bool ticked = step_device();
@@ -101,7 +106,7 @@ int DeviceNode::run() {
   }
   if (log_) log_->flush();
   check_log();
-  return log_watch_ && log_watch_->failed() ? 1 : 0;
+  return cut_short_ || (log_watch_ && log_watch_->failed()) ? 1 : 0;
 }
 
 void DeviceNode::check_log() {

@@ -47,6 +47,7 @@ class DeviceNode final : public DeviceStepper {
   std::uint64_t session_;
   std::optional<std::ofstream> log_;
   std::optional<WriteWatch> log_watch_;  // reports a failed log write when it is noticed
+  bool cut_short_ = false;               // lockstep: the haptic controller died before the trajectory ended
   std::uint64_t ticks_ = 0;
 };
 

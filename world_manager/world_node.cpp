@@ -116,12 +116,15 @@ int WorldNode::run() {
       options_.duration_s > 0.0
           ? static_cast<std::uint64_t>(std::llround(options_.duration_s / world_.world_period_s()))
           : std::numeric_limits<std::uint64_t>::max();
+  bool cut_short = false;  // the lockstep master died mid-trial: the trial is incomplete
   if (options_.clock == ClockMode::lockstep) {
     while (world_.steps_taken() < max_steps) {
       const TurnResult result = link_->wait_turn();
       if (result != TurnResult::ok) {
         if (result == TurnResult::peer_gone && !g_stop_requested.load()) {
-          std::fprintf(stderr, "world_manager: the haptic controller went away\n");
+          std::fprintf(stderr, "world_manager: error: the haptic controller went away mid-trial (lockstep); the trial "
+                               "is incomplete\n");
+          cut_short = true;
         }
         break;
       }
@@ -142,7 +145,7 @@ int WorldNode::run() {
     log_file_->flush();
     log_watch_->check(*log_file_);
   }
-  return log_watch_ && log_watch_->failed() ? 1 : 0;  // the failure was reported when it happened
+  return cut_short || (log_watch_ && log_watch_->failed()) ? 1 : 0;  // each reported when it happened
 }
 
 nlohmann::json WorldNode::summary() const {

@@ -161,3 +161,35 @@ TEST_CASE("a log or summary that cannot be written (a full disk) is reported and
 }
 
 }  // namespace impetus
+
+namespace impetus {
+
+TEST_CASE("lockstep: when the haptic controller dies mid-trial, the world and the device say so and exit non-zero") {
+  const auto dir = test::out_dir("lockstep-cut-short");
+  const std::string shm = "impetus_test_cut_" + std::to_string(getpid());
+  const pid_t world = test::spawn({test::binary("world_manager"), "--scene", std::string(IMPETUS_SOURCE_DIR) +
+                                   "/scenes/tap.json", "--clock", "lockstep", "--shm", shm}, dir / "world.out");
+  const pid_t haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm},
+                                   dir / "haptic.out");
+  // A 60 s press: far longer than the half second before the kill, whatever the machine's speed.
+  const pid_t device = test::spawn({test::binary("spidar_sim"), "--clock", "lockstep", "--shm", shm,
+                                    "--attach-timeout", "5", "--trajectory", "press:hold=60"}, dir / "device.out");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  kill(haptic, SIGKILL);
+  test::wait_for(haptic, 5);
+  const int device_status = test::wait_for(device, 10);
+  const int world_status = test::wait_for(world, 10);
+  const std::string world_out = test::read_text(dir / "world.out");
+  const std::string device_out = test::read_text(dir / "device.out");
+  INFO(world_out);
+  INFO(device_out);
+  CHECK(world_status == 1);
+  CHECK(device_status == 1);
+  CHECK_THAT(world_out, Catch::Contains("went away mid-trial"));
+  CHECK_THAT(device_out, Catch::Contains("went away mid-trajectory"));
+  // The dead controller's device segment is its to remove; the survivors leave nothing of their own.
+  CHECK_FALSE(std::filesystem::exists("/dev/shm/" + shm + ".world"));
+  std::filesystem::remove("/dev/shm/" + shm + ".device");
+}
+
+}  // namespace impetus
