@@ -193,3 +193,35 @@ TEST_CASE("lockstep: when the haptic controller dies mid-trial, the world and th
 }
 
 }  // namespace impetus
+
+namespace impetus {
+
+TEST_CASE("lockstep: a device killed mid-session is reported by the haptic controller, which then stops on SIGTERM") {
+  const auto dir = test::out_dir("lockstep-device-killed");
+  const std::string shm = "impetus_test_devkill_" + std::to_string(getpid());
+  const pid_t world = test::spawn({test::binary("world_manager"), "--scene", std::string(IMPETUS_SOURCE_DIR) +
+                                   "/scenes/tap.json", "--clock", "lockstep", "--shm", shm}, dir / "world.out");
+  const pid_t haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm},
+                                   dir / "haptic.out");
+  const pid_t device = test::spawn({test::binary("spidar_sim"), "--clock", "lockstep", "--shm", shm,
+                                    "--attach-timeout", "5", "--trajectory", "press:hold=60"}, dir / "device.out");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  kill(device, SIGKILL);
+  test::wait_for(device, 5);
+  // The controller notices within its turn timeout and says so (it used to wait in silence).
+  std::string haptic_out;
+  for (int i = 0; i < 100 && haptic_out.find("went away mid-session") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    haptic_out = test::read_text(dir / "haptic.out");
+  }
+  INFO(haptic_out);
+  CHECK_THAT(haptic_out, Catch::Contains("went away mid-session"));
+  kill(haptic, SIGTERM);
+  CHECK(test::wait_for(haptic, 10) != -1);  // it stops: no hang
+  kill(world, SIGTERM);
+  CHECK(test::wait_for(world, 10) != -1);
+  CHECK_FALSE(std::filesystem::exists("/dev/shm/" + shm + ".world"));
+  CHECK_FALSE(std::filesystem::exists("/dev/shm/" + shm + ".device"));
+}
+
+}  // namespace impetus

@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <cstdio>
 #include <stdexcept>
 
 namespace impetus {
@@ -55,6 +56,12 @@ const DeviceState* ShmDevicePortHost::lockstep_turn(std::uint64_t tick) {
   segment_->device_turn.give(tick);
   const TurnResult result = segment_->device_turn.wait_done([&] { return process_alive(pid); }, kTurnTimeout_s);
   if (result != TurnResult::ok || segment_->detaching.load(std::memory_order_acquire) != 0) {
+    if (result != TurnResult::ok) {
+      // Not a detach: the device died or stopped answering. Lockstep time waits for the next device, so say so
+      // rather than wait in silence.
+      std::fprintf(stderr, "haptic_controller: the device (pid %d) went away mid-session; lockstep waits for a device "
+                           "to attach (Ctrl-C or SIGTERM to stop)\n", static_cast<int>(pid));
+    }
     release_device();
     return nullptr;
   }
