@@ -17,25 +17,20 @@ int main(int argc, char** argv) {
   CLI::App app{"haptic_controller: the 1 kHz haptic servo of Impetus. Interpolates the world's planes, renders the "
                "god-object force on the SPIDAR and integrates it into impulses for the world."};
   app.add_option("--rate", options.rate_hz, "servo rate in Hz (1000)")
-      ->check(finite_number())
-      ->check(CLI::Range(100.0, 20000.0));
+      ->check(number_in(limits::kMinHapticRate_Hz, limits::kMaxHapticRate_Hz));
   app.add_option("--stiffness", options.stiffness_Npm, "k_p in N/m (default: the scene's)")
-      ->check(finite_number())
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number(limits::kMaxStiffness_Npm));
   app.add_option("--damping", options.damping_Nspm, "k_d in N·s/m (default: the scene's)")
-      ->check(finite_number())
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_in(0.0, limits::kMaxDamping_Nspm));
   add_clock_flag(app, options.clock);
   app.add_option("--duration", options.duration_s, "seconds to run (default: until stopped)")
-      ->check(finite_number())
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number(kMaxFlagSeconds));
   add_output_flag(app, "--log", options.log_path,
                   "CSV log: finger, proxy, force, accumulated impulse, lateness per tick");
   add_output_flag(app, "--summary", summary_path, "JSON summary written at exit (loop statistics, faults)");
   add_shm_flag(app, shm);
   app.add_option("--world-wait", world_wait_s, "seconds to wait for the world manager's link (10)")
-      ->check(finite_number())
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number(kMaxFlagSeconds));
   app.add_option("--device", device_spec, "spidar (the built-in geometry) or spidar:FILE.json (a device file)");
   app.add_flag("!--no-realtime-priority", options.realtime_priority,
                "do not ask for SCHED_FIFO and mlockall in real time");

@@ -10,7 +10,7 @@
                coarse substep's correction gives at the impact (world_manager/scene.h).
 
 Each at --phases world-clock phases per coupling at --rate (local, impulse, position), the reference once per case
-(its phase only delays the first step by whole ticks). Prints a table: mean error against the reference as a
+(a world at the haptic rate has one phase). Prints a table: mean error against the reference as a
 percentage of the reference's value, and the spread over the phases. --check exits 1 unless local coupling's yaw is
 within --max-yaw-error of the reference's in every off-centre case and the second cube's travel is within
 --max-travel-error of the reference's with the correction capped.

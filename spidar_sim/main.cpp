@@ -7,6 +7,13 @@
 #include "spidar_sim/device_node.h"
 #include "spidar_sim/trajectory.h"
 
+namespace {
+// A finger with hand and forearm behind it is ~2 kg: 10 kg is beyond any body part a device is strapped to.
+constexpr double kMaxFingerMass_kg = 10.0;
+// Real capstan motors follow a current command within milliseconds; a 1 s lag is a device that cannot render.
+constexpr double kMaxMotorLag_s = 1.0;
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace impetus;
   std::string trajectory_spec;
@@ -28,22 +35,17 @@ int main(int argc, char** argv) {
   add_output_flag(app, "--summary", summary_path, "JSON summary written at exit (ticks, finger and device)");
   add_shm_flag(app, shm);
   app.add_option("--attach-timeout", attach_timeout_s, "seconds to wait for the haptic controller's port")
-      ->check(finite_number())
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number(kMaxFlagSeconds));
   app.add_option("--device", device_spec,
                  "spidar (the built-in geometry) or spidar:FILE.json; must match the haptic controller's");
   app.add_option("--hand-stiffness", finger.hand_stiffness_Npm, "hand impedance stiffness, N/m (300)")
-      ->check(finite_number())
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number(limits::kMaxStiffness_Npm));
   app.add_option("--hand-damping", finger.hand_damping_Nspm, "hand impedance damping, N·s/m (8)")
-      ->check(finite_number())
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_in(0.0, limits::kMaxDamping_Nspm));
   app.add_option("--finger-mass", finger.mass_kg, "finger point mass, kg (0.1)")
-      ->check(finite_number())
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number(kMaxFingerMass_kg));
   app.add_option("--motor-lag", hardware.motor_time_constant_s, "motor time constant, s (0 = ideal)")
-      ->check(finite_number())
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_in(0.0, kMaxMotorLag_s));
   CLI11_PARSE(app, argc, argv);
 
   return run_node("spidar_sim", [&] {

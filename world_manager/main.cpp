@@ -6,6 +6,13 @@
 #include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world_node.h"
 
+namespace {
+// A phase is less than one world period in haptic ticks, and the longest period is the fastest haptic rate over the
+// slowest world rate; WorldNode checks it against the actual period.
+constexpr std::uint64_t kMaxPhaseTicks =
+    static_cast<std::uint64_t>(impetus::limits::kMaxHapticRate_Hz / impetus::limits::kMinWorldRate_Hz);
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace impetus;
   WorldNodeOptions options;
@@ -15,24 +22,21 @@ int main(int argc, char** argv) {
                "controller's impulses and publishes the planes near the finger."};
   app.add_option("--scene", options.scene_path, "scene file (JSON, see scenes/)")->required()->check(CLI::ExistingFile);
   app.add_option("--rate", options.rate_hz, "world rate in Hz, 0.1 to 10000 (default: the scene's world_rate_hz)")
-      ->check(finite_number())
-      ->check(CLI::Range(0.1, 10000.0));
+      ->check(number_in(limits::kMinWorldRate_Hz, limits::kMaxWorldRate_Hz));
   app.add_option("--substeps", options.substeps, "ODE steps per world period (default: the scene's physics.substeps)")
-      ->check(CLI::Range(1, 10000));
+      ->check(whole_number_in(1, limits::kMaxSubsteps));
   app.add_option("--coupling", options.coupling, "impulse (paper §2.2), position (the previous method) or local")
       ->transform(CLI::CheckedTransformer(kCouplingNames, CLI::ignore_case));
   add_clock_flag(app, options.clock);
   app.add_option("--phase", options.phase_ticks, "lockstep: world step i happens at haptic tick i*n + PHASE")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_number_in(0, kMaxPhaseTicks));
   app.add_option("--duration", options.duration_s, "seconds of world time to run (default: until stopped)")
-      ->check(finite_number())
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number(kMaxFlagSeconds));
   add_output_flag(app, "--log", options.log_path, "CSV log of every dynamic object per step");
   add_output_flag(app, "--summary", summary_path, "JSON summary written at exit (objects, loop statistics)");
   add_shm_flag(app, shm);
   app.add_option("--haptic-rate", options.haptic_rate_hz, "haptic rate the lockstep phase is counted in (1000)")
-      ->check(finite_number())
-      ->check(CLI::Range(100.0, 20000.0));
+      ->check(number_in(limits::kMinHapticRate_Hz, limits::kMaxHapticRate_Hz));
   CLI11_PARSE(app, argc, argv);
 
   return run_node("world_manager", [&] {

@@ -1,5 +1,8 @@
 #include "world_manager/scene.h"
 
+#include "common/contract/limits.h"
+#include "common/runtime/message_text.h"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -21,6 +24,15 @@ using nlohmann::json;
 constexpr double kUnitQuaternionTolerance = 1e-6;
 // Long values (a whole object echoed back) would drown the message; the start is enough to find it.
 constexpr std::size_t kMaxEchoedChars = 80;
+
+// A short quote of a value for an error message, built without recursion: a scalar as written (at most
+// kMaxEchoedChars), an array or object by its size. Dumping a container would recurse once per nesting level (a
+// stack overflow on a deeply nested file) and could quote megabytes.
+std::string echo(const json& value) {
+  if (value.is_array()) return "an array of " + std::to_string(value.size()) + " elements";
+  if (value.is_object()) return "an object with " + std::to_string(value.size()) + " keys";
+  return excerpt(value.dump(), kMaxEchoedChars);
+}
 
 // JSON pointer escaping (RFC 6901) for keys that contain '/' or '~'.
 std::string escape_key(std::string_view key) {
@@ -47,9 +59,7 @@ class Node {
   const std::string& pointer() const { return pointer_; }
 
   [[noreturn]] void fail(const std::string& reason) const {
-    std::string echoed = value_.dump();
-    if (echoed.size() > kMaxEchoedChars) echoed = echoed.substr(0, kMaxEchoedChars) + "...";
-    throw SceneError(source_ + ": " + where() + ": " + reason + " (got " + echoed + ")");
+    throw SceneError(source_ + ": " + where() + ": " + reason + " (got " + echo(value_) + ")");
   }
   [[noreturn]] void fail_missing(std::string_view key, std::string_view hint = {}) const {
     std::string message = source_ + ": " + pointer_ + "/" + escape_key(key) + ": missing required field";
@@ -79,7 +89,11 @@ class Node {
     for (const auto& item : value_.items()) {
       bool known = false;
       for (std::string_view name : allowed) known = known || item.key() == name;
-      if (!known) child(item.key()).fail("unknown key '" + item.key() + "'");
+      if (!known) {
+        const std::string key = excerpt(item.key(), kMaxEchoedChars);
+        throw SceneError(source_ + ": " + pointer_ + "/" + escape_key(key) + ": unknown key '" + key + "' (got " +
+                         echo(item.value()) + ")");
+      }
     }
   }
 
@@ -99,6 +113,22 @@ class Node {
     if (x < 0.0) fail("must not be negative");
     return x;
   }
+  double in_range(double lowest, double highest, const char* unit) const {
+    const double x = number();
+    if (x < lowest || x > highest) fail("must be between " + readable(lowest) + " and " + readable(highest) + unit);
+    return x;
+  }
+  double positive_up_to(double highest, const char* unit) const {
+    const double x = positive();
+    if (x > highest) fail("must be at most " + readable(highest) + unit);
+    return x;
+  }
+  // Three numbers whose Euclidean length is at most `highest`.
+  std::array<double, 3> vector_up_to(double highest, const char* unit) const {
+    const std::array<double, 3> v = numbers<3>();
+    if (std::hypot(v[0], v[1], v[2]) > highest) fail("its length must be at most " + readable(highest) + unit);
+    return v;
+  }
   double in_unit_interval() const {
     const double x = number();
     if (x < 0.0 || x > 1.0) fail("must be in [0, 1]");
@@ -108,11 +138,13 @@ class Node {
     if (!value_.is_number_integer()) fail("expected an integer");
     return value_.get<std::int64_t>();
   }
-  int positive_int() const {
-    const std::int64_t x = integer();
-    constexpr std::int64_t kLargestSensible = 1'000'000;  // far beyond any step count; guards int overflow
-    if (x <= 0 || x > kLargestSensible) fail("must be a positive integer no larger than 1000000");
-    return static_cast<int>(x);
+  int positive_int(int highest) const {
+    if (!value_.is_number_integer()) fail("expected a whole number");
+    // Compared as a double first: a huge integer must not wrap when converted.
+    if (value_.get<double>() < 1.0 || value_.get<double>() > highest) {
+      fail("must be a whole number from 1 to " + std::to_string(highest));
+    }
+    return static_cast<int>(value_.get<std::int64_t>());
   }
   bool boolean() const {
     if (!value_.is_boolean()) fail("expected true or false");
@@ -139,9 +171,11 @@ class Node {
 };
 
 Material parse_material(const Node& node, Material material) {
-  if (node.has("static_friction")) material.static_friction = node.child("static_friction").non_negative();
+  if (node.has("static_friction")) {
+    material.static_friction = node.child("static_friction").in_range(0.0, SceneLimits::kMaxFriction, "");
+  }
   if (node.has("dynamic_friction")) {
-    material.dynamic_friction = node.child("dynamic_friction").non_negative();
+    material.dynamic_friction = node.child("dynamic_friction").in_range(0.0, SceneLimits::kMaxFriction, "");
   } else if (node.has("static_friction")) {
     material.dynamic_friction = material.static_friction;  // one coefficient given: no stick-slip difference
   }
@@ -161,7 +195,10 @@ Floor parse_floor(const Node& node) {
     return floor;
   }
   node.expect_keys({"height_m", "static_friction", "dynamic_friction", "restitution"});
-  if (node.has("height_m")) floor.height_m = node.child("height_m").number();
+  if (node.has("height_m")) {
+    floor.height_m =
+        node.child("height_m").in_range(-SceneLimits::kMaxCoordinate_m, SceneLimits::kMaxCoordinate_m, " m");
+  }
   floor.material = parse_material(node, floor.material);
   return floor;
 }
@@ -172,12 +209,9 @@ PhysicsParams parse_physics(const Node& node) {
        "auto_disable", "seed"});
   PhysicsParams physics;
   if (node.has("world_rate_hz")) {
-    const Node rate = node.child("world_rate_hz");
-    physics.world_rate_hz = rate.positive();
-    // A denormal rate is positive but its period 1/rate is infinite.
-    if (!std::isfinite(physics.world_period_s())) rate.fail("too small: the world period 1/rate is not finite");
+    physics.world_rate_hz = node.child("world_rate_hz").in_range(limits::kMinWorldRate_Hz, limits::kMaxWorldRate_Hz, " Hz");
   }
-  if (node.has("substeps")) physics.substeps = node.child("substeps").positive_int();
+  if (node.has("substeps")) physics.substeps = node.child("substeps").positive_int(limits::kMaxSubsteps);
   if (node.has("solver")) {
     const Node solver = node.child("solver");
     const std::string name = solver.string();
@@ -189,11 +223,14 @@ PhysicsParams parse_physics(const Node& node) {
       solver.fail("expected \"quickstep\" or \"direct\"");
     }
   }
-  if (node.has("solver_iterations")) physics.solver_iterations = node.child("solver_iterations").positive_int();
+  if (node.has("solver_iterations")) {
+    physics.solver_iterations = node.child("solver_iterations").positive_int(limits::kMaxSolverIterations);
+  }
   if (node.has("erp")) physics.erp = node.child("erp").in_unit_interval();
-  if (node.has("cfm")) physics.cfm = node.child("cfm").non_negative();
+  if (node.has("cfm")) physics.cfm = node.child("cfm").in_range(0.0, SceneLimits::kMaxCfm, "");
   if (node.has("max_correcting_velocity_mps")) {
-    physics.max_correcting_velocity_mps = node.child("max_correcting_velocity_mps").positive();
+    physics.max_correcting_velocity_mps =
+        node.child("max_correcting_velocity_mps").positive_up_to(SceneLimits::kMaxSpeed_mps, " m/s");
   }
   if (node.has("auto_disable")) physics.auto_disable = node.child("auto_disable").boolean();
   if (node.has("seed")) {
@@ -207,9 +244,15 @@ PhysicsParams parse_physics(const Node& node) {
 HapticParams parse_haptic(const Node& node) {
   node.expect_keys({"reach_radius_m", "stiffness_Npm", "damping_Nspm", "static_friction", "dynamic_friction"});
   HapticParams haptic;
-  if (node.has("reach_radius_m")) haptic.reach_radius_m = node.child("reach_radius_m").positive();
-  if (node.has("stiffness_Npm")) haptic.stiffness_Npm = node.child("stiffness_Npm").positive();
-  if (node.has("damping_Nspm")) haptic.damping_Nspm = node.child("damping_Nspm").non_negative();
+  if (node.has("reach_radius_m")) {
+    haptic.reach_radius_m = node.child("reach_radius_m").positive_up_to(SceneLimits::kMaxReachRadius_m, " m");
+  }
+  if (node.has("stiffness_Npm")) {
+    haptic.stiffness_Npm = node.child("stiffness_Npm").positive_up_to(limits::kMaxStiffness_Npm, " N/m");
+  }
+  if (node.has("damping_Nspm")) {
+    haptic.damping_Nspm = node.child("damping_Nspm").in_range(0.0, limits::kMaxDamping_Nspm, " N·s/m");
+  }
   if (node.has("static_friction") || node.has("dynamic_friction")) {
     if (!node.has("static_friction")) node.fail_missing("static_friction", "the finger material needs both");
     haptic.finger_material_given = true;
@@ -219,26 +262,26 @@ HapticParams parse_haptic(const Node& node) {
 }
 
 Shape parse_shape(const Node& node, ShapeKind kind) {
+  constexpr double kMin = SceneLimits::kMinLength_m;
+  constexpr double kMax = SceneLimits::kMaxLength_m;
   Shape shape;
   shape.kind = kind;
   switch (kind) {
     case ShapeKind::box: {
       const Node size = node.required("size_m");
       shape.box_size_m = size.numbers<3>();
-      for (std::size_t i = 0; i < 3; ++i) {
-        if (!(shape.box_size_m[i] > 0.0)) size.element(i).fail("box size must be positive");
-      }
+      for (std::size_t i = 0; i < 3; ++i) size.element(i).in_range(kMin, kMax, " m");
       break;
     }
     case ShapeKind::sphere:
-      shape.radius_m = node.required("radius_m").positive();
+      shape.radius_m = node.required("radius_m").in_range(kMin, kMax, " m");
       break;
     case ShapeKind::capsule:
     case ShapeKind::cylinder:
-      shape.radius_m = node.required("radius_m").positive();
+      shape.radius_m = node.required("radius_m").in_range(kMin, kMax, " m");
       // A capsule of zero length is a sphere, which is allowed; a cylinder needs a length.
-      shape.length_m = kind == ShapeKind::capsule ? node.required("length_m").non_negative()
-                                                  : node.required("length_m").positive();
+      shape.length_m = kind == ShapeKind::capsule ? node.required("length_m").in_range(0.0, kMax, " m")
+                                                  : node.required("length_m").in_range(kMin, kMax, " m");
       break;
   }
   return shape;
@@ -286,12 +329,13 @@ SceneObject parse_object(const Node& node) {
       if (has_mass) node.child("density_kgpm3").fail("give either mass_kg or density_kgpm3, not both");
       node.fail_missing("mass_kg", "a dynamic object needs mass_kg or density_kgpm3");
     }
-    object.mass_kg = has_mass ? node.child("mass_kg").positive()
+    constexpr double kMinMass = SceneLimits::kMinMass_kg;
+    constexpr double kMaxMass = SceneLimits::kMaxMass_kg;
+    object.mass_kg = has_mass ? node.child("mass_kg").in_range(kMinMass, kMaxMass, " kg")
                               : node.child("density_kgpm3").positive() * object.shape.volume_m3();
-    // Each factor can be valid while the product over- or underflows; ODE needs a positive finite mass.
-    if (!has_mass && !(object.mass_kg > 0.0 && std::isfinite(object.mass_kg))) {
-      node.child("density_kgpm3").fail("density × volume is not a positive finite mass (" +
-                                       std::to_string(object.mass_kg) + " kg)");
+    if (!has_mass && !(object.mass_kg >= kMinMass && object.mass_kg <= kMaxMass)) {
+      node.child("density_kgpm3").fail("density × volume = " + readable(object.mass_kg) + " kg; the mass must be " +
+                                       "between " + readable(kMinMass) + " and " + readable(kMaxMass) + " kg");
     }
   } else {
     // A static object is immovable: a mass or a velocity would be silently ignored, so it is an error.
@@ -300,7 +344,13 @@ SceneObject parse_object(const Node& node) {
     }
   }
 
-  object.position_m = node.required("position_m").numbers<3>();
+  {
+    const Node position = node.required("position_m");
+    object.position_m = position.numbers<3>();
+    for (std::size_t i = 0; i < 3; ++i) {
+      position.element(i).in_range(-SceneLimits::kMaxCoordinate_m, SceneLimits::kMaxCoordinate_m, " m");
+    }
+  }
   if (node.has("orientation_wxyz")) {
     const Node q_node = node.child("orientation_wxyz");
     object.orientation_wxyz = q_node.numbers<4>();
@@ -310,9 +360,12 @@ SceneObject parse_object(const Node& node) {
       q_node.fail("quaternion must be unit within 1e-6 (norm " + std::to_string(norm) + ")");
     }
   }
-  if (node.has("linear_velocity_mps")) object.linear_velocity_mps = node.child("linear_velocity_mps").numbers<3>();
+  if (node.has("linear_velocity_mps")) {
+    object.linear_velocity_mps = node.child("linear_velocity_mps").vector_up_to(SceneLimits::kMaxSpeed_mps, " m/s");
+  }
   if (node.has("angular_velocity_radps")) {
-    object.angular_velocity_radps = node.child("angular_velocity_radps").numbers<3>();
+    object.angular_velocity_radps =
+        node.child("angular_velocity_radps").vector_up_to(SceneLimits::kMaxAngularSpeed_radps, " rad/s");
   }
   object.material = parse_material(node, Material{});
   return object;
@@ -360,13 +413,19 @@ Scene parse_scene(const nlohmann::json& document, const std::string& source_name
 
   Scene scene;
   scene.source_name = source_name;
-  if (root.has("gravity_mps2")) scene.gravity_mps2 = root.child("gravity_mps2").numbers<3>();
+  if (root.has("gravity_mps2")) {
+    scene.gravity_mps2 = root.child("gravity_mps2").vector_up_to(SceneLimits::kMaxGravity_mps2, " m/s²");
+  }
   if (root.has("floor")) scene.floor = parse_floor(root.child("floor"));
   if (root.has("physics")) scene.physics = parse_physics(root.child("physics"));
   if (root.has("haptic")) scene.haptic = parse_haptic(root.child("haptic"));
 
   const Node objects = root.required("objects");
   if (!objects.value().is_array()) objects.fail("expected an array of objects");
+  if (objects.value().size() > SceneLimits::kMaxObjects) {
+    objects.fail("a scene holds at most " + std::to_string(SceneLimits::kMaxObjects) + " objects, this one has " +
+                 std::to_string(objects.value().size()));
+  }
   std::set<std::string> names;
   for (std::size_t i = 0; i < objects.value().size(); ++i) {
     const Node node = objects.element(i);
@@ -448,7 +507,7 @@ Scene parse_scene_text(std::string_view text, const std::string& source_name) {
     throw SceneError(source_name + ": not valid JSON" + where + ": number '" + locator.token().substr(0, 40) +
                      "' is out of range for a double");
   } catch (const nlohmann::json::exception& error) {
-    throw SceneError(source_name + ": not valid JSON: " + error.what());
+    throw SceneError(source_name + ": not valid JSON: " + excerpt(error.what()));  // nlohmann quotes the whole bad token
   }
   return parse_scene(document, source_name);
 }

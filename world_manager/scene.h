@@ -49,6 +49,9 @@
 //
 // Keys for another shape (e.g. "radius_m" on a box) are unknown keys. Every error throws SceneError with the message
 // `FILE: /json/pointer: reason (got VALUE)`.
+//
+// Every number must lie in a range the engine can simulate (SceneLimits below; rates, substeps, iterations,
+// stiffness and damping as in common/contract/limits.h). docs/scene_format.md lists them with their reasons.
 
 #include "common/contract/vec3.h"
 
@@ -68,6 +71,29 @@ class SceneError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// The physical ranges a scene's values must lie in. ODE's broadphase stores bounding boxes as integers in cells of
+// 1/8 m and asserts when a coordinate leaves that range (measured: 10^6 m works, 10^12 m aborts), and its solver
+// loses all digits when masses or lengths differ by more than ~10^12; these ranges keep a scene well inside both.
+struct SceneLimits {
+  static constexpr double kMinLength_m = 1e-4;     // sizes and radii: 0.1 mm, below a device's position resolution
+  static constexpr double kMaxLength_m = 1e3;      // 1 km
+  static constexpr double kMaxCoordinate_m = 1e4;  // positions and floor height: a 20 km world around the device
+  static constexpr double kMinMass_kg = 1e-6;      // 1 mg
+  static constexpr double kMaxMass_kg = 1e6;       // 1000 t
+  static constexpr double kMaxSpeed_mps = 1e3;     // faster than a rifle bullet
+  static constexpr double kMaxAngularSpeed_radps = 1e4;  // ~1600 turns per second
+  static constexpr double kMaxGravity_mps2 = 1e3;  // 100 g
+  static constexpr double kMaxFriction = 100.0;    // real pairs stay below ~2; 100 already holds like glue
+  static constexpr double kMaxCfm = 1.0;           // ODE: CFM above 1 makes every contact softer than the body it holds
+  static constexpr double kMaxReachRadius_m = 10.0;  // 30× a desktop device's workspace
+  // A world step costs O(objects) in ODE's broadphase and our feature grid; 10^4 static spheres step in ~35 ms on
+  // this class of machine (within a 20 Hz period) and 10^5 in tens of seconds (docs/reliability.md).
+  static constexpr std::size_t kMaxObjects = 10'000;
+};
+// A body the solver throws beyond this distance from the origin is taken out of the simulation (World reports it):
+// 100× the largest scene coordinate, 10^6 below where ODE's broadphase aborts.
+inline constexpr double kEscapeDistance_m = 1e6;
 
 // A surface material. Coefficients are dimensionless; dynamic_friction <= static_friction; restitution in [0, 1].
 struct Material {

@@ -126,6 +126,8 @@ void World::take_report(const HapticReport& report) {
   }
 }
 
+const std::vector<std::size_t>& World::escaped() const { return engine_->escaped(); }
+
 void World::refresh_states() {
   for (std::size_t id = 0; id < states_.size(); ++id) {
     ObjectState& state = states_[id];

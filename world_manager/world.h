@@ -59,6 +59,8 @@ class World {
   double time_s() const { return time_s_; }
   std::uint64_t steps_taken() const { return steps_taken_; }
   const PlaneFrame& frame() const { return frame_; }
+  // Objects the engine took out of the simulation after the solver threw them out of range (RigidBodyEngine::escaped).
+  const std::vector<std::size_t>& escaped() const;
 
   // State of every scene object after the last step (static ones never change).
   std::span<const ObjectState> states() const { return states_; }

@@ -36,7 +36,19 @@ nlohmann::json to_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()};
 WorldNode::WorldNode(const WorldNodeOptions& options)
     : options_(options), scene_(scene_with_overrides(options)), world_(scene_, world_options(options)) {
   if (options.clock == ClockMode::lockstep) {
-    LockstepSchedule::ticks_per_world_step(world_.world_period_s(), options.haptic_rate_hz);  // throws if not whole
+    const std::uint64_t ticks = LockstepSchedule::ticks_per_world_step(world_.world_period_s(), options.haptic_rate_hz);
+    // Step i happens at tick i·n + phase: a phase of n or more only delays every step by whole periods, and a trial
+    // shorter than the delay would run with no world at all.
+    if (options.phase_ticks >= ticks) {
+      char message[256];
+      std::snprintf(message, sizeof message,
+                    "--phase %llu is not within one world period: a %g Hz world at a %g Hz haptic rate steps every "
+                    "%llu ticks, so the phase must be 0 to %llu",
+                    static_cast<unsigned long long>(options.phase_ticks), 1.0 / world_.world_period_s(),
+                    options.haptic_rate_hz, static_cast<unsigned long long>(ticks),
+                    static_cast<unsigned long long>(ticks - 1));
+      throw std::invalid_argument(message);
+    }
   }
   if (!options.log_path.empty()) {
     log_file_.emplace(options.log_path);
@@ -95,6 +107,13 @@ void WorldNode::step_world() {
   const PlaneFrame& frame = world_.step(have_report_ ? &report_ : nullptr);
   step_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
   link_->publish_frame(frame);
+  // Rare and never on the haptic path: the world loop can afford a line on stderr when it happens.
+  for (; escapes_reported_ < world_.escaped().size(); ++escapes_reported_) {
+    const std::size_t id = world_.escaped()[escapes_reported_];
+    std::fprintf(stderr, "world_manager: warning: at %.3f s the solver threw '%s' out of range (beyond %g m or not "
+                 "finite); it is taken out of the simulation\n", world_.time_s(), scene_.objects[id].name.c_str(),
+                 kEscapeDistance_m);
+  }
   if (log_) {
     log_->write_row(*log_file_);
     // The world steps at 10–50 Hz: flushing each row costs nothing and shows a full disk at once.
@@ -148,6 +167,12 @@ int WorldNode::run() {
   return cut_short || (log_watch_ && log_watch_->failed()) ? 1 : 0;  // each reported when it happened
 }
 
+nlohmann::json WorldNode::escaped_names() const {
+  nlohmann::json names = nlohmann::json::array();
+  for (std::size_t id : world_.escaped()) names.push_back(scene_.objects[id].name);
+  return names;
+}
+
 nlohmann::json WorldNode::summary() const {
   nlohmann::json objects = nlohmann::json::object();
   const auto states = world_.states();
@@ -171,6 +196,7 @@ nlohmann::json WorldNode::summary() const {
             {"skipped_periods", stats_.skipped_periods},
             {"rejected_reports", stats_.rejected_frames},
             {"foreign_reports", world_.foreign_reports()},
+            {"escaped_objects", escaped_names()},
             {"lateness_p50_ns", stats_.lateness_p50_ns},
             {"lateness_p99_ns", stats_.lateness_p99_ns},
             {"lateness_max_ns", stats_.lateness_max_ns},

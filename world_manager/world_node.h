@@ -58,6 +58,7 @@ class WorldNode final : public WorldStepper {
   const World& world() const { return world_; }
 
  private:
+  nlohmann::json escaped_names() const;
   void publish_stats(const class RealtimeClock* clock);
 
   WorldNodeOptions options_;
@@ -69,6 +70,7 @@ class WorldNode final : public WorldStepper {
   std::optional<WorldLog> log_;
   HapticReport report_{};
   bool have_report_ = false;
+  std::size_t escapes_reported_ = 0;  // world_.escaped() entries already announced on stderr
   std::uint64_t report_tick_ = 0;
   std::uint64_t report_session_ = 0;
   std::int64_t report_fresh_ns_ = 0;

@@ -1,8 +1,11 @@
 #include "common/runtime/cli.h"
 
+#include "common/runtime/message_text.h"
+
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <cerrno>
@@ -23,16 +26,66 @@ std::string check_writable_path(const std::string& path) {
   return "";
 }
 
-CLI::Validator finite_number() {
+namespace {
+
+// Parses a decimal number; "" on success, otherwise why not.
+std::string parse_number(const std::string& input, double& value) {
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtod(input.c_str(), &end);
+  if (input.empty() || end == input.c_str() || *end != '\0') return "'" + excerpt(input, 40) + "' is not a number";
+  // strtod saturates an overflow to ±HUGE_VAL (infinite) and flushes an underflow towards 0: the first is an error,
+  // the second an honest reading of the number.
+  if (!std::isfinite(value)) return "must be a finite number, not '" + excerpt(input, 40) + "'";
+  return "";
+}
+
+}  // namespace
+
+CLI::Validator number_in(double lowest, double highest) {
   return CLI::Validator(
-      [](std::string& input) -> std::string {
-        char* end = nullptr;
-        const double value = std::strtod(input.c_str(), &end);
-        if (input.empty() || end == input.c_str() || *end != '\0') return "'" + input + "' is not a number";
-        if (!std::isfinite(value)) return "must be a finite number, not '" + input + "'";
+      [lowest, highest](std::string& input) -> std::string {
+        double value = 0.0;
+        if (std::string problem = parse_number(input, value); !problem.empty()) return problem;
+        if (value < lowest || value > highest) {
+          return "must be between " + readable(lowest) + " and " + readable(highest) + ", not " + excerpt(input, 40);
+        }
         return "";
       },
-      "FINITE");
+      "NUMBER in [" + readable(lowest) + ", " + readable(highest) + "]");
+}
+
+CLI::Validator positive_number(double highest) {
+  return CLI::Validator(
+      [highest](std::string& input) -> std::string {
+        double value = 0.0;
+        if (std::string problem = parse_number(input, value); !problem.empty()) return problem;
+        if (!(value > 0.0)) return "must be positive, not " + excerpt(input, 40);
+        if (value > highest) return "must be at most " + readable(highest) + ", not " + excerpt(input, 40);
+        return "";
+      },
+      "POSITIVE <= " + readable(highest));
+}
+
+CLI::Validator whole_number_in(std::uint64_t lowest, std::uint64_t highest) {
+  return CLI::Validator(
+      [lowest, highest](std::string& input) -> std::string {
+        const auto outside = [&] {
+          return "must be a whole number from " + std::to_string(lowest) + " to " + std::to_string(highest) +
+                 ", not " + excerpt(input, 40);
+        };
+        if (input.empty() || input.find_first_not_of("0123456789") != std::string::npos) return outside();
+        // More digits than the bound has cannot be in range, and must not reach strtoull (which saturates).
+        if (input.find_first_not_of('0') != std::string::npos &&
+            input.size() - input.find_first_not_of('0') > std::to_string(highest).size()) {
+          return outside();
+        }
+        errno = 0;
+        const unsigned long long value = std::strtoull(input.c_str(), nullptr, 10);
+        if (errno == ERANGE || value < lowest || value > highest) return outside();
+        return "";
+      },
+      "INT in [" + std::to_string(lowest) + ", " + std::to_string(highest) + "]");
 }
 
 void add_clock_flag(CLI::App& app, ClockMode& clock) {

@@ -3,6 +3,7 @@
 // everywhere, and bad values rejected with the flag, the value and the reason.
 
 #include "common/contract/frames.h"
+#include "common/contract/limits.h"
 #include "common/runtime/lockstep.h"
 #include "common/runtime/process.h"
 
@@ -25,8 +26,16 @@ inline const std::map<std::string, Coupling> kCouplingNames{
 // A CLI11 validator for file paths we will write: not empty, the directory must exist and be writable.
 std::string check_writable_path(const std::string& path);
 
-// A CLI11 validator for numeric flags: the value must be a finite number (CLI11's range checks let NaN through).
-CLI::Validator finite_number();
+// CLI11 validators for numeric flags. Each parses the text itself, so NaN, infinities, integers too large for their
+// type and values out of range are all rejected with the flag and a readable reason ("must be between 0.1 and 10000,
+// not 1e+300"). CLI11's own range checks let NaN through and print their bounds with 309 digits.
+CLI::Validator number_in(double lowest, double highest);  // lowest <= x <= highest
+CLI::Validator positive_number(double highest);            // 0 < x <= highest
+CLI::Validator whole_number_in(std::uint64_t lowest, std::uint64_t highest);
+
+// Longest --duration, --world-wait or --attach-timeout: 10^7 s (116 days) is longer than any session, and tick counts
+// at 20 kHz stay exact far beyond it, so the bound only rejects typing mistakes and values that would overflow.
+inline constexpr double kMaxFlagSeconds = 1e7;
 
 void add_clock_flag(CLI::App& app, ClockMode& clock);
 void add_shm_flag(CLI::App& app, std::string& shm);

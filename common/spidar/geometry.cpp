@@ -1,5 +1,7 @@
 #include "common/spidar/geometry.h"
 
+#include "common/runtime/message_text.h"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -13,12 +15,23 @@ namespace {
   throw SpidarGeometryError(path + ": " + key + ": " + reason);
 }
 
-double positive(const nlohmann::json& document, const std::string& path, const char* key, double fallback) {
+// A quote of a value: scalars as written (capped), containers by size; never a recursive dump of a deep document.
+std::string quote(const nlohmann::json& value) {
+  if (value.is_array()) return "an array of " + std::to_string(value.size()) + " elements";
+  if (value.is_object()) return "an object with " + std::to_string(value.size()) + " keys";
+  return excerpt(value.dump(), 80);
+}
+
+// A value in (0, highest]: each key's bound is given with its reason where the key is read.
+double positive(const nlohmann::json& document, const std::string& path, const char* key, double fallback,
+                double highest) {
   if (!document.contains(key)) return fallback;
   const nlohmann::json& value = document.at(key);
-  if (!value.is_number()) fail(path, key, "must be a number, got " + value.dump());
+  if (!value.is_number()) fail(path, key, "must be a number, got " + quote(value));
   const double number = value.get<double>();
-  if (!std::isfinite(number) || !(number > 0.0)) fail(path, key, "must be positive and finite, got " + value.dump());
+  if (!std::isfinite(number) || !(number > 0.0) || number > highest) {
+    fail(path, key, "must be positive and at most " + readable(highest) + ", got " + quote(value));
+  }
   return number;
 }
 
@@ -30,8 +43,8 @@ SpidarGeometry load_spidar_geometry(const std::string& path) {
   nlohmann::json document;
   try {
     document = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& error) {
-    throw SpidarGeometryError(path + ": not valid JSON: " + error.what());
+  } catch (const nlohmann::json::exception& error) {  // parse errors, and numbers too large for a double
+    throw SpidarGeometryError(path + ": not valid JSON: " + excerpt(error.what()));  // nlohmann quotes the whole token
   }
   if (!document.is_object()) throw SpidarGeometryError(path + ": must be a JSON object");
   static const char* const kKeys[] = {"frame_side_m",  "centre_m",      "metres_per_count",
@@ -39,21 +52,28 @@ SpidarGeometry load_spidar_geometry(const std::string& path) {
   for (const auto& [key, value] : document.items()) {
     bool known = false;
     for (const char* name : kKeys) known = known || key == name;
-    if (!known) fail(path, key, "unknown key (known: frame_side_m, centre_m, metres_per_count, tension_min_N, "
+    if (!known) fail(path, excerpt(key, 80), "unknown key (known: frame_side_m, centre_m, metres_per_count, tension_min_N, "
                                 "tension_max_N, max_force_N)");
   }
   SpidarGeometry geometry;
-  geometry.frame_side_m = positive(document, path, "frame_side_m", geometry.frame_side_m);
-  geometry.metres_per_count = positive(document, path, "metres_per_count", geometry.metres_per_count);
-  geometry.tension_min_N = positive(document, path, "tension_min_N", geometry.tension_min_N);
-  geometry.tension_max_N = positive(document, path, "tension_max_N", geometry.tension_max_N);
-  geometry.max_force_N = positive(document, path, "max_force_N", geometry.max_force_N);
+  // Bounds: a string frame of 10 m is a room-sized SPIDAR; an encoder count above 1 cm cannot resolve a contact;
+  // 1 kN is beyond any string and motor a person should be tied to.
+  constexpr double kMaxFrameSide_m = 10.0;
+  constexpr double kMaxMetresPerCount = 0.01;
+  constexpr double kMaxForce_N = 1000.0;
+  geometry.frame_side_m = positive(document, path, "frame_side_m", geometry.frame_side_m, kMaxFrameSide_m);
+  geometry.metres_per_count =
+      positive(document, path, "metres_per_count", geometry.metres_per_count, kMaxMetresPerCount);
+  geometry.tension_min_N = positive(document, path, "tension_min_N", geometry.tension_min_N, kMaxForce_N);
+  geometry.tension_max_N = positive(document, path, "tension_max_N", geometry.tension_max_N, kMaxForce_N);
+  geometry.max_force_N = positive(document, path, "max_force_N", geometry.max_force_N, kMaxForce_N);
   if (document.contains("centre_m")) {
     const nlohmann::json& centre = document.at("centre_m");
     if (!centre.is_array() || centre.size() != 3) fail(path, "centre_m", "must be [x, y, z] in metres");
     for (int a = 0; a < 3; ++a) {
-      if (!centre[a].is_number() || !std::isfinite(centre[a].get<double>())) {
-        fail(path, "centre_m", "must hold three finite numbers, got " + centre.dump());
+      if (!centre[a].is_number() || !(std::abs(centre[a].get<double>()) <= kMaxFrameSide_m)) {
+        fail(path, "centre_m", "must hold three numbers within ±" + readable(kMaxFrameSide_m) + " m, got " +
+                                   quote(centre[a]));
       }
       geometry.centre_m[a] = centre[a].get<double>();
     }

@@ -4,8 +4,14 @@
 #include <catch2/catch.hpp>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+#include <vector>
 
 namespace impetus {
 namespace {
@@ -60,7 +66,7 @@ TEST_CASE("opening a segment of another kind or a missing one fails with the rea
 TEST_CASE("a segment whose creator is alive is not taken over") {
   const std::string name = test::unique_segment_name("live");
   auto segment = Segment<SmallLayout>::create(name);
-  CHECK_THROWS_WITH(Segment<SmallLayout>::create(name), Catch::Contains("in use by running process"));
+  CHECK_THROWS_WITH(Segment<SmallLayout>::create(name), Catch::Contains("a running process holds it"));
   // The failed attempt must not have removed the live segment.
   segment->value = 42;
   auto reader = Segment<SmallLayout>::open(name);
@@ -91,6 +97,123 @@ TEST_CASE("the owner removes the segment name when it goes away") {
   { auto segment = Segment<SmallLayout>::create(name); }
   struct stat info {};
   CHECK(stat(("/dev/shm/" + name).c_str(), &info) != 0);
+}
+
+namespace {
+
+std::string shm_path(const std::string& name) { return "/dev/shm/" + name; }
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// A file at the segment's name with `text` and `mode`, as another program or user might leave it.
+void plant(const std::string& name, const std::string& text, mode_t mode) {
+  std::ofstream(shm_path(name)) << text;
+  REQUIRE(chmod(shm_path(name).c_str(), mode) == 0);
+}
+
+}  // namespace
+
+TEST_CASE("another program's file at the name is refused, named and left as it was") {
+  const std::string name = test::unique_segment_name("foreign");
+  plant(name, "another program's data\n", 0600);
+  CHECK_THROWS_WITH(Segment<SmallLayout>::create(name),
+                    Catch::Contains(shm_path(name)) && Catch::Contains("not an Impetus segment"));
+  CHECK_THROWS(Segment<SmallLayout>::open(name));
+  CHECK(read_file(shm_path(name)) == "another program's data\n");
+  std::filesystem::remove(shm_path(name));
+}
+
+TEST_CASE("a symbolic link at the name is refused and neither it nor its target is touched") {
+  const std::string name = test::unique_segment_name("symlink");
+  const std::string target =
+      (std::filesystem::temp_directory_path() / ("impetus_victim_" + std::to_string(getpid()))).string();
+  std::ofstream(target) << "precious";
+  std::filesystem::remove(shm_path(name));
+  std::filesystem::create_symlink(target, shm_path(name));
+  CHECK_THROWS_WITH(Segment<SmallLayout>::create(name), Catch::Contains("symbolic link"));
+  CHECK_THROWS_WITH(Segment<SmallLayout>::open(name), Catch::Contains("symbolic link"));
+  CHECK(std::filesystem::is_symlink(shm_path(name)));
+  CHECK(read_file(target) == "precious");
+  std::filesystem::remove(shm_path(name));
+  std::filesystem::remove(target);
+}
+
+TEST_CASE("a segment other users can open is refused by creator and opener, saying why") {
+  // A valid segment of ours made world-writable (as a planted one would be): its header would pass every other check.
+  const std::string name = test::unique_segment_name("mode");
+  auto segment = Segment<SmallLayout>::create(name);
+  REQUIRE(chmod(shm_path(name).c_str(), 0666) == 0);
+  CHECK_THROWS_WITH(Segment<SmallLayout>::open(name), Catch::Contains("mode is 0666"));
+  const pid_t creator = test::fork_child([&] {
+    try {
+      Segment<SmallLayout>::create(name);
+    } catch (const SegmentError& error) {
+      return std::string(error.what()).find("mode is 0666") != std::string::npos ? 0 : 2;
+    }
+    return 1;
+  });
+  CHECK(test::wait_child(creator) == 0);
+}
+
+TEST_CASE("a segment owned by another user is refused, naming the owner (as root: the planted-segment attack)") {
+  if (geteuid() != 0) {
+    WARN("not root: cannot give a file to another user; this check runs only as root (CI runs as root)");
+    return;
+  }
+  // An unprivileged user's segment with a valid header: made by us, then given to `nobody`.
+  const std::string name = test::unique_segment_name("owner");
+  const pid_t creator = test::fork_child([&] {
+    auto segment = Segment<SmallLayout>::create(name);
+    _exit(0);  // leaves the name, with a valid header and a dead creator
+    return 0;
+  });
+  REQUIRE(test::wait_child(creator) == 0);
+  constexpr uid_t kNobody = 65534;
+  REQUIRE(chown(shm_path(name).c_str(), kNobody, kNobody) == 0);
+  CHECK_THROWS_WITH(Segment<SmallLayout>::open(name), Catch::Contains("belongs to user 65534"));
+  CHECK_THROWS_WITH(Segment<SmallLayout>::create(name), Catch::Contains("belongs to user 65534"));
+  CHECK(std::filesystem::exists(shm_path(name)));  // not taken over: it is not ours
+  std::filesystem::remove(shm_path(name));
+}
+
+TEST_CASE("creators racing for one name: exactly one wins, every time") {
+  for (int round = 0; round < 50; ++round) {
+    const std::string name = test::unique_segment_name("race");
+    std::atomic<int> ready{0};
+    std::atomic<int> winners{0};
+    std::vector<std::thread> creators;
+    std::vector<std::unique_ptr<Segment<SmallLayout>>> segments(4);
+    for (int c = 0; c < 4; ++c) {
+      creators.emplace_back([&, c] {
+        ready.fetch_add(1);
+        while (ready.load() < 4) {
+        }
+        try {
+          segments[c] = std::make_unique<Segment<SmallLayout>>(Segment<SmallLayout>::create(name));
+          winners.fetch_add(1);
+        } catch (const SegmentError& error) {
+          CHECK(error.problem() == SegmentProblem::in_use);
+        }
+      });
+    }
+    for (auto& thread : creators) thread.join();
+    INFO("round " << round);
+    REQUIRE(winners.load() == 1);
+  }
+}
+
+TEST_CASE("an owner never removes a name that no longer names its own segment") {
+  const std::string name = test::unique_segment_name("replaced");
+  {
+    auto segment = Segment<SmallLayout>::create(name);
+    std::filesystem::remove(shm_path(name));  // a user removes it by hand and something else takes the name
+    plant(name, "someone else's", 0600);
+  }
+  CHECK(read_file(shm_path(name)) == "someone else's");
+  std::filesystem::remove(shm_path(name));
 }
 
 }  // namespace impetus

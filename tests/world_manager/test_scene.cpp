@@ -111,9 +111,9 @@ TEST_CASE("scene error: wrong type") {
 TEST_CASE("scene error: negative or zero mass") {
   json object = cube();
   object["mass_kg"] = -1.0;
-  require_error(scene_with(object), "/objects/0/mass_kg", "positive");
+  require_error(scene_with(object), "/objects/0/mass_kg", "between 1e-06 and");
   object["mass_kg"] = 0.0;
-  require_error(scene_with(object), "/objects/0/mass_kg", "positive");
+  require_error(scene_with(object), "/objects/0/mass_kg", "between 1e-06 and");
 }
 
 TEST_CASE("scene error: mass and density together") {
@@ -125,9 +125,9 @@ TEST_CASE("scene error: mass and density together") {
 TEST_CASE("scene error: zero or negative size") {
   json object = cube();
   object["size_m"] = {0.05, 0.0, 0.05};
-  require_error(scene_with(object), "/objects/0/size_m/1", "positive");
+  require_error(scene_with(object), "/objects/0/size_m/1", "between 0.0001 and");
   json sphere{{"name", "s"}, {"shape", "sphere"}, {"radius_m", -0.1}, {"dynamic", false}, {"position_m", {0, 0, 0}}};
-  require_error(scene_with(sphere), "/objects/0/radius_m", "positive");
+  require_error(scene_with(sphere), "/objects/0/radius_m", "between 0.0001 and");
 }
 
 TEST_CASE("scene error: non-unit quaternion") {
@@ -188,8 +188,8 @@ TEST_CASE("scene error: static object with a mass or a velocity") {
 }
 
 TEST_CASE("scene error: bad physics settings") {
-  require_error(json{{"objects", json::array()}, {"physics", {{"substeps", 0}}}}, "/physics/substeps", "positive");
-  require_error(json{{"objects", json::array()}, {"physics", {{"substeps", 2.5}}}}, "/physics/substeps", "integer");
+  require_error(json{{"objects", json::array()}, {"physics", {{"substeps", 0}}}}, "/physics/substeps", "from 1 to");
+  require_error(json{{"objects", json::array()}, {"physics", {{"substeps", 2.5}}}}, "/physics/substeps", "whole");
   require_error(json{{"objects", json::array()}, {"haptic", {{"stiffness_Npm", -1}}}}, "/haptic/stiffness_Npm",
                 "positive");
   require_error(json{{"objects", json::array()}, {"physics", {{"solver", "magic"}}}}, "/physics/solver",
@@ -228,4 +228,100 @@ TEST_CASE("scene error: unreadable file and invalid JSON name the file") {
   const std::string path = std::string(IMPETUS_BINARY_DIR) + "/broken_scene_for_test.json";
   std::ofstream(path) << "{\"objects\": [";
   CHECK_THROWS_WITH(impetus::load_scene(path), Catch::Contains(path) && Catch::Contains("not valid JSON"));
+}
+
+namespace {
+
+// The scene with one value replaced, at a JSON pointer.
+json with_value(json document, const std::string& pointer, const json& value) {
+  document[json::json_pointer(pointer)] = value;
+  return document;
+}
+
+}  // namespace
+
+TEST_CASE("scene error: finite values beyond what the engine can simulate name the field and the range") {
+  // Each of these passed the parser before and then aborted ODE, hung the world or overflowed an integer.
+  const json base = scene_with(cube());
+  struct Case {
+    std::string pointer;
+    json value;
+    std::string reason;
+  };
+  const Case cases[] = {
+      {"/objects/0/position_m/0", 1e12, "between -10000 and 10000 m"},
+      {"/objects/0/size_m/1", 1e6, "between 0.0001 and 1000 m"},
+      {"/objects/0/size_m/2", 1e-9, "between 0.0001 and 1000 m"},
+      {"/objects/0/mass_kg", 1e30, "between 1e-06 and 1e+06 kg"},
+      {"/objects/0/linear_velocity_mps", json{1e12, 0, 0}, "at most 1000 m/s"},
+      {"/objects/0/angular_velocity_radps", json{0, 1e12, 0}, "at most 10000 rad/s"},
+      {"/objects/0/static_friction", 1e30, "between 0 and 100"},
+      {"/gravity_mps2", json{0, 0, -1e30}, "at most 1000 m/s"},
+      {"/floor/height_m", 1e12, "between -10000 and 10000 m"},
+      {"/physics/substeps", 1000000, "from 1 to 10000"},
+      {"/physics/solver_iterations", 1000000, "from 1 to 10000"},
+      {"/physics/substeps", 1e300, "whole number"},
+      {"/physics/world_rate_hz", 1e30, "between 0.1 and 10000 Hz"},
+      {"/physics/world_rate_hz", 1e-300, "between 0.1 and 10000 Hz"},
+      {"/physics/cfm", 1e30, "between 0 and 1"},
+      {"/haptic/stiffness_Npm", 1e30, "at most 1e+06 N/m"},
+      {"/haptic/reach_radius_m", 1e30, "at most 10 m"},
+  };
+  for (const Case& test_case : cases) {
+    INFO(test_case.pointer << " = " << test_case.value.dump());
+    require_error(with_value(base, test_case.pointer, test_case.value), test_case.pointer, test_case.reason);
+  }
+  // A density that is fine alone but gives a mass out of range.
+  json dense = cube();
+  dense.erase("mass_kg");
+  dense["density_kgpm3"] = 1e300;
+  require_error(scene_with(dense), "/objects/0/density_kgpm3", "between 1e-06 and 1e+06 kg");
+}
+
+TEST_CASE("scene error: more objects than the stated limit is refused before anything is built") {
+  json objects = json::array();
+  for (std::size_t i = 0; i <= impetus::SceneLimits::kMaxObjects; ++i) {
+    json object = cube();
+    object["name"] = std::to_string(i);
+    objects.push_back(object);
+  }
+  require_error(json{{"objects", objects}}, "/objects", "at most 10000 objects");
+}
+
+TEST_CASE("scene error: deep nesting and huge tokens give a short message without recursion") {
+  // 10^6 levels: dumping the value to quote it used to recurse once per level and overflow the stack.
+  const std::size_t depth = 1'000'000;
+  std::string deep = "{\"objects\": [{\"name\": ";
+  deep.append(depth, '[').append(depth, ']').append("}]}");
+  try {
+    impetus::parse_scene_text(deep, "deep.json");
+    FAIL("expected SceneError");
+  } catch (const SceneError& error) {
+    const std::string message = error.what();
+    INFO(message.substr(0, 300));
+    CHECK(message.size() < 300);
+    CHECK_THAT(message, Catch::Contains("/objects/0"));
+  }
+  // A 50 MB bad string: nlohmann quotes the whole token in its message.
+  std::string huge = "{\"objects\": \"";
+  huge.append(50'000'000, 'a').append("\x01\"}");
+  try {
+    impetus::parse_scene_text(huge, "huge.json");
+    FAIL("expected SceneError");
+  } catch (const SceneError& error) {
+    const std::string message = error.what();
+    INFO(message.substr(0, 300));
+    CHECK(message.size() < 400);
+    CHECK_THAT(message, Catch::Contains("huge.json") && Catch::Contains("not valid JSON"));
+  }
+  // A 10 MB unknown key is quoted in part.
+  std::string key = "{\"";
+  key.append(10'000'000, 'k').append("\": 1, \"objects\": []}");
+  try {
+    impetus::parse_scene_text(key, "key.json");
+    FAIL("expected SceneError");
+  } catch (const SceneError& error) {
+    CHECK(std::string(error.what()).size() < 600);
+    CHECK_THAT(error.what(), Catch::Contains("unknown key"));
+  }
 }

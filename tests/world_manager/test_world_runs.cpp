@@ -114,3 +114,30 @@ TEST_CASE("a tapped cube slides and stops on the floor") {
   // 5 %: the discrete Coulomb pyramid and ERP make ODE's stop distance slightly inexact.
   CHECK(cube.pose.position_m.x() - start_x_m == Approx(expected_m).epsilon(0.05));
 }
+
+TEST_CASE("a body the solver throws out of range is taken out of the simulation, finite and reported") {
+  // No floor and no gravity: a cube at the largest speed a scene allows, in 10 s steps, travels 10 km per step and
+  // passes the escape distance after ~100 steps. ODE's broadphase used to abort once coordinates left its integer cell
+  // range (1e12 m); from the escape distance on the body must be parked, every state finite.
+  const impetus::Scene scene = impetus::parse_scene(
+      nlohmann::json::parse(R"({"floor": null, "gravity_mps2": [0, 0, 0],
+        "physics": {"world_rate_hz": 0.1, "substeps": 1},
+        "objects": [{"name": "bullet", "shape": "sphere", "radius_m": 0.01, "dynamic": true, "mass_kg": 0.01,
+                     "position_m": [0, 0, 0], "linear_velocity_mps": [1000, 0, 0]},
+                    {"name": "ball", "shape": "sphere", "radius_m": 0.05, "dynamic": true, "mass_kg": 1,
+                     "position_m": [0, 1, 0]}]})"),
+      "escape.json");
+  auto world = make_world(scene);
+  for (int i = 0; i < 150; ++i) world->step(nullptr);
+  REQUIRE(world->escaped().size() == 1);
+  CHECK(world->escaped()[0] == 0);
+  const ObjectState& bullet = world->states()[0];
+  CHECK(bullet.pose.position_m.allFinite());
+  CHECK(bullet.pose.position_m.norm() <= impetus::kEscapeDistance_m + 1000.0 * 10.0);
+  CHECK(bullet.velocity_mps.norm() == 0.0);
+  // The other body is untouched and the world keeps stepping.
+  CHECK(world->states()[1].pose.position_m.isApprox(Eigen::Vector3d(0, 1, 0)));
+  const double parked_x = bullet.pose.position_m.x();
+  for (int i = 0; i < 10; ++i) world->step(nullptr);
+  CHECK(world->states()[0].pose.position_m.x() == parked_x);
+}

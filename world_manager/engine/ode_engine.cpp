@@ -50,6 +50,40 @@ struct OdeEngine::Handles {
   };
   std::vector<RecordedContact> recorded;
   std::vector<dJointFeedback> feedback;  // one per recorded contact; sized before the step so the addresses hold
+  std::vector<std::size_t> escaped;      // objects taken out of the simulation (park_escaped)
+  std::vector<bool> is_escaped;          // per object
+
+  // Takes every body the solver has thrown beyond kEscapeDistance_m, or whose state is no longer finite, out of the
+  // simulation before the broadphase sees it: ODE's hash space asserts on coordinates it cannot store in its cells.
+  // The body stops, its geom collides with nothing, and a non-finite position is replaced by the escape distance on
+  // the ray it left along (or on +x), so every state the world reads stays finite.
+  void park_escaped() {
+    for (std::size_t id = 0; id < bodies.size(); ++id) {
+      dBodyID body = bodies[id];
+      if (body == nullptr || is_escaped[id]) continue;
+      const dReal* p = dBodyGetPosition(body);
+      const dReal* v = dBodyGetLinearVel(body);
+      const dReal* w = dBodyGetAngularVel(body);
+      const Eigen::Vector3d position(p[0], p[1], p[2]);
+      const bool finite = position.allFinite() && std::isfinite(v[0] + v[1] + v[2]) && std::isfinite(w[0] + w[1] + w[2]);
+      if (finite && position.lpNorm<Eigen::Infinity>() <= kEscapeDistance_m) continue;
+      Eigen::Vector3d parked = position;
+      if (!parked.allFinite()) parked = Eigen::Vector3d(kEscapeDistance_m, 0.0, 0.0);
+      const dReal* q = dBodyGetQuaternion(body);
+      if (!std::isfinite(q[0] + q[1] + q[2] + q[3])) {
+        const dQuaternion identity{1.0, 0.0, 0.0, 0.0};
+        dBodySetQuaternion(body, identity);
+      }
+      dBodySetPosition(body, parked.x(), parked.y(), parked.z());
+      dBodySetLinearVel(body, 0.0, 0.0, 0.0);
+      dBodySetAngularVel(body, 0.0, 0.0, 0.0);
+      dBodySetGravityMode(body, 0);
+      dBodyDisable(body);
+      dGeomDisable(geoms[id]);
+      is_escaped[id] = true;
+      escaped.push_back(id);
+    }
+  }
 
   ~Handles() {
     if (contacts != nullptr) dJointGroupDestroy(contacts);
@@ -132,6 +166,7 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   ode.bodies.assign(scene.objects.size(), nullptr);
   ode.contact_graph.reset(scene.objects.size());
   ode.geoms.assign(scene.objects.size(), nullptr);
+  ode.is_escaped.assign(scene.objects.size(), false);
   ode.inverse_inertia_body.assign(scene.objects.size(), Eigen::Matrix3d::Zero());
   for (std::size_t id = 0; id < scene.objects.size(); ++id) {
     const SceneObject& object = scene.objects[id];
@@ -244,6 +279,7 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
     ode.record_contacts = record_contacts && substep + 1 == substeps;
     const bool recording = ode.record_contacts;
     if (recording) ode.recorded.clear();
+    ode.park_escaped();
     dSpaceCollide(ode.space, &ode, &Handles::near_callback);
     ode.record_contacts = false;
     if (recording) {
@@ -258,9 +294,12 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
     if (recording) ode.record_graph();
     dJointGroupEmpty(ode.contacts);
   }
+  ode.park_escaped();  // the world reads the state next
   ode.random_state = dRandGetSeed();
 }
 
 ContactGraph& OdeEngine::contacts() { return ode_->contact_graph; }
+
+const std::vector<std::size_t>& OdeEngine::escaped() const { return ode_->escaped; }
 
 }  // namespace impetus

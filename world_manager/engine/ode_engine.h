@@ -31,6 +31,7 @@ class OdeEngine final : public RigidBodyEngine {
   void add_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m) override;
   void step(int substeps, double substep_s, bool record_contacts, SubstepHook& hook) override;
   ContactGraph& contacts() override;
+  const std::vector<std::size_t>& escaped() const override;
 
  private:
   struct Handles;

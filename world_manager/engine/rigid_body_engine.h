@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <vector>
 
 namespace impetus {
 
@@ -47,6 +48,9 @@ class RigidBodyEngine {
 
   // The contacts recorded by the last step that recorded them.
   virtual ContactGraph& contacts() = 0;
+  // Objects taken out of the simulation because the solver threw them beyond kEscapeDistance_m (scene.h) or made their
+  // state non-finite; they stay where they were taken out, at rest, and collide with nothing. In order of escape.
+  virtual const std::vector<std::size_t>& escaped() const = 0;
 };
 
 }  // namespace impetus

@@ -5,6 +5,8 @@
 #include <boost/interprocess/shared_memory_object.hpp>
 
 #include <signal.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -25,6 +27,11 @@ std::int64_t unix_now_ns() {
   clock_gettime(CLOCK_REALTIME, &now);
   return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
 }
+
+struct OpenProblem {
+  SegmentProblem problem = SegmentProblem::system;
+  std::string reason;  // empty: the segment can be used
+};
 
 }  // namespace
 
@@ -65,26 +72,57 @@ bool creator_alive(const SegmentHeader& header) {
 struct SegmentMapping::Impl {
   bip::shared_memory_object object;
   bip::mapped_region region;
+  bool locked = false;  // this process holds the creator's lock on `object`
 };
 
 namespace {
 
-struct OpenProblem {
-  SegmentProblem problem = SegmentProblem::system;
-  std::string reason;  // empty: the segment can be used
-};
+// Where the system keeps a segment's file (Linux: POSIX shared memory lives in /dev/shm), for messages and checks.
+std::string segment_path(const std::string& name) { return "/dev/shm/" + name; }
 
-// Opens `name` read-write and checks its header.
-OpenProblem check_existing(SegmentMapping::Impl& impl, const std::string& name, SegmentKind kind,
-                           std::size_t size_bytes) {
+int descriptor(const SegmentMapping::Impl& impl) { return impl.object.get_mapping_handle().handle; }
+
+// Why the file behind an open segment is not one this process may use, or "" if it is: it must be a regular file
+// owned by this user that nobody else can read or write. Checked on the descriptor, so a rename between the open and
+// the check changes nothing. A symbolic link never gets this far: shm_open opens with O_NOFOLLOW.
+std::string foreign_reason(int fd) {
+  struct stat status {};
+  if (fstat(fd, &status) != 0) return std::string("cannot inspect it: ") + std::strerror(errno);
+  if (!S_ISREG(status.st_mode)) return "it is not a regular file";
+  if (status.st_uid != geteuid()) {
+    return "it belongs to user " + std::to_string(status.st_uid) + ", not to this process's user " +
+           std::to_string(geteuid()) + " (someone else may have planted it)";
+  }
+  if ((status.st_mode & 077) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(status.st_mode & 07777));
+    return std::string("its mode is ") + mode + ": other users can open it (Impetus segments are 0600)";
+  }
+  return "";
+}
+
+// Opens an existing segment file read-write. A name that is a symbolic link (ELOOP) or that we may not open is
+// reported as incompatible; only a missing name is `missing`.
+OpenProblem open_existing(SegmentMapping::Impl& impl, const std::string& name) {
   try {
     impl.object = bip::shared_memory_object(bip::open_only, name.c_str(), bip::read_write);
   } catch (const bip::interprocess_exception& error) {
     if (error.get_error_code() == bip::not_found_error) {
       return {SegmentProblem::missing, "it does not exist (is its creator running?)"};
     }
-    throw;
+    if (error.get_native_error() == ELOOP) {
+      return {SegmentProblem::incompatible, segment_path(name) + " is a symbolic link, not an Impetus segment"};
+    }
+    return {SegmentProblem::incompatible, "cannot open " + segment_path(name) + ": " + error.what()};
   }
+  if (std::string reason = foreign_reason(descriptor(impl)); !reason.empty()) {
+    return {SegmentProblem::incompatible, segment_path(name) + ": " + reason};
+  }
+  return {};
+}
+
+// Why the header of an open segment does not match what this program expects, or "" if it does.
+OpenProblem check_header(SegmentMapping::Impl& impl, SegmentKind kind, std::size_t size_bytes) {
   bip::offset_t actual_size = 0;
   impl.object.get_size(actual_size);
   if (static_cast<std::size_t>(actual_size) < sizeof(SegmentHeader)) {
@@ -113,44 +151,108 @@ OpenProblem check_existing(SegmentMapping::Impl& impl, const std::string& name, 
   return {};
 }
 
+// The creator's lock: an exclusive flock on the segment's file, held for the creator's life and released by the
+// kernel when it dies, however it dies. Whoever holds it owns the name; nobody else ever removes it.
+bool take_creator_lock(SegmentMapping::Impl& impl) {
+  while (flock(descriptor(impl), LOCK_EX | LOCK_NB) != 0) {
+    if (errno != EINTR) return false;
+  }
+  impl.locked = true;
+  return true;
+}
+
+// Whether `name` still names the file `impl` has open (a name is only ever removed by the lock holder, but a user may
+// have removed it by hand and another creator made a new one).
+bool names_our_file(const SegmentMapping::Impl& impl, const std::string& name) {
+  struct stat ours {};
+  struct stat named {};
+  if (fstat(descriptor(impl), &ours) != 0 || lstat(segment_path(name).c_str(), &named) != 0) return false;
+  return ours.st_dev == named.st_dev && ours.st_ino == named.st_ino;
+}
+
+// Whether a segment whose creator's lock is free may be taken over: it is an Impetus segment left by a creator that
+// died, or an empty or zero-headed file left by a creation cut short. Anything else is another program's file.
+OpenProblem stale_reason(SegmentMapping::Impl& impl) {
+  bip::offset_t size = 0;
+  impl.object.get_size(size);
+  if (size == 0) return {};
+  if (static_cast<std::size_t>(size) < sizeof(SegmentHeader)) {
+    return {SegmentProblem::incompatible, "it is " + std::to_string(size) + " bytes and not an Impetus segment"};
+  }
+  impl.region = bip::mapped_region(impl.object, bip::read_only);
+  const auto* bytes = static_cast<const unsigned char*>(impl.region.get_address());
+  const auto& header = *reinterpret_cast<const SegmentHeader*>(bytes);
+  const std::uint64_t magic = header.magic.load(std::memory_order_acquire);
+  if (magic == kSegmentMagic) {
+    // A creator of an older build held no lock: its liveness is still told by pid and start time.
+    if (creator_alive(header)) {
+      return {SegmentProblem::in_use, "it is in use by running process " + std::to_string(header.creator_pid)};
+    }
+    return {};
+  }
+  for (std::size_t i = 0; i < sizeof(SegmentHeader); ++i) {
+    if (bytes[i] != 0) return {SegmentProblem::incompatible, "it is not an Impetus segment (bad magic)"};
+  }
+  return {};
+}
+
 }  // namespace
 
 SegmentMapping::SegmentMapping(const std::string& name, SegmentKind kind, std::size_t size_bytes, bool create)
-    : impl_(std::make_unique<Impl>()), name_(name), owner_(create) {
+    : impl_(std::make_unique<Impl>()), name_(name), owner_(false) {
   const std::string what = std::string(to_string(kind)) + " segment '" + name + "'";
+  const auto refuse = [&](const OpenProblem& problem, const char* verb) {
+    throw SegmentError(problem.problem, std::string("cannot ") + verb + " " + what + ": " + problem.reason);
+  };
   try {
     if (!create) {
-      const OpenProblem problem = check_existing(*impl_, name, kind, size_bytes);
-      if (!problem.reason.empty()) throw SegmentError(problem.problem, "cannot open " + what + ": " + problem.reason);
+      if (OpenProblem problem = open_existing(*impl_, name); !problem.reason.empty()) refuse(problem, "open");
+      if (OpenProblem problem = check_header(*impl_, kind, size_bytes); !problem.reason.empty()) refuse(problem, "open");
       return;
     }
     bip::permissions permissions;
     permissions.set_permissions(kSegmentPermissions);
-    try {
-      impl_->object = bip::shared_memory_object(bip::create_only, name.c_str(), bip::read_write, permissions);
-    } catch (const bip::interprocess_exception& error) {
-      if (error.get_error_code() != bip::already_exists_error) throw;
-      // A segment of that name exists: refuse if its creator lives, otherwise take it over.
-      Impl existing;
-      existing.object = bip::shared_memory_object(bip::open_only, name.c_str(), bip::read_write);
-      bip::offset_t existing_size = 0;
-      existing.object.get_size(existing_size);
-      if (static_cast<std::size_t>(existing_size) >= sizeof(SegmentHeader)) {
-        existing.region = bip::mapped_region(existing.object, bip::read_only);
-        const auto& header = *static_cast<const SegmentHeader*>(existing.region.get_address());
-        if (header.magic.load(std::memory_order_acquire) == kSegmentMagic && impetus::creator_alive(header)) {
-          throw SegmentError(SegmentProblem::in_use, "cannot create " + what + ": it is in use by running process " +
-                             std::to_string(header.creator_pid) + " (stop it, or choose another --shm name)");
-        }
+    const auto create_exclusive = [&] {
+      try {
+        impl_->object = bip::shared_memory_object(bip::create_only, name.c_str(), bip::read_write, permissions);
+        return true;
+      } catch (const bip::interprocess_exception& error) {
+        if (error.get_error_code() != bip::already_exists_error) throw;
+        return false;
       }
-      bip::shared_memory_object::remove(name.c_str());
-      impl_->object = bip::shared_memory_object(bip::create_only, name.c_str(), bip::read_write, permissions);
+    };
+    const OpenProblem racing{SegmentProblem::in_use, "another process is creating it at the same moment"};
+    if (!create_exclusive()) {
+      // The name exists. Take it over only if nobody holds its creator's lock and it is ours and stale.
+      Impl existing;
+      if (OpenProblem problem = open_existing(existing, name); !problem.reason.empty()) {
+        if (problem.problem == SegmentProblem::missing) problem = racing;  // removed by a taker since our attempt
+        refuse(problem, "create");
+      }
+      if (!take_creator_lock(existing)) {
+        refuse({SegmentProblem::in_use, "a running process holds it (stop it, or choose another --shm name)"},
+               "create");
+      }
+      if (OpenProblem problem = stale_reason(existing); !problem.reason.empty()) {
+        if (problem.problem == SegmentProblem::incompatible) {
+          problem.reason = segment_path(name) + ": " + problem.reason +
+                           "; it is left alone (remove it yourself if it is not needed, or choose another --shm name)";
+        }
+        refuse(problem, "create");
+      }
+      // Holding the lock, we are the only process that may remove this file's name.
+      if (names_our_file(existing, name)) bip::shared_memory_object::remove(name.c_str());
+      if (!create_exclusive()) refuse(racing, "create");
     }
+    // Between our exclusive creation and this lock another creator may have found the new file unlocked and taken it
+    // over; then it is theirs.
+    if (!take_creator_lock(*impl_)) refuse(racing, "create");
+    owner_ = true;
     impl_->object.truncate(static_cast<bip::offset_t>(size_bytes));
     impl_->region = bip::mapped_region(impl_->object, bip::read_write);
     std::memset(impl_->region.get_address(), 0, size_bytes);
   } catch (const bip::interprocess_exception& error) {
-    if (create) bip::shared_memory_object::remove(name.c_str());
+    if (owner_ && names_our_file(*impl_, name)) bip::shared_memory_object::remove(name.c_str());
     throw SegmentError(SegmentProblem::system,
                        "cannot " + std::string(create ? "create " : "open ") + what + ": " + error.what());
   }
@@ -168,7 +270,8 @@ void SegmentMapping::publish_header(SegmentKind kind, std::size_t size_bytes) {
 }
 
 SegmentMapping::~SegmentMapping() {
-  if (owner_) bip::shared_memory_object::remove(name_.c_str());
+  // Only our own file's name: never one a user or another creator has put in its place.
+  if (owner_ && names_our_file(*impl_, name_)) bip::shared_memory_object::remove(name_.c_str());
 }
 
 void* SegmentMapping::address() const { return impl_->region.get_address(); }

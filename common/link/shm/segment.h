@@ -7,8 +7,15 @@
 // waits on with a timeout and a liveness check of its peer.
 //
 // Ownership: exactly one process creates a segment (the world manager the world link, the haptic controller the device
-// port) and removes its name when it exits. Other processes open it. A segment whose creator is dead (a crash) is taken
-// over by the next creator; a segment with another layout version is refused with both versions in the message.
+// port) and removes its name when it exits. Other processes open it. The creator holds an exclusive flock on the file
+// for its whole life (the kernel drops it when the process dies, however it dies), so of several creators started at
+// once exactly one wins, and a segment whose lock is free is stale: the next creator takes it over.
+//
+// Nothing that is not ours is used or removed: every open checks, on the descriptor, that the file is a regular file
+// owned by this user with no access for others (0600); a symbolic link at the name is never followed; a file without
+// an Impetus header (another program's) is refused with its path and left alone; a creator removes a name only while
+// holding its lock and only if the name still refers to its own file. A segment with another layout version is
+// refused with both versions in the message.
 
 #include <atomic>
 #include <cstdint>
