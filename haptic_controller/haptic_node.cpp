@@ -110,15 +110,30 @@ void HapticNode::run_lockstep() {
   const LockstepSchedule schedule(LockstepSchedule::ticks_per_world_step(world_.info().world_period_s, options_.rate_hz),
                                   world_.info().phase_ticks);
   const std::uint64_t ticks = max_ticks();
-  for (std::uint64_t t = 0; t < ticks && device_.wait_attached(); ++t) {
+  bool world_lost = false;
+  // A stop request is checked every tick: the followers' turns keep coming, so the stop must come from the master.
+  for (std::uint64_t t = 0; t < ticks && !g_stop_requested.load() && device_.wait_attached(); ++t) {
     // Exactly t·T: interpolation weights are then tick counts over n, the same in every run.
     const double now_s = static_cast<double>(t) * period_s_;
     tick(t, now_s, period_s_, 0);
-    if (schedule.world_step_due(t) && world_.step_world(t)) receive_frame(now_s);
+    if (schedule.world_step_due(t)) {
+      if (world_.step_world(t)) {
+        receive_frame(now_s);
+      } else {
+        world_lost = true;
+      }
+    }
     if (t % kStatsEveryTicks == 0) publish_stats(nullptr);
   }
   world_.end_session();
   device_.end_session();
+  // A lockstep trial is one deterministic run: a world or device that left mid-way makes it incomplete, whatever came
+  // after (each loss was reported when it happened).
+  if (world_lost || device_.counters().devices_lost > 0) {
+    std::fprintf(stderr, "haptic_controller: error: the trial is incomplete: the %s went away mid-trial (lockstep)\n",
+                 world_lost ? "world manager" : "device");
+    cut_short_ = true;
+  }
 }
 
 void HapticNode::run_realtime() {
@@ -156,7 +171,8 @@ int HapticNode::run() {
   }
   publish_stats(nullptr);
   if (log_) log_->close();
-  return log_ && log_->failed() ? 1 : 0;  // a failed log write was reported when it happened (rt_log.h)
+  // A failed log write was reported when it happened (rt_log.h), a trial cut short at its end.
+  return cut_short_ || (log_ && log_->failed()) ? 1 : 0;
 }
 
 void HapticNode::publish_stats(const RealtimeClock* clock) {
@@ -181,6 +197,8 @@ nlohmann::json HapticNode::summary() const {
             {"faults", counters.faults},
             {"force_clamps", counters.force_clamps},
             {"saturations", device_.counters().saturations},
+            {"devices_lost", device_.counters().devices_lost},
+            {"channel_repairs", world_.channel_repairs() + device_.counters().channel_repairs},
             {"infeasible_contacts", counters.infeasible_contacts},
             {"stale_world_ticks", counters.stale_world_ticks},
             {"no_device_ticks", counters.no_device_ticks},

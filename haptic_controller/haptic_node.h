@@ -70,6 +70,7 @@ class HapticNode {
   HapticNodeOptions options_;
   double period_s_;
   WorldLinkClient& world_;
+  bool cut_short_ = false;  // lockstep: the world or the device went away mid-trial
   HapticDevice& device_;
   HapticServo servo_;
   std::optional<RtLog<HapticLogRow>> log_;

@@ -74,7 +74,10 @@ int DeviceNode::run() {
         break;
       }
       if (result != TurnResult::ok) {
-        if (g_stop_requested.load()) {
+        if (result == TurnResult::corrupted) {
+          std::fprintf(stderr, "spidar_sim: error: %s; the trial is incomplete\n", to_string(result));
+          cut_short_ = true;
+        } else if (g_stop_requested.load()) {
           std::fprintf(stderr, "spidar_sim: stopped\n");
         } else {
           std::fprintf(stderr, "spidar_sim: error: the haptic controller went away mid-trajectory (lockstep); the "
@@ -84,8 +87,16 @@ int DeviceNode::run() {
         break;
       }
       const bool ticked = step_device();
+      // Turns keep coming while the master runs, so a stop is taken between them: this turn becomes the last, handed
+      // back as a detach so the host frees the slot instead of finding a dead device.
+      const bool stopping = ticked && g_stop_requested.load();
+      if (stopping) port_.detach();
       port_.finish_turn();
       if (!ticked) break;
+      if (stopping) {
+        std::fprintf(stderr, "spidar_sim: stopped\n");
+        break;
+      }
     }
     publish_stats(nullptr);
   } else {
@@ -124,6 +135,7 @@ nlohmann::json DeviceNode::summary() const {
            {{"ticks", ticks_},
             {"time_s", sim_.time_s()},
             {"rejected_commands", port_.rejected_commands()},
+            {"channel_repairs", port_.channel_repairs()},
             {"finger_mass_kg", finger.mass_kg},
             {"hand_stiffness_Npm", finger.hand_stiffness_Npm},
             {"hand_damping_Nspm", finger.hand_damping_Nspm},

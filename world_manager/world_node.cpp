@@ -140,7 +140,10 @@ int WorldNode::run() {
     while (world_.steps_taken() < max_steps) {
       const TurnResult result = link_->wait_turn();
       if (result != TurnResult::ok) {
-        if (result == TurnResult::peer_gone && !g_stop_requested.load()) {
+        if (result == TurnResult::corrupted) {
+          std::fprintf(stderr, "world_manager: error: %s; the trial is incomplete\n", to_string(result));
+          cut_short = true;
+        } else if (result == TurnResult::peer_gone && !g_stop_requested.load()) {
           std::fprintf(stderr, "world_manager: error: the haptic controller went away mid-trial (lockstep); the trial "
                                "is incomplete\n");
           cut_short = true;
@@ -150,6 +153,7 @@ int WorldNode::run() {
       step_world();
       publish_stats(nullptr);
       link_->finish_turn();
+      if (g_stop_requested.load()) break;  // turns keep coming while the master runs: stop between them
     }
     publish_stats(nullptr);
   } else {
@@ -195,6 +199,7 @@ nlohmann::json WorldNode::summary() const {
             {"period_s", world_.world_period_s()},
             {"skipped_periods", stats_.skipped_periods},
             {"rejected_reports", stats_.rejected_frames},
+            {"channel_repairs", link_ != nullptr ? link_->channel_repairs() : 0},
             {"foreign_reports", world_.foreign_reports()},
             {"escaped_objects", escaped_names()},
             {"lateness_p50_ns", stats_.lateness_p50_ns},

@@ -43,6 +43,11 @@ class DevicePortHost {
   virtual void end_session() = 0;
 
   virtual std::uint64_t rejected_states() const = 0;
+  // Devices that left mid-session without detaching (died, or stopped answering a lockstep turn).
+  virtual std::uint64_t devices_lost() const = 0;
+  // Writes that found their channel's sequence word odd at rest (scribbled, or a writer killed mid-write) and repaired
+  // it (seqlock.h); 0 for transports without sequence words.
+  virtual std::uint64_t channel_repairs() const { return 0; }
 };
 
 // The device's end.
@@ -68,6 +73,9 @@ class DevicePortClient {
   virtual bool host_alive() const = 0;
 
   virtual std::uint64_t rejected_commands() const = 0;
+  // Writes that found their channel's sequence word odd at rest (scribbled, or a writer killed mid-write) and repaired
+  // it (seqlock.h); 0 for transports without sequence words.
+  virtual std::uint64_t channel_repairs() const { return 0; }
 };
 
 }  // namespace impetus

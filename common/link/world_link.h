@@ -41,6 +41,9 @@ class WorldLinkServer {
   virtual void finish_turn() = 0;
 
   virtual std::uint64_t rejected_reports() const = 0;
+  // Writes that found their channel's sequence word odd at rest (scribbled, or a writer killed mid-write) and repaired
+  // it (seqlock.h); 0 for transports without sequence words.
+  virtual std::uint64_t channel_repairs() const { return 0; }
 };
 
 // A haptic node's end.
@@ -66,6 +69,9 @@ class WorldLinkClient {
 
   virtual std::uint64_t rejected_frames() const = 0;
   virtual std::uint64_t attaches() const = 0;  // 1 + re-attachments
+  // Writes that found their channel's sequence word odd at rest (scribbled, or a writer killed mid-write) and repaired
+  // it (seqlock.h); 0 for transports without sequence words.
+  virtual std::uint64_t channel_repairs() const { return 0; }
 };
 
 }  // namespace impetus

@@ -1,6 +1,9 @@
 #include "common/runtime/lockstep.h"
 
+#include <linux/futex.h>
+#include <sys/syscall.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <cerrno>
 
@@ -28,50 +31,69 @@ void cpu_relax() {
 
 const char* to_string(ClockMode mode) { return mode == ClockMode::lockstep ? "lockstep" : "realtime"; }
 
-LockstepTurn::LockstepTurn() {
-  sem_init(&go_, /*pshared=*/1, 0);
-  sem_init(&done_, /*pshared=*/1, 0);
+const char* to_string(TurnResult result) {
+  switch (result) {
+    case TurnResult::ok: return "ok";
+    case TurnResult::shutdown: return "the session ended";
+    case TurnResult::peer_gone: return "the peer went away";
+    case TurnResult::timed_out: return "the peer stopped answering";
+    case TurnResult::corrupted: return "the lockstep turn in shared memory holds values the protocol never writes "
+                                       "(corrupted by another process)";
+  }
+  return "unknown";
 }
 
 void LockstepTurn::reset() {
-  sem_destroy(&go_);
-  sem_destroy(&done_);
-  sem_init(&go_, 1, 0);
-  sem_init(&done_, 1, 0);
+  go_.store(0, std::memory_order_release);
+  done_.store(0, std::memory_order_release);
 }
 
 void LockstepTurn::give(std::uint64_t tick) {
   tick_.store(tick, std::memory_order_release);
-  sem_post(&go_);
+  post(go_);
 }
 
-void LockstepTurn::finish() { sem_post(&done_); }
+void LockstepTurn::finish() { post(done_); }
 
 void LockstepTurn::request_shutdown() {
   shutdown_.store(1, std::memory_order_release);
-  sem_post(&go_);  // wake a follower that is waiting for a turn
+  post(go_);  // wake a follower that is waiting for a turn
 }
 
-LockstepTurn::Wait LockstepTurn::wait_slice(sem_t& semaphore) {
+void LockstepTurn::post(std::atomic<std::uint32_t>& turn) {
+  turn.store(1, std::memory_order_release);
+  // Process-shared futex (no FUTEX_PRIVATE_FLAG): the waiter is in another process. Waking nobody is harmless.
+  syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&turn), FUTEX_WAKE, 1, nullptr, nullptr, 0);
+}
+
+LockstepTurn::Wait LockstepTurn::wait_slice(std::atomic<std::uint32_t>& turn) {
+  // Takes the pending turn (1 → 0). Any value but 0 or 1 was not written by the protocol.
+  const auto take = [&turn]() -> int {
+    std::uint32_t expected = 1;
+    if (turn.compare_exchange_strong(expected, 0, std::memory_order_acq_rel)) return 1;
+    return expected == 0 ? 0 : -1;
+  };
   // A peer's turn is usually a few microseconds of work on the other core, while waking a thread blocked in the kernel
   // costs tens of microseconds on this VM: poll briefly first, then block. The poll is bounded (kSpinNs) so a long
   // turn (a world step of a big scene) or a machine shared by more processes wastes at most that much per wait.
   const std::int64_t spin_until_ns = monotonic_ns() + kSpinNs;
   do {
-    if (sem_trywait(&semaphore) == 0) return Wait::posted;
+    const int taken = take();
+    if (taken != 0) return taken > 0 ? Wait::posted : Wait::corrupted;
     cpu_relax();
   } while (monotonic_ns() < spin_until_ns);
-  timespec deadline{};
-  clock_gettime(CLOCK_MONOTONIC, &deadline);
-  deadline.tv_nsec += kWaitSliceNs;
-  if (deadline.tv_nsec >= 1'000'000'000) {
-    deadline.tv_sec += 1;
-    deadline.tv_nsec -= 1'000'000'000;
-  }
+  const std::int64_t deadline_ns = monotonic_ns() + kWaitSliceNs;
   for (;;) {
-    if (sem_clockwait(&semaphore, CLOCK_MONOTONIC, &deadline) == 0) return Wait::posted;
-    if (errno == EINTR) continue;
-    return errno == ETIMEDOUT ? Wait::slice_over : Wait::error;
+    const int taken = take();
+    if (taken != 0) return taken > 0 ? Wait::posted : Wait::corrupted;
+    const std::int64_t left_ns = deadline_ns - monotonic_ns();
+    if (left_ns <= 0) return Wait::slice_over;
+    const timespec timeout{static_cast<time_t>(left_ns / 1'000'000'000), static_cast<long>(left_ns % 1'000'000'000)};
+    // Sleeps only while the word is still 0; returns at a post, a signal or the timeout, each re-checked above.
+    if (syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&turn), FUTEX_WAIT, 0, &timeout, nullptr, 0) != 0 &&
+        errno != EAGAIN && errno != EINTR && errno != ETIMEDOUT) {
+      return Wait::corrupted;  // the kernel refused the word itself (it cannot, unless the mapping is gone)
+    }
   }
 }
 

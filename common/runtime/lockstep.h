@@ -1,12 +1,10 @@
 #pragma once
 // Turn-taking for `--clock lockstep` (DESIGN.md §3): the haptic controller's tick count is the master clock; the device
 // advances once per haptic tick and the world steps at tick i·n + phase. A follower sleeps on an interprocess semaphore
-// until the master gives it a turn, does its step, and hands the turn back — no spinning (the machine has 2 cores) and
+// until the master gives it a turn, does its step, and hands the turn back — no long spinning (the machine has 2 cores) and
 // the order of every read and write is fixed, so runs are bitwise reproducible.
 //
 // Every wait is sliced (kWaitSlice) so a waiter notices a dead peer or a shutdown request instead of hanging forever.
-
-#include <semaphore.h>
 
 #include <atomic>
 #include <cstdint>
@@ -16,14 +14,20 @@ namespace impetus {
 enum class ClockMode : std::uint32_t { realtime = 0, lockstep = 1 };
 const char* to_string(ClockMode mode);
 
-enum class TurnResult { ok, shutdown, peer_gone, timed_out };
+// `corrupted`: a word of the turn holds a value the protocol never writes (another process scribbled on the segment).
+enum class TurnResult { ok, shutdown, peer_gone, timed_out, corrupted };
+// What a TurnResult means, for messages.
+const char* to_string(TurnResult result);
 
-// Lives in a segment. Both semaphores are process-shared.
+// Lives in a segment; every word is a process-shared atomic. A turn is handed over by a binary semaphore built on a
+// futex word (0: no turn pending, 1: one pending) rather than a POSIX sem_t: glibc aborts the whole process when a
+// scribbled sem_t makes the futex call fail, whereas here every word is checked before use and a value the protocol
+// never writes ends the wait with `corrupted`, so the caller can say so and stop cleanly.
 class LockstepTurn {
  public:
-  LockstepTurn();
-  // Re-initialises both semaphores. Only when no process can be waiting on them (the peer died and its slot is not
-  // yet released), so stale posts from a dead peer cannot hand a new peer a turn that was never given.
+  LockstepTurn() = default;
+  // Clears both turns. Only when no process can be waiting on them (the peer died and its slot is not yet released),
+  // so a stale post from a dead peer cannot hand a new peer a turn that was never given.
   void reset();
 
   // Master: hands tick `tick` to the follower.
@@ -42,17 +46,20 @@ class LockstepTurn {
   std::uint64_t tick() const { return tick_.load(std::memory_order_acquire); }
   // Master: ends the session; a follower's wait returns `shutdown` from then on.
   void request_shutdown();
-  bool shutdown_requested() const { return shutdown_.load(std::memory_order_acquire) != 0; }
+  bool shutdown_requested() const { return shutdown_.load(std::memory_order_acquire) == 1; }
 
  private:
-  enum class Wait { posted, slice_over, error };
-  static Wait wait_slice(sem_t& semaphore);
+  enum class Wait { posted, slice_over, corrupted };
+  static Wait wait_slice(std::atomic<std::uint32_t>& turn);
+  static void post(std::atomic<std::uint32_t>& turn);
+  bool shutdown_corrupted() const { return shutdown_.load(std::memory_order_acquire) > 1; }
 
-  sem_t go_;
-  sem_t done_;
+  std::atomic<std::uint32_t> go_{0};    // master → follower
+  std::atomic<std::uint32_t> done_{0};  // follower → master
   std::atomic<std::uint64_t> tick_{0};
   std::atomic<std::uint32_t> shutdown_{0};
 };
+static_assert(std::atomic<std::uint32_t>::is_always_lock_free);
 
 template <class PeerAlive>
 TurnResult LockstepTurn::wait_done(PeerAlive&& peer_alive, double timeout_s) {
@@ -60,7 +67,7 @@ TurnResult LockstepTurn::wait_done(PeerAlive&& peer_alive, double timeout_s) {
   for (int slice = 0; slice < slices; ++slice) {
     switch (wait_slice(done_)) {
       case Wait::posted: return TurnResult::ok;
-      case Wait::error: return TurnResult::peer_gone;
+      case Wait::corrupted: return TurnResult::corrupted;
       case Wait::slice_over:
         if (!peer_alive()) return TurnResult::peer_gone;
         break;
@@ -72,10 +79,13 @@ TurnResult LockstepTurn::wait_done(PeerAlive&& peer_alive, double timeout_s) {
 template <class KeepWaiting>
 TurnResult LockstepTurn::wait_turn(KeepWaiting&& keep_waiting) {
   for (;;) {
+    if (shutdown_corrupted()) return TurnResult::corrupted;
     if (shutdown_requested()) return TurnResult::shutdown;
     switch (wait_slice(go_)) {
-      case Wait::posted: return shutdown_requested() ? TurnResult::shutdown : TurnResult::ok;
-      case Wait::error: return TurnResult::peer_gone;
+      case Wait::posted:
+        if (shutdown_corrupted()) return TurnResult::corrupted;
+        return shutdown_requested() ? TurnResult::shutdown : TurnResult::ok;
+      case Wait::corrupted: return TurnResult::corrupted;
       case Wait::slice_over:
         if (!keep_waiting()) return TurnResult::peer_gone;
         break;

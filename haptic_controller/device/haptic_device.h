@@ -27,6 +27,8 @@ struct DeviceLimits {
 struct DeviceCounters {
   std::uint64_t saturations = 0;      // forces the device could render only approximately
   std::uint64_t rejected_frames = 0;  // readings its transport refused (checksum, range)
+  std::uint64_t devices_lost = 0;     // devices that left mid-session without detaching
+  std::uint64_t channel_repairs = 0;  // odd sequence words its transport found at rest and repaired
 };
 
 class HapticDevice {

@@ -41,6 +41,8 @@ DeviceCounters SpidarDriver::counters() const {
   DeviceCounters counters;
   counters.saturations = saturations_;
   counters.rejected_frames = port_.rejected_states();
+  counters.devices_lost = port_.devices_lost();
+  counters.channel_repairs = port_.channel_repairs();
   return counters;
 }
 

@@ -7,6 +7,7 @@
 #include <signal.h>
 
 #include <array>
+#include <cstring>
 #include <atomic>
 #include <vector>
 
@@ -93,6 +94,25 @@ TEST_CASE("a lockstep master notices a dead follower instead of hanging") {
   REQUIRE(test::wait_child(follower) == 0);
   segment->device_turn.give(0);
   CHECK(segment->device_turn.wait_done([&] { return kill(follower, 0) == 0; }, 5.0) == TurnResult::peer_gone);
+}
+
+TEST_CASE("a scribbled turn is reported as corrupted, never aborts, in either direction") {
+  // With POSIX semaphores glibc aborted the whole process ("The futex facility returned an unexpected error code")
+  // when another process had written over a sem_t. Every byte pattern here must give `corrupted` or a clean result.
+  for (const unsigned char pattern : {0xFF, 0xAB, 0x02, 0x80}) {
+    INFO("pattern " << static_cast<int>(pattern));
+    const std::string name = test::unique_segment_name("scribble");
+    auto segment = Segment<LockstepLayout>::create(name);
+    std::memset(static_cast<void*>(&segment->device_turn), pattern, sizeof(LockstepTurn));
+    CHECK(segment->device_turn.wait_turn([] { return true; }) == TurnResult::corrupted);
+    CHECK(segment->device_turn.wait_done([] { return true; }, 0.2) == TurnResult::corrupted);
+    // The master's posts on a scribbled turn do not abort either, and a reset turn works again.
+    segment->device_turn.give(7);
+    segment->device_turn.finish();
+    segment->device_turn.reset();
+    segment->device_turn.give(8);
+    CHECK(segment->device_turn.tick() == 8);
+  }
 }
 
 }  // namespace impetus

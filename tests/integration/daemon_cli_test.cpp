@@ -1,7 +1,13 @@
 #include "trial_support.h"
 
+#include "common/link/shm/world_link_layout.h"
+
 #include <catch2/catch.hpp>
 
+#include <sys/mman.h>
+
+#include <cstddef>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -68,6 +74,14 @@ TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment 
       {device + "--trajectory tap:speed=-1", "speed"},
       {device + "--trajectory nosuchfile.csv", "nosuchfile.csv"},
       {device + "--trajectory tap", "device port"},  // no haptic controller running
+      // A phase is an offset within one world period; 2^64 must not saturate into a valid-looking value.
+      {world + "--scene scenes/tap.json --clock lockstep --phase 50", "the phase must be 0 to 49"},
+      {world + "--scene scenes/tap.json --clock lockstep --phase 18446744073709551616", "whole number from 0"},
+      // Readable bounds (CLI11's printed 309 digits) and the real reason.
+      {haptic + "--rate 1e300", "between 100 and 20000"},
+      {device + "--trajectory tap --finger-mass -1", "must be positive, not -1"},
+      {haptic + "--stiffness 1e12", "at most 1e+06"},
+      {world + "--scene scenes/tap.json --substeps 99999999999999999999", "whole number from 1 to 10000"},
   };
   for (const Case& test_case : cases) {
     INFO(test_case.command);
@@ -76,6 +90,7 @@ TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment 
     CHECK(result.status != 0);
     CHECK(result.status != 124);  // not killed by the timeout: no hang
     CHECK_THAT(result.output, Catch::Contains(test_case.expected));
+    CHECK(result.output.size() < 600);  // a short message, no 309-digit bounds
     CHECK_FALSE(segments_left(shm));
   }
 }
@@ -210,18 +225,186 @@ TEST_CASE("lockstep: a device killed mid-session is reported by the haptic contr
   test::wait_for(device, 5);
   // The controller notices within its turn timeout and says so (it used to wait in silence).
   std::string haptic_out;
-  for (int i = 0; i < 100 && haptic_out.find("went away mid-session") == std::string::npos; ++i) {
+  for (int i = 0; i < 100 && haptic_out.find("is lost mid-session") == std::string::npos; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     haptic_out = test::read_text(dir / "haptic.out");
   }
   INFO(haptic_out);
-  CHECK_THAT(haptic_out, Catch::Contains("went away mid-session"));
+  CHECK_THAT(haptic_out, Catch::Contains("is lost mid-session"));
   kill(haptic, SIGTERM);
-  CHECK(test::wait_for(haptic, 10) != -1);  // it stops: no hang
+  CHECK(test::wait_for(haptic, 10) == 1);  // it stops (no hang), and the cut-short trial is not a success
   kill(world, SIGTERM);
   CHECK(test::wait_for(world, 10) != -1);
   CHECK_FALSE(std::filesystem::exists("/dev/shm/" + shm + ".world"));
   CHECK_FALSE(std::filesystem::exists("/dev/shm/" + shm + ".device"));
+}
+
+}  // namespace impetus
+
+namespace impetus {
+namespace {
+
+// The three daemons of a lockstep trial that would run for minutes: a 600 s press.
+struct LongLockstepTrial {
+  std::filesystem::path dir;
+  std::string shm;
+  pid_t world, haptic, device;
+
+  explicit LongLockstepTrial(const std::string& name)
+      : dir(test::out_dir(name)), shm("impetus_test_" + name + "_" + std::to_string(getpid())) {
+    world = test::spawn({test::binary("world_manager"), "--scene", std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json",
+                         "--clock", "lockstep", "--shm", shm}, dir / "world.out");
+    haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm}, dir / "haptic.out");
+    device = test::spawn({test::binary("spidar_sim"), "--clock", "lockstep", "--shm", shm, "--attach-timeout", "5",
+                          "--trajectory", "press:hold=600"}, dir / "device.out");
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  std::string output(const char* who) const { return test::read_text(dir / (std::string(who) + ".out")); }
+  bool segments_left() const {
+    return std::filesystem::exists("/dev/shm/" + shm + ".world") ||
+           std::filesystem::exists("/dev/shm/" + shm + ".device");
+  }
+};
+
+}  // namespace
+
+TEST_CASE("lockstep: a stop request ends a running trial at once and cleanly, whichever process gets it") {
+  // Turns keep coming in lockstep, so a follower never waited long enough to look at its stop flag, and the master
+  // never looked at it at all: SIGINT (Ctrl-C) and SIGTERM were ignored until the trajectory ended.
+  SECTION("SIGINT to all three, as Ctrl-C in a terminal sends it") {
+    LongLockstepTrial trial("stop-all");
+    const auto start = std::chrono::steady_clock::now();
+    for (pid_t pid : {trial.world, trial.haptic, trial.device}) kill(pid, SIGINT);
+    CHECK(test::wait_for(trial.haptic, 10) == 0);
+    CHECK(test::wait_for(trial.world, 10) == 0);
+    CHECK(test::wait_for(trial.device, 10) == 0);
+    std::printf("lockstep stop, SIGINT to all: %.0f ms until all three exited\n",
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    CHECK_FALSE(trial.segments_left());
+  }
+  SECTION("SIGTERM to the haptic controller, the master clock: it ends the session for the others") {
+    LongLockstepTrial trial("stop-master");
+    kill(trial.haptic, SIGTERM);
+    CHECK(test::wait_for(trial.haptic, 10) == 0);
+    CHECK(test::wait_for(trial.world, 10) == 0);
+    CHECK(test::wait_for(trial.device, 10) == 0);
+    CHECK_THAT(trial.output("device"), Catch::Contains("ended the session"));
+    CHECK_FALSE(trial.segments_left());
+  }
+  SECTION("SIGTERM to the device: it detaches cleanly, and the controller is not told a device died") {
+    LongLockstepTrial trial("stop-device");
+    kill(trial.device, SIGTERM);
+    CHECK(test::wait_for(trial.device, 10) == 0);
+    kill(trial.haptic, SIGTERM);
+    CHECK(test::wait_for(trial.haptic, 10) == 0);
+    kill(trial.world, SIGTERM);
+    CHECK(test::wait_for(trial.world, 10) == 0);
+    CHECK_THAT(trial.output("device"), Catch::Contains("stopped"));
+    CHECK_THAT(trial.output("haptic"), !Catch::Contains("is lost"));
+    CHECK_FALSE(trial.segments_left());
+  }
+}
+
+TEST_CASE("lockstep: the haptic controller exits non-zero when the world dies mid-trial") {
+  LongLockstepTrial trial("world-killed");
+  kill(trial.world, SIGKILL);
+  test::wait_for(trial.world, 5);
+  kill(trial.device, SIGTERM);
+  CHECK(test::wait_for(trial.device, 10) == 0);
+  kill(trial.haptic, SIGTERM);
+  CHECK(test::wait_for(trial.haptic, 10) == 1);
+  const std::string haptic_out = trial.output("haptic");
+  INFO(haptic_out);
+  CHECK_THAT(haptic_out, Catch::Contains("the trial is incomplete") && Catch::Contains("world manager"));
+  std::filesystem::remove("/dev/shm/" + trial.shm + ".world");  // the killed world's own segment
+  CHECK_FALSE(trial.segments_left());
+}
+
+TEST_CASE("run.sh stops a lockstep trial on SIGINT and leaves nothing behind") {
+  const auto dir = test::out_dir("run-interrupted");
+  const pid_t run = test::spawn({"/bin/bash", std::string(IMPETUS_SOURCE_DIR) + "/scripts/run.sh", "--scene",
+                                 std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json", "--clock", "lockstep",
+                                 "--trajectory", "press:hold=600", "--duration", "700", "--out",
+                                 (dir / "trial").string(), "--quiet"},
+                                dir / "run.out");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  REQUIRE(waitpid(run, nullptr, WNOHANG) == 0);  // still running: a 600 s press
+  kill(run, SIGINT);
+  CHECK(test::wait_for(run, 15) == 130);
+  CHECK_THAT(test::read_text(dir / "run.out"), Catch::Contains("interrupted"));
+}
+
+}  // namespace impetus
+
+namespace impetus {
+
+TEST_CASE("lockstep: a turn scribbled by another process ends the trial with a message, no abort, no segment left") {
+  LongLockstepTrial trial("scribbled-turn");
+  // Another process (here the test) writes garbage over the world link's turn while the trial runs.
+  const std::string path = "/dev/shm/" + trial.shm + ".world";
+  const int fd = ::open(path.c_str(), O_RDWR);
+  REQUIRE(fd >= 0);
+  void* mapping = mmap(nullptr, sizeof(WorldLinkLayout), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  ::close(fd);
+  REQUIRE(mapping != MAP_FAILED);
+  auto* turn = static_cast<unsigned char*>(mapping) + offsetof(WorldLinkLayout, world_turn);
+  std::memset(turn, 0xAB, sizeof(LockstepTurn));
+  munmap(mapping, sizeof(WorldLinkLayout));
+  // The world and the controller each find the corrupted turn and say so; neither aborts (status -1: a signal).
+  CHECK(test::wait_for(trial.world, 10) == 1);
+  kill(trial.device, SIGTERM);
+  CHECK(test::wait_for(trial.device, 10) == 0);
+  kill(trial.haptic, SIGTERM);
+  CHECK(test::wait_for(trial.haptic, 10) == 1);
+  INFO(trial.output("world"));
+  INFO(trial.output("haptic"));
+  CHECK_THAT(trial.output("world"), Catch::Contains("corrupted"));
+  CHECK_THAT(trial.output("haptic"), Catch::Contains("the trial is incomplete"));
+  CHECK_FALSE(trial.segments_left());
+}
+
+}  // namespace impetus
+
+namespace impetus {
+
+TEST_CASE("lockstep: odd sequence words scribbled into the running link are repaired and counted, the trial goes on") {
+  const auto dir = test::out_dir("scribbled-sequence");
+  const std::string shm = "impetus_test_seq_" + std::to_string(getpid());
+  const pid_t world = test::spawn({test::binary("world_manager"), "--scene", std::string(IMPETUS_SOURCE_DIR) +
+                                   "/scenes/tap.json", "--clock", "lockstep", "--shm", shm, "--summary",
+                                   (dir / "world.json").string()}, dir / "world.out");
+  const pid_t haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm,
+                                    "--summary", (dir / "haptic.json").string()}, dir / "haptic.out");
+  const pid_t device = test::spawn({test::binary("spidar_sim"), "--clock", "lockstep", "--shm", shm,
+                                    "--attach-timeout", "5", "--trajectory", "press:hold=600"}, dir / "device.out");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const int fd = ::open(("/dev/shm/" + shm + ".world").c_str(), O_RDWR);
+  REQUIRE(fd >= 0);
+  void* mapping = mmap(nullptr, sizeof(WorldLinkLayout), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  ::close(fd);
+  REQUIRE(mapping != MAP_FAILED);
+  auto& layout = *static_cast<WorldLinkLayout*>(mapping);
+  // The sequence word is each channel's first; an odd value at rest made every reader wait for a write that never
+  // ends. A scribble that lands while the writer is mid-write is overwritten by that write, so it is done 20 times.
+  const std::uint64_t before = layout.report.sequence();
+  for (int i = 0; i < 20; ++i) {
+    reinterpret_cast<std::atomic<std::uint64_t>*>(&layout.planes)->store(1001);
+    reinterpret_cast<std::atomic<std::uint64_t>*>(&layout.report)->store(2001);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const bool still_moving = layout.report.sequence() % 2 == 0 && layout.report.sequence() != before;
+  munmap(mapping, sizeof(WorldLinkLayout));
+  for (pid_t pid : {world, haptic, device}) kill(pid, SIGINT);
+  CHECK(test::wait_for(haptic, 10) == 0);
+  CHECK(test::wait_for(world, 10) == 0);
+  CHECK(test::wait_for(device, 10) == 0);
+  CHECK(still_moving);
+  const auto haptic_summary = nlohmann::json::parse(test::read_text(dir / "haptic.json"));
+  const auto world_summary = nlohmann::json::parse(test::read_text(dir / "world.json"));
+  INFO(haptic_summary.dump());
+  CHECK(haptic_summary["haptic"]["channel_repairs"].get<int>() >= 1);
+  CHECK(world_summary["world"]["channel_repairs"].get<int>() >= 1);
 }
 
 }  // namespace impetus

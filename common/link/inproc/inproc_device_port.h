@@ -40,6 +40,7 @@ class InProcessDevicePort final : public DevicePortHost, public DevicePortClient
   bool wait_for_device() override { return device_ != nullptr && !detached_; }
   void end_session() override {}
   std::uint64_t rejected_states() const override { return 0; }
+  std::uint64_t devices_lost() const override { return 0; }  // the in-process device cannot die apart
 
   // Device end.
   ClockMode clock() const override { return ClockMode::lockstep; }

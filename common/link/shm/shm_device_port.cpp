@@ -55,12 +55,14 @@ const DeviceState* ShmDevicePortHost::lockstep_turn(std::uint64_t tick) {
   attached_pid_ = pid;
   segment_->device_turn.give(tick);
   const TurnResult result = segment_->device_turn.wait_done([&] { return process_alive(pid); }, kTurnTimeout_s);
-  if (result != TurnResult::ok || segment_->detaching.load(std::memory_order_acquire) != 0) {
-    if (result != TurnResult::ok) {
-      // Not a detach: the device died or stopped answering. Lockstep time waits for the next device, so say so
-      // rather than wait in silence.
-      std::fprintf(stderr, "haptic_controller: the device (pid %d) went away mid-session; lockstep waits for a device "
-                           "to attach (Ctrl-C or SIGTERM to stop)\n", static_cast<int>(pid));
+  const bool detaching = segment_->detaching.load(std::memory_order_acquire) != 0;
+  if (result != TurnResult::ok || detaching) {
+    if (!detaching) {
+      // Not a detach: the device died, stopped answering or its turn was corrupted. Lockstep time waits for the next
+      // device, so say so rather than wait in silence.
+      std::fprintf(stderr, "haptic_controller: the device (pid %d) is lost mid-session: %s; lockstep waits for a "
+                           "device to attach (Ctrl-C or SIGTERM to stop)\n", static_cast<int>(pid), to_string(result));
+      ++devices_lost_;
     }
     release_device();
     return nullptr;
@@ -82,7 +84,10 @@ const DeviceState* ShmDevicePortHost::latest_state(double now_s) {
   if (read_state()) fresh_s_ = now_s;
   if (device_stale(now_s - fresh_s_) || !have_state_) {
     // A stale device gets minimum output; a dead one also loses its slot so that a new device can attach.
-    if (!process_alive(pid)) release_device();
+    if (!process_alive(pid)) {
+      ++devices_lost_;
+      release_device();
+    }
     return nullptr;
   }
   return &state_;
@@ -90,7 +95,7 @@ const DeviceState* ShmDevicePortHost::latest_state(double now_s) {
 
 void ShmDevicePortHost::send_command(const DeviceCommand& command) {
   encode(command, command_wire_);
-  segment_->command.write(command_wire_);
+  if (!segment_->command.write(command_wire_)) ++repairs_;
 }
 
 bool ShmDevicePortHost::wait_for_device() {
@@ -138,10 +143,12 @@ bool ShmDevicePortClient::latest_command(DeviceCommand& out) { return commands_.
 
 void ShmDevicePortClient::publish_state(const DeviceState& state) {
   encode(state, state_wire_);
-  segment_->state.write(state_wire_);
+  if (!segment_->state.write(state_wire_)) ++repairs_;
 }
 
-void ShmDevicePortClient::publish_stats(const LoopStats& stats) { segment_->device_stats.write(stats); }
+void ShmDevicePortClient::publish_stats(const LoopStats& stats) {
+  if (!segment_->device_stats.write(stats)) ++repairs_;
+}
 
 TurnResult ShmDevicePortClient::wait_turn() {
   return segment_->device_turn.wait_turn([&] { return !g_stop_requested.load() && segment_.creator_alive(); });

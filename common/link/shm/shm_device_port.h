@@ -24,6 +24,8 @@ class ShmDevicePortHost final : public DevicePortHost {
   bool wait_for_device() override;
   void end_session() override;
   std::uint64_t rejected_states() const override { return rejected_; }
+  std::uint64_t devices_lost() const override { return devices_lost_; }
+  std::uint64_t channel_repairs() const override { return repairs_; }
 
   const std::string& name() const { return segment_.name(); }
 
@@ -38,6 +40,8 @@ class ShmDevicePortHost final : public DevicePortHost {
   wire::DeviceCommand command_wire_{};
   DeviceState state_{};
   bool have_state_ = false;
+  std::uint64_t devices_lost_ = 0;
+  std::uint64_t repairs_ = 0;
   double fresh_s_ = 0.0;
   std::uint64_t rejected_ = 0;
 };
@@ -60,12 +64,14 @@ class ShmDevicePortClient final : public DevicePortClient {
   void detach() override;
   bool host_alive() const override { return segment_.creator_alive(); }
   std::uint64_t rejected_commands() const override { return commands_.rejected(); }
+  std::uint64_t channel_repairs() const override { return repairs_; }
 
   const std::string& name() const { return segment_.name(); }
 
  private:
   Segment<DevicePortLayout> segment_;
   LatestValid<wire::DeviceCommand, DeviceCommand> commands_;
+  std::uint64_t repairs_ = 0;
   wire::DeviceState state_wire_{};
   bool detached_ = false;
 };

@@ -27,10 +27,12 @@ bool ShmWorldLinkServer::latest_report(HapticReport& out) { return reports_.read
 
 void ShmWorldLinkServer::publish_frame(const PlaneFrame& frame) {
   encode(frame, frame_wire_);
-  segment_->planes.write(frame_wire_);
+  if (!segment_->planes.write(frame_wire_)) ++repairs_;
 }
 
-void ShmWorldLinkServer::publish_stats(const LoopStats& stats) { segment_->world_stats.write(stats); }
+void ShmWorldLinkServer::publish_stats(const LoopStats& stats) {
+  if (!segment_->world_stats.write(stats)) ++repairs_;
+}
 
 TurnResult ShmWorldLinkServer::wait_turn() {
   WorldLinkLayout& link = *segment_;
@@ -74,10 +76,12 @@ bool ShmWorldLinkClient::receive_frame(PlaneFrame& out) {
 
 void ShmWorldLinkClient::publish_report(const HapticReport& report) {
   encode(report, report_wire_);
-  world().report.write(report_wire_);
+  if (!world().report.write(report_wire_)) ++repairs_;
 }
 
-void ShmWorldLinkClient::publish_stats(const LoopStats& stats) { world().haptic_stats.write(stats); }
+void ShmWorldLinkClient::publish_stats(const LoopStats& stats) {
+  if (!world().haptic_stats.write(stats)) ++repairs_;
+}
 
 bool ShmWorldLinkClient::step_world(std::uint64_t tick) {
   if (!world_alive_) world_alive_ = reattach();
@@ -86,7 +90,8 @@ bool ShmWorldLinkClient::step_world(std::uint64_t tick) {
   link.world_turn.give(tick);
   const TurnResult result = link.world_turn.wait_done([&] { return worlds_.back()->creator_alive(); }, kTurnTimeout_s);
   if (result != TurnResult::ok) {
-    std::fprintf(stderr, "haptic_controller: the world manager went away; keeping its last planes\n");
+    std::fprintf(stderr, "haptic_controller: the world manager is lost: %s; keeping its last planes\n",
+                 to_string(result));
     world_alive_ = false;
   }
   return world_alive_;

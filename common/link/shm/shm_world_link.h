@@ -25,6 +25,7 @@ class ShmWorldLinkServer final : public WorldLinkServer {
   TurnResult wait_turn() override;
   void finish_turn() override;
   std::uint64_t rejected_reports() const override { return reports_.rejected(); }
+  std::uint64_t channel_repairs() const override { return repairs_; }
 
   const std::string& name() const { return segment_.name(); }
 
@@ -32,6 +33,7 @@ class ShmWorldLinkServer final : public WorldLinkServer {
   Segment<WorldLinkLayout> segment_;
   wire::PlaneFrame frame_wire_{};
   LatestValid<wire::HapticReport, HapticReport> reports_;
+  std::uint64_t repairs_ = 0;
 };
 
 class ShmWorldLinkClient final : public WorldLinkClient {
@@ -49,12 +51,14 @@ class ShmWorldLinkClient final : public WorldLinkClient {
   bool reattach() override;
   std::uint64_t rejected_frames() const override { return rejected_; }
   std::uint64_t attaches() const override { return attaches_.load(); }
+  std::uint64_t channel_repairs() const override { return repairs_; }
 
   const std::string& name() const { return name_; }
 
  private:
   WorldLinkLayout& world() const { return *current_.load(std::memory_order_acquire); }
 
+  std::uint64_t repairs_ = 0;
   std::string name_;
   ClockMode clock_;
   WorldLinkInfo info_;
