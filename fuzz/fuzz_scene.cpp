@@ -4,10 +4,12 @@
 // pointing at the field. An accepted scene must hold only numbers the world manager can use.
 
 #include "world_manager/scene.h"
+#include "common/contract/limits.h"
 #include "fuzz/fuzz_check.h"
 
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <cstdint>
 #include <string_view>
 
@@ -21,8 +23,49 @@ bool material_ok(const impetus::Material& m) {
          m.restitution <= 1.0;
 }
 
+// The same length the parser checks (std::hypot), so a value on the bound is judged alike.
+double hypot3(const impetus::Vec3& v) { return std::hypot(v[0], v[1], v[2]); }
+
+bool within(double x, double lowest, double highest) { return x >= lowest && x <= highest; }
+
+bool coordinates_ok(const impetus::Vec3& v) {
+  using impetus::SceneLimits;
+  for (double x : v) {
+    if (!within(x, -SceneLimits::kMaxCoordinate_m, SceneLimits::kMaxCoordinate_m)) return false;
+  }
+  return true;
+}
+
+// The physical ranges of scene.h (SceneLimits): what keeps ODE's broadphase and solver away from their asserts.
+void check_limits(const impetus::Scene& scene) {
+  using impetus::SceneLimits;
+  FUZZ_CHECK(scene.objects.size() <= SceneLimits::kMaxObjects);
+  FUZZ_CHECK(hypot3(scene.gravity_mps2) <= SceneLimits::kMaxGravity_mps2);
+  FUZZ_CHECK(within(scene.floor.height_m, -SceneLimits::kMaxCoordinate_m, SceneLimits::kMaxCoordinate_m));
+  FUZZ_CHECK(
+      within(scene.physics.world_rate_hz, impetus::limits::kMinWorldRate_Hz, impetus::limits::kMaxWorldRate_Hz));
+  FUZZ_CHECK(scene.physics.substeps <= impetus::limits::kMaxSubsteps);
+  FUZZ_CHECK(scene.physics.solver_iterations <= impetus::limits::kMaxSolverIterations);
+  for (const impetus::SceneObject& object : scene.objects) {
+    FUZZ_CHECK(coordinates_ok(object.position_m));
+    FUZZ_CHECK(hypot3(object.linear_velocity_mps) <= SceneLimits::kMaxSpeed_mps);
+    FUZZ_CHECK(hypot3(object.angular_velocity_radps) <= SceneLimits::kMaxAngularSpeed_radps);
+    if (object.dynamic) FUZZ_CHECK(within(object.mass_kg, SceneLimits::kMinMass_kg, SceneLimits::kMaxMass_kg));
+    const impetus::Shape& shape = object.shape;
+    if (shape.kind == impetus::ShapeKind::box) {
+      for (double size : shape.box_size_m) {
+        FUZZ_CHECK(within(size, SceneLimits::kMinLength_m, SceneLimits::kMaxLength_m));
+      }
+    } else {
+      FUZZ_CHECK(within(shape.radius_m, SceneLimits::kMinLength_m, SceneLimits::kMaxLength_m));
+      FUZZ_CHECK(within(shape.length_m, 0.0, SceneLimits::kMaxLength_m));
+    }
+  }
+}
+
 // What scene.h promises about a scene that parsed.
 void check_scene(const impetus::Scene& scene) {
+  check_limits(scene);
   FUZZ_CHECK(finite3(scene.gravity_mps2));
   FUZZ_CHECK(std::isfinite(scene.floor.height_m));
   FUZZ_CHECK(material_ok(scene.floor.material));
@@ -55,7 +98,9 @@ void check_scene(const impetus::Scene& scene) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
     check_scene(impetus::parse_scene_text(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json"));
-  } catch (const impetus::SceneError&) {
+  } catch (const impetus::SceneError& error) {
+    // A message quotes at most a short excerpt of the input, however large the input (fuzz/regressions/*.gen).
+    FUZZ_CHECK(std::strlen(error.what()) < impetus::fuzz::kMaxMessageChars);
   }
   return 0;
 }

@@ -7,6 +7,7 @@
 #include "fuzz/trajectory_check.h"
 
 #include <cstddef>
+#include <cstring>
 #include <cstdint>
 #include <sstream>
 #include <string>
@@ -15,7 +16,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));
   try {
     impetus::fuzz::check_trajectory(impetus::parse_trajectory_csv(in, "fuzz.csv"));
-  } catch (const impetus::TrajectoryError&) {
+  } catch (const impetus::TrajectoryError& error) {
+    // A message quotes at most a short excerpt of the input, however large the input (fuzz/regressions/*.gen).
+    FUZZ_CHECK(std::strlen(error.what()) < impetus::fuzz::kMaxMessageChars);
   }
   return 0;
 }

@@ -1,5 +1,7 @@
 #include "spidar_sim/trajectory.h"
 
+#include "common/runtime/message_text.h"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -138,7 +140,7 @@ constexpr std::array<std::string_view, 4> kCsvColumns = {"t", "x", "y", "z"};
 [[noreturn]] void csv_error(const std::string& path, int line, std::size_t column, std::string_view column_name,
                             std::string_view reason, std::string_view got) {
   std::ostringstream message;
-  message << path << ':' << line << ':' << column << " (" << column_name << "): " << reason << " (got '" << got
+  message << path << ':' << line << ':' << column << " (" << column_name << "): " << reason << " (got '" << excerpt(got, 80)
           << "')";
   throw TrajectoryError(message.str());
 }
@@ -170,34 +172,35 @@ std::vector<CsvField> split_fields(std::string_view line) {
 
 Trajectory::Trajectory(std::vector<TrajectorySegment> segments, std::string description)
     : segments_(std::move(segments)), description_(std::move(description)) {
-  if (segments_.empty()) throw TrajectoryError(description_ + ": trajectory has no segments");
+  if (segments_.empty()) throw TrajectoryError(excerpt(description_, 80) + ": trajectory has no segments");
   for (std::size_t i = 0; i < segments_.size(); ++i) {
     const TrajectorySegment& seg = segments_[i];
-    if (!segment_finite(seg)) throw TrajectoryError(description_ + ": segment " + std::to_string(i) + " is not finite");
+    if (!segment_finite(seg)) throw TrajectoryError(excerpt(description_, 80) + ": segment " + std::to_string(i) + " is not finite");
     if (!segment_evaluable(seg)) {
-      throw TrajectoryError(description_ + ": segment " + std::to_string(i) +
+      throw TrajectoryError(excerpt(description_, 80) + ": segment " + std::to_string(i) +
                             " has positions or speeds too large to represent");
     }
     if (seg.end_s < seg.begin_s) {
-      throw TrajectoryError(description_ + ": segment " + std::to_string(i) + " ends before it begins");
+      throw TrajectoryError(excerpt(description_, 80) + ": segment " + std::to_string(i) + " ends before it begins");
     }
     if (i == 0) {
-      if (seg.begin_s < 0.0) throw TrajectoryError(description_ + ": trajectory begins before t = 0");
+      if (seg.begin_s < 0.0) throw TrajectoryError(excerpt(description_, 80) + ": trajectory begins before t = 0");
       continue;
     }
     const TrajectorySegment& prev = segments_[i - 1];
     if (seg.begin_s != prev.end_s) {
-      throw TrajectoryError(description_ + ": segment " + std::to_string(i) + " does not begin when the previous ends");
+      throw TrajectoryError(excerpt(description_, 80) + ": segment " + std::to_string(i) +
+                            " does not begin when the previous ends");
     }
     if ((point_on_path(seg, 0.0) - point_on_path(prev, 1.0)).norm() > kJoinTolerance_m) {
-      throw TrajectoryError(description_ + ": segment " + std::to_string(i) +
+      throw TrajectoryError(excerpt(description_, 80) + ": segment " + std::to_string(i) +
                             " does not begin where the previous ends");
     }
   }
 }
 
 Trajectory Trajectory::from_waypoints(const std::vector<Waypoint>& waypoints, std::string description) {
-  if (waypoints.empty()) throw TrajectoryError(description + ": no waypoints");
+  if (waypoints.empty()) throw TrajectoryError(excerpt(description, 80) + ": no waypoints");
   std::vector<TrajectorySegment> segments;
   const auto line_between = [](const Waypoint& a, const Waypoint& b) {
     TrajectorySegment seg;
@@ -212,7 +215,7 @@ Trajectory Trajectory::from_waypoints(const std::vector<Waypoint>& waypoints, st
   }
   for (std::size_t i = 1; i < waypoints.size(); ++i) {
     if (!(waypoints[i].t_s > waypoints[i - 1].t_s)) {
-      throw TrajectoryError(description + ": waypoint " + std::to_string(i) + ": time must be strictly increasing");
+      throw TrajectoryError(excerpt(description, 80) + ": waypoint " + std::to_string(i) + ": time must be strictly increasing");
     }
     segments.push_back(line_between(waypoints[i - 1], waypoints[i]));
   }
@@ -355,18 +358,18 @@ class BuiltinParams {
           trim(text.substr(start, comma == std::string_view::npos ? text.npos : comma - start));
       start = comma == std::string_view::npos ? text.size() + 1 : comma + 1;
       const std::size_t equals = item.find('=');
-      if (item.empty()) fail("empty parameter in '" + std::string(text) + "'");
+      if (item.empty()) fail("empty parameter in '" + excerpt(text, 80) + "'");
       if (equals == std::string_view::npos) {
-        fail("parameter '" + std::string(item) + "' has no value (expected key=value)");
+        fail("parameter '" + excerpt(item, 80) + "' has no value (expected key=value)");
       }
       const std::string key(trim(item.substr(0, equals)));
       const std::string value(trim(item.substr(equals + 1)));
       if (std::find(known_keys.begin(), known_keys.end(), key) == known_keys.end()) {
         std::string known;
         for (const std::string_view k : known_keys) known += (known.empty() ? "" : ", ") + std::string(k);
-        fail("unknown parameter '" + key + "' (value '" + value + "'); known: " + known);
+        fail("unknown parameter '" + excerpt(key, 80) + "' (value '" + excerpt(value, 80) + "'); known: " + known);
       }
-      if (!values_.emplace(key, value).second) fail("parameter '" + key + "' given twice (value '" + value + "')");
+      if (!values_.emplace(key, value).second) fail("parameter '" + key + "' given twice (value '" + excerpt(value, 80) + "')");
     }
   }
 
@@ -376,11 +379,11 @@ class BuiltinParams {
     double value = 0.0;
     switch (parse_number(it->second, value)) {
       case NumberStatus::ok: break;
-      case NumberStatus::not_a_number: fail(key + "='" + it->second + "': not a number");
-      case NumberStatus::not_finite: fail(key + "='" + it->second + "': must be finite");
+      case NumberStatus::not_a_number: fail(key + "='" + excerpt(it->second, 80) + "': not a number");
+      case NumberStatus::not_finite: fail(key + "='" + excerpt(it->second, 80) + "': must be finite");
     }
     if (!in_range(range, value)) {
-      fail(key + "='" + it->second + "': " + range_text(range) + (unit.empty() ? "" : " (" + std::string(unit) + ")"));
+      fail(key + "='" + excerpt(it->second, 80) + "': " + range_text(range) + (unit.empty() ? "" : " (" + std::string(unit) + ")"));
     }
     return value;
   }
@@ -392,13 +395,15 @@ class BuiltinParams {
     if (std::find(allowed.begin(), allowed.end(), it->second) == allowed.end()) {
       std::string options;
       for (const std::string_view a : allowed) options += (options.empty() ? "" : ", ") + std::string(a);
-      fail(key + "='" + it->second + "': must be one of " + options);
+      fail(key + "='" + excerpt(it->second, 80) + "': must be one of " + options);
     }
     return it->second;
   }
 
  private:
-  [[noreturn]] void fail(const std::string& reason) const { throw TrajectoryError(name_ + ": " + reason); }
+  [[noreturn]] void fail(const std::string& reason) const {
+    throw TrajectoryError(excerpt(name_, 80) + ": " + reason);
+  }
 
   std::string name_;
   std::map<std::string, std::string, std::less<>> values_;
@@ -584,7 +589,7 @@ Trajectory make_builtin_trajectory(const std::string& spec) {
   }
   std::string known;
   for (const Builtin& builtin : builtins()) known += (known.empty() ? "" : ", ") + std::string(builtin.name);
-  throw TrajectoryError("'" + std::string(name) + "': unknown built-in trajectory; known: " + known);
+  throw TrajectoryError("'" + excerpt(name, 80) + "': unknown built-in trajectory; known: " + known);
 }
 
 Trajectory load_trajectory(const std::string& spec_or_path) {

@@ -53,6 +53,39 @@ TEST_CASE("a device file with an unknown key or an unusable value is an error na
   for (const std::string& path : {typo, negative, inverted, centre}) std::remove(path.c_str());
 }
 
+TEST_CASE("a device file with extreme, deep or huge content gives a short error naming the file") {
+  // Values beyond the physical bounds, a centre nested a million levels deep (quoting it used to recurse once per
+  // level), a 10 MB key and a number too large for a double (nlohmann's out_of_range, not a parse error).
+  std::string deep = R"({"centre_m": [0, 0, )";
+  deep.append(1'000'000, '[').append(1'000'000, ']').append("]}");
+  std::string huge_key = "{\"";
+  huge_key.append(10'000'000, 'k').append("\": 1}");
+  struct Case {
+    std::string name, text, expected;
+  };
+  const Case cases[] = {
+      {"huge_frame", R"({"frame_side_m": 1e300})", "at most 10"},
+      {"huge_force", R"({"max_force_N": 1e9})", "at most 1000"},
+      {"far_centre", R"({"centre_m": [1e12, 0, 0]})", "within"},
+      {"deep", deep, "centre_m"},
+      {"huge_key", huge_key, "unknown key"},
+      {"overflow", R"({"frame_side_m": 1e999})", "not valid JSON"},
+  };
+  for (const Case& test_case : cases) {
+    INFO(test_case.name);
+    const std::string path = write_file(test_case.name, test_case.text);
+    try {
+      load_spidar_geometry(path);
+      FAIL("expected SpidarGeometryError");
+    } catch (const SpidarGeometryError& error) {
+      const std::string message = error.what();
+      INFO(message.substr(0, 300));
+      CHECK(message.size() < 600);
+      CHECK_THAT(message, Catch::Contains(path) && Catch::Contains(test_case.expected));
+    }
+  }
+}
+
 TEST_CASE("devices that differ in any value hash differently") {
   const SpidarGeometry base;
   SpidarGeometry wider = base;

@@ -3,8 +3,8 @@
 //
 // We map a plain boost::interprocess::shared_memory_object instead of a managed segment: a managed segment's allocator
 // keeps a mutex in shared memory that stays locked forever if a process dies holding it. Here nothing in the segment is
-// ever locked; channels are seqlocks and the only blocking primitives are the lockstep semaphores, which every waiter
-// waits on with a timeout and a liveness check of its peer.
+// ever locked; channels are seqlocks and the only blocking primitives are the lockstep turns (futex words), which
+// every waiter waits on with a timeout and a liveness check of its peer.
 //
 // Ownership: exactly one process creates a segment (the world manager the world link, the haptic controller the device
 // port) and removes its name when it exits. Other processes open it. The creator holds an exclusive flock on the file
