@@ -50,8 +50,8 @@
 // Keys for another shape (e.g. "radius_m" on a box) are unknown keys. Every error throws SceneError with the message
 // `FILE: /json/pointer: reason (got VALUE)`.
 //
-// Every number must lie in a range the engine can simulate (SceneLimits below; rates, substeps, iterations,
-// stiffness and damping as in common/contract/limits.h). docs/scene_format.md lists them with their reasons.
+// Every number must lie in a range the engine can simulate: SceneLimits below, and common/contract/limits.h for rates,
+// substeps, iterations, stiffness and damping; each bound has its reason next to it.
 
 #include "common/contract/vec3.h"
 
