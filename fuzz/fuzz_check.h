@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Shared by the fuzz targets: an invariant check that stays on in Release builds (assert() is compiled out by NDEBUG,
 // and a fuzzer that silently skips its checks finds nothing) and aborts, which libFuzzer and the regression runner

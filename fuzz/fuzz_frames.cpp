@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fuzz target: the shared-memory transport's frame decoding, the gate every reader of the world link and the device
 // port passes frames through.
 // Input: one selector byte, then the frame's bytes (short input: the rest stays zero, as in a fresh segment).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fuzz target: scene files. Bytes → parse_scene_text (nlohmann::json::parse, then parse_scene), exactly what
 // load_scene does after reading the file. Expected outcomes: a Scene or a SceneError (bad JSON included). Any other
 // exception escapes and terminates: it is a bug, since a daemon's main would report it as an unknown error instead of

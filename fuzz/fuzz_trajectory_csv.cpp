@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fuzz target: trajectory CSV files, through parse_trajectory_csv (the body of load_trajectory_csv without the file).
 // Expected outcomes: a Trajectory or a TrajectoryError. An accepted trajectory must evaluate to finite positions and
 // velocities everywhere, since spidar_sim feeds them straight into the hand model at 1 kHz.

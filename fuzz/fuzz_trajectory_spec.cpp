@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fuzz target: built-in trajectory specs (`NAME[:key=value,...]`) through make_builtin_trajectory. Expected outcomes:
 // a Trajectory or a TrajectoryError; an accepted trajectory must evaluate to finite positions and velocities.
 

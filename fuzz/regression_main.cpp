@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Replays inputs through a fuzz target without libFuzzer, so the default (g++) build runs the seed corpus and every
 // recorded crash as a CTest test. Arguments are files or directories (directories: every regular file in them, in
 // name order so failures reproduce). A failing input aborts inside the target; the line printed before it names the

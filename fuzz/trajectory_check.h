@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What trajectory.h promises about a trajectory that loaded: finite position and velocity at any time, including
 // before the start, at and around the segment joins we can reach cheaply, and after the end.

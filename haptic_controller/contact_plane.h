@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The planes the servo renders in one tick: paper §3.1's (point, normal) pairs after interpolation (§3.2), in Eigen
 // form, plus the object data needed for friction (§6.2) and for sharing the reaction among objects (§3.4).

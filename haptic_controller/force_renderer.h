@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Force rendering (paper §3.3, DESIGN.md §1 haptic tick step 4): the spring–damper between proxy D and finger C,
 //     f_j = k_p (D_j − C_j) + k_d ((D_j − C_j) − (D_{j−1} − C_{j−1})) / Δt      (paper §3.3)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Friction on the proxy (paper §6.2, DESIGN.md §1 haptic tick step 3).
 //

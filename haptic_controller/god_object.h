@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The god-object (Zilles & Salisbury; paper §3.3, DESIGN.md §1 haptic tick step 3): the proxy D_j, the point that
 // represents the finger on the surface, outside every interpolated plane, with friction (paper §6.2).

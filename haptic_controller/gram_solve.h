@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Least squares over one to three independent unit normals, the columns of N (an active face, edge or corner): the
 // coefficients c of the combination N·c whose components along the normals are `rhs`,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/haptic_node.h"
 
 #include "common/runtime/csv_line.h"

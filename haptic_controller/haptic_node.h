@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The haptic node (DESIGN.md §1.3): the 1 kHz servo on its schedule. Each tick: the finger from the device, the
 // world's newest frame from the world link, HapticServo::tick, the force back to the device, the report to the world,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Impulse integration (paper §3.4, DESIGN.md §1 haptic tick step 5): the user's force on the world is the reaction
 // −f_j of the force rendered on the finger. Each tick it is shared among the active constraints: each plane takes

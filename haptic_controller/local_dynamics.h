@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Local dynamics: the haptic side moves the touched objects between world frames (paper §6.3,
 // `--coupling local`).

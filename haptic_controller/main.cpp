@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // haptic_controller: the 1 kHz haptic servo (DESIGN.md §1.2). Parses the flags, creates the device port, opens the
 // world link and runs a HapticNode on them; writes the haptic half of summary.json at exit.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Plane interpolation between world frames i−1 and i (paper §3.2, DESIGN.md §1 haptic tick step 2).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Which plane of one frame is which plane of another (paper §3.2 interpolates "each received plane"): an object can
 // give several planes (a box seen at an edge), so a plane is named by (object_id, occurrence), the occurrence being

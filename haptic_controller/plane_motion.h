@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // How the planes move on the haptic side between world frames (DESIGN.md §1.2 step 2), one strategy per coupling:
 //   InterpolatedPlanes  impulse and position coupling: paper §3.2's interpolation between frames i−1 and i;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/proxy_projection.h"
 
 #include "haptic_controller/gram_solve.h"

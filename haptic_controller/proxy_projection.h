@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The constrained step of the god-object (Zilles & Salisbury; paper §3.3): the point closest to a goal that lies
 // outside every plane, i.e. min |x − goal|² subject to n_k·(x − p_k) ≥ 0 for all k.

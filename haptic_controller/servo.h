@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The 1 kHz haptic servo (DESIGN.md §1.2): `tick(finger sample, dt) -> force`, device-agnostic. Composes plane
 // interpolation (§3.2), the god-object with friction (§3.3, §6.2), force rendering (§3.3) and impulse integration

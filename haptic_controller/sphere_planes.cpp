@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/sphere_planes.h"
 
 #include <cmath>

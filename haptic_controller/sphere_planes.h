@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Spheres at the haptic rate. A plane is §3.1's first-order picture of a surface at the point nearest the proxy when
 // the world stepped. For a face that picture holds across the face; for a sphere it holds only near its point, and

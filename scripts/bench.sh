@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Builds Impetus (scripts/build.sh build) and runs its benchmarks, printing the numbers. Asserts nothing: timing on a
 # shared 2-core VM is a measurement, not a pass/fail test (timing goals live in benchmarks).
 #   scripts/bench.sh [--short]       --short: 5 s instead of 30 s for the real-time loop benchmark

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs what is missing and builds Impetus.
 #   scripts/build.sh [--daemons] [BUILD_DIR [extra cmake -D options...]]     default BUILD_DIR: build (Release)
 #   --daemons   build only world_manager, haptic_controller and spidar_sim (what the demo needs), not the tests

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The main job: on a fresh Debian machine, installs what is missing, builds, and runs the paper's tap trial in real
 # time (world manager at 20 Hz with impulse coupling, 1 kHz haptic controller, simulated SPIDAR and finger), prints
 # the outcome and writes a plot of the cube and the finger over time to out/demo/trial.png.

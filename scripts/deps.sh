@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs the Debian packages Impetus builds and runs with, skipping those already present.
 # Sourced by scripts/test.sh and scripts/demo.sh; safe to run alone.
 set -euo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Builds the libFuzzer targets with clang (ASan+UBSan) in build-fuzz/ and fuzzes each for SECONDS (default 60).
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     targets: scene trajectory_csv trajectory_spec frames (default: all)
 # Each run starts from fuzz/corpus/<target> and fuzz/regressions/<target> (read only) and grows a working corpus in

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Stability suite ("hard cases"): the scenes and trajectories under tests/hard_cases/, each run through the
 real processes (scripts/run.sh, lockstep clock), each checked for
 

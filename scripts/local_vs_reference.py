@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Rotation and several bodies at a slow world, against the single-rate reference (the world at the haptic rate, 1 kHz):
 
   off-centre   the paper's tap struck 15 mm off the cube's centre line, at two speeds: the cube turns as it slides.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Regenerates the figures and tables the README shows (docs/*.png, docs/*.md) from real lockstep runs.
 #   scripts/make_figures.sh
 set -euo pipefail

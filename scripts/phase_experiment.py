@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Phase sensitivity of the tap trial (paper Fig. 5): stop position of the cube against the world clock's phase.
 
 Runs the tap scene through the real processes in lockstep at the world rate (default 20 Hz) for PHASES phases spread

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Plots one trial (scripts/run.sh output): the objects' x, the finger and the proxy over time, and the force.
 
 usage: plot_trial.py DIR [--out FILE.png]

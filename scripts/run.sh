@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Runs one trial: world_manager + haptic_controller + spidar_sim (DESIGN.md §4), collects their logs under DIR,
 # prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
 #

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Speed against error: how far a multi-rate trial lands from the 1 kHz single-rate reference, and what it costs.
 
 Grid (through the real processes in lockstep, see DESIGN.md §3):

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """The tap task (paper §4.2, Fig. 7/8): a simulated subject taps the cube to move it 30 cm, trial after trial,
 learning from each outcome, once with position coupling and once with impulse coupling.
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs what is missing, configures, builds and runs the whole test suite (CTest).
 #   scripts/test.sh                      Release build in build/
 #   scripts/test.sh --sanitize address   ASan+UBSan build in build-address/

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "spidar_sim/device_node.h"
 
 #include "common/runtime/process.h"

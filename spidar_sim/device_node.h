@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The device node (DESIGN.md §1.3): a simulated SPIDAR and finger (DeviceSim) on the device port. Each tick takes the
 // newest commanded tensions (minimum tension before the first command), advances the simulation and publishes the

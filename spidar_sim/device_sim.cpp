@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "spidar_sim/device_sim.h"
 
 #include "common/runtime/csv_line.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One simulated device session: the SPIDAR hardware, the finger and the scripted target, advanced one device tick at a
 // time (DESIGN.md §1 "One device tick"). main.cpp wires it to the device port and the clock; tests drive it directly.

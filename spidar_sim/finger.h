@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The user's fingertip: a point mass held by the hand, which tracks the scripted target like a spring and damper
 // (DESIGN.md §1 "One device tick"). The device's string force pushes it off the target, as a real finger is pushed:

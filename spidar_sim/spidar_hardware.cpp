@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "spidar_sim/spidar_hardware.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The SPIDAR hardware as the haptic controller sees it through the device port: four motors that pull strings with
 // the commanded tensions, and four encoders that report the string lengths (DESIGN.md §1 "One device tick").

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Scripted finger trajectories: where the simulated hand wants the fingertip to be at each time (DESIGN.md §4
 // "Trajectory"). World frame, metres, seconds; time 0 is the start of the device session.

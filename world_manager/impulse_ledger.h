@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The world's side of "no impulse is lost or counted twice" (DESIGN.md §2).
 //

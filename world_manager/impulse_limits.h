@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Which objects are too light for impulse coupling at a world rate (paper §2.2; hard case 10).
 //

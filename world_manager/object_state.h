@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The state of one scene object at the end of a world step, in the world frame. The World refreshes it from ODE after
 // every step; the feature extractor, the log and the tests read it without touching ODE.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The scene model: what a world contains (DESIGN.md §4), parsed and validated from JSON before anything starts.
 //

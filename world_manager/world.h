@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The virtual world of the world manager: a Scene on a rigid-body engine, stepped once per world period T_w
 // (DESIGN.md §1.1): the report's impulses through the ledger to the coupling, the engine's substeps, the planes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The world log (DESIGN.md §4 "Logs"): a CSV with a header row and one row per world step, time first, then for every
 // dynamic object its pose, velocity and the impulse the world applied to it (this step and since the start), then the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "world_manager/world_node.h"
 
 #include "common/runtime/lockstep_schedule.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The world node (DESIGN.md §1.3): one World on its schedule. Each step takes the newest report from the world link,
 // steps the world, publishes the frame and the loop statistics, and logs a row. Real time: its own clock at the world

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What crosses the world link and the device port (DESIGN.md §1, §2), as the nodes and algorithms see it: plain data,
 // fixed capacity (the 1 kHz path never allocates), SI units, world frame (right-handed, z up).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The ranges every node accepts for rates and contact parameters, from a flag or a scene file alike. Each bound is
 // a physical or numerical limit, not a preference; values outside are rejected with the name of the flag or field.

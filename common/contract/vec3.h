@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Plain 3-vectors for structs that cross process boundaries, and their bridge to Eigen.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The device port (DESIGN.md §1, §2): a haptic node and its device, always on one machine. The host end belongs to the
 // haptic side's device driver; the device end to the device (spidar_sim, or a real device's bridge). Transports

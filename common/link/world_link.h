@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The world link (DESIGN.md §1, §2): plane frames from the world to each endpoint, running impulse totals and the
 // finger back. Two ends, each an interface the nodes talk through; the transports (shared memory, in-process) encode,

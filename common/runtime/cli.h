@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The command-line vocabulary every node's main.cpp shares (DESIGN.md §4): the same flag names, checks and wording
 // everywhere, and bad values rejected with the flag, the value and the reason.

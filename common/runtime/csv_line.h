@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Writing one CSV row of numbers fast and exactly, the same way in every log.
 //

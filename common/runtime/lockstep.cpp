@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "common/runtime/lockstep.h"
 
 #include <linux/futex.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Turn-taking for `--clock lockstep` (DESIGN.md §3): the haptic controller's tick count is the master clock; the device
 // advances once per haptic tick and the world steps at tick i·n + phase. A follower sleeps on an interprocess semaphore

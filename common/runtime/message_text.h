@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Pieces of error messages that must stay short and readable whatever the input: numbers as a person writes them and
 // quotes of user text capped in length (a file may hold a 100 MB token; a message must not).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What every node process shares outside its loop: a stop flag raised by SIGINT/SIGTERM, session ids, and whether
 // another process still runs.

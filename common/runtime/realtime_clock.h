@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The real-time clock of a periodic loop (DESIGN.md §3, `--clock realtime`).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Logging out of a real-time loop: the loop copies a fixed-size row into a preallocated single-producer /
 // single-consumer ring; a separate thread drains the ring into a CSV file. The loop never allocates, locks or does I/O.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // When a peer counts as silent (DESIGN.md §2 "Staleness"): one policy, used by every node and transport.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A log or output file whose writes must not fail silently: the first failed write (disk full, I/O error) is reported
 // on stderr when it is noticed, naming the program, the file and the system's reason, and is remembered so the

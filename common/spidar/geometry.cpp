@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "common/spidar/geometry.h"
 
 #include "common/runtime/message_text.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The SPIDAR device as both sides see it: the haptic controller's driver (kinematics, tension distribution) and the
 // simulated hardware in spidar_sim use this one description, so they cannot disagree about the frame.

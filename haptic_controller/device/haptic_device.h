@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A haptic device as the servo sees it (DESIGN.md §1.2): finger samples in, forces out, within its limits. What a
 // device is made of — strings and encoders (SpidarDriver), linkages, a network bridge — stays behind this interface,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/device/spidar_driver.h"
 
 #include "haptic_controller/device/tension_distribution.h"

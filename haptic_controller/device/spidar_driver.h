@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The SPIDAR driver: a HapticDevice made of three parts, each testable alone (DESIGN.md §1.2) —
 //   SpidarKinematics      encoder counts → finger position;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SPIDAR kinematics (DESIGN.md §1 haptic tick step 1): encoder counts ↔ string lengths ↔ finger position.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Tension distribution (DESIGN.md §1 haptic tick step 6): the force on the finger → four string tensions.
 //

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What the experiment scripts in scripts/ share: running trials through scripts/run.sh and reading what a trial
 leaves behind.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """C++ defaults the scripts need before any trial has run (a trial's own values are in its summary.json: the haptic
 rate, the force limit, the finger and hand, the scene's gravity), kept here once. Each names the flag or field it
 mirrors; if that default changes in C++, change it here too.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Mechanical energy of a trial's finger and rigid bodies, and the work the hand does on the finger: the energy
 balance every hard case is checked against (energy_balance)."""
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The daemons' CSV logs of one trial (DESIGN.md §4: a header row, time first, units in the column names):
 
   world.csv   world_manager: one row per world step, the state after it; per object NAME.x_m .. NAME.z_m,

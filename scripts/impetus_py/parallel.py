@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Running many trials at once.
 
 Each trial is three real processes in lockstep (DESIGN.md §3); they take turns on semaphores, so one trial keeps

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Where things are: the repository root and the daemons' build directory."""
 import os
 import pathlib

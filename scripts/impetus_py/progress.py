@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Progress of a batch of trials, on stderr."""
 import sys
 import time

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A scene file (scenes/*.json, tests/hard_cases/*.json; format in world_manager/scene.h) as the scripts read it:
 objects by name, with the scene parser's defaults filled in wherever a file leaves a key out, so no script guesses a
 default of its own."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Running one trial: the three daemons in lockstep through scripts/run.sh (DESIGN.md §3), into a directory of its
 own (logs, the daemons' summaries and summary.json)."""
 import subprocess

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Channel latency between two processes: a writer publishes a HapticReport-sized frame every millisecond with its
 // CLOCK_MONOTONIC send time inside; a reader in another process polls the sequence word and records publish→observe
 // latency. Prints p50/p99/max; asserts nothing (timing on a shared VM is a measurement, not a test).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tick cost of the haptic servo with its SPIDAR driver (kinematics + interpolation + proxy + force + accumulation +
 // tensions) against the number of planes in the world frame: p50 / p99 in ns. Prints only; no assertions.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Real-time loop lateness at 1 kHz: runs RealtimeClock for SECONDS with ordinary scheduling, then again with
 // SCHED_FIFO + mlockall (if granted), and prints wake-up lateness p50/p99/p99.9/max and skipped periods for each.
 // Asserts nothing: this VM has host stalls of tens of milliseconds; the numbers are the result.

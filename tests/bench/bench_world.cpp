@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // World manager benchmarks: printed, no assertions.
 //  1. World::step time for 20 / 200 / 2000 dynamic spheres on the floor (ODE dominates).
 //  2. FeatureExtractor::extract time vs number of objects at a constant density around the finger: the query must

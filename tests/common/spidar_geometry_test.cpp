@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The SPIDAR description file (common/spidar/geometry.h): the shipped file is the built-in device, bad files are
 // errors naming the file and key, and the hash tells devices apart.
 

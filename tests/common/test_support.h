@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Helpers for tests that run real processes: unique segment names and a forked child whose exit status is checked.
 

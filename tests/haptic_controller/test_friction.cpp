@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/god_object.h"
 #include "test_support.h"
 

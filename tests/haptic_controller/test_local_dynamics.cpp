@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Local dynamics (haptic_controller/local_dynamics.h, paper §6.3): the haptic side moves the touched object
 // between world frames. Physics-backed checks: a free body gives way by J/m per second, a sliding cube loses μ·g·h of
 // speed per world substep and never reverses, a support blocks, a wrong model never pushes the finger out, and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Real-time discipline: the servo's tick() and on_plane_frame() and the SPIDAR driver's read() and command() never
 // touch the heap. Global operator new/delete are replaced for
 // the whole test binary, but count only while `g_counting` is set, so other tests are unaffected.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/plane_interpolator.h"
 #include "test_support.h"
 

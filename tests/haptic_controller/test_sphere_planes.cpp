@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A sphere's plane is taken again at the proxy every tick (sphere_planes.h); its push turns nothing.
 
 #include "haptic_controller/impulse_accumulator.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The SPIDAR driver alone (device/spidar_driver.h): encoder counts from its port become a finger sample, a force
 // becomes tensions on the port, and what it does without a device or with a broken reading.
 

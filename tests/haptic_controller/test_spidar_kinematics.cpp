@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/device/spidar_kinematics.h"
 
 #include <catch2/catch.hpp>

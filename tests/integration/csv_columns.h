@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reads a numeric CSV log (header row, then rows of numbers) into columns by header name.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "trial_support.h"
 
 #include "common/link/shm/world_link_layout.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Faults in real time: processes killed with SIGKILL mid-contact and restarted, and garbage written into a
 // live segment. No timing is asserted (this VM has host stalls); the tests check that the survivors keep running,
 // forces stay bounded, nothing bursts, and the restarted process re-attaches.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Integration tests launch the real daemons through scripts/run.sh (the same script users run) or directly, and read
 // what they wrote. Trials run in lockstep unless a test is about real time.

@@ -1,8 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
 // The in-process loop against the three daemons: the same nodes over the in-process links must reproduce a trial
 // run through shared memory bit for bit (DESIGN.md §6: the same trial in one process or three gives the same outcome).
 
 #include "tests/integration/trial_support.h"
-#include "tests/loop/in_process_trial.h"
+#include "loop/in_process_trial.h"
 
 #include <catch2/catch.hpp>
 
@@ -18,13 +19,13 @@ void check_same_trial(const std::string& name, Coupling coupling, std::uint64_t 
                                                coupling_name + " --phase " + std::to_string(phase_ticks));
   REQUIRE(processes.exit_status == 0);
 
-  test::InProcessTrialOptions options;
+  InProcessTrialOptions options;
   options.scene_path = std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json";
   options.trajectory = "tap";
   options.coupling = coupling;
   options.phase_ticks = phase_ticks;
   options.out_dir = test::out_dir(name + "-in-process");
-  const nlohmann::json summary = test::run_in_process_trial(options);
+  const nlohmann::json summary = run_in_process_trial(options);
 
   for (const char* log : {"world.csv", "haptic.csv", "device.csv"}) {
     INFO(log);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A world that restarts mid-contact (DESIGN.md §6: impulse rendered == impulse applied, across a restart of either
 // side), deterministically: the servo and two worlds in this thread. The finger presses the cube of the tap scene from
 // above; at 0.6 s the first world is gone and a fresh one (a new world session, the cube back where the scene puts

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // DeviceSim: the tick contract, tracking of the tap trajectory under the hand impedance, static deflection by the
 // string force, and the log format.
 #include "spidar_sim/device_sim.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The device tick runs in a 1 kHz loop: it must not touch the heap. This file replaces the global operator new to
 // count allocations; AddressSanitizer owns operator new itself, so under it the check is skipped.
 #include "spidar_sim/device_sim.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Finger model: static deflection under a constant force, the hand's step response, and sub-step selection.
 #include "spidar_sim/finger.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // SPIDAR hardware: string lengths and encoder counts follow the shared geometry, the applied tensions give the net
 // force Σ t_i·u_i, commands are clamped to the motor limits, and the motor lag is first order.
 #include "spidar_sim/spidar_hardware.h"

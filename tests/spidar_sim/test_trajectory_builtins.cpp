@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Built-in trajectories: each shape starts, peaks and ends where its parameters say, moves with continuous velocity,
 // and every parameter error names the key and the value.
 #include "spidar_sim/trajectory.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CSV trajectories: interpolation, holding outside the time range, and error messages that point at line and column.
 #include "spidar_sim/trajectory.h"
 #include "trajectory_test_util.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Helpers shared by the trajectory tests: write a CSV to a private temporary file, and sample a trajectory densely.
 

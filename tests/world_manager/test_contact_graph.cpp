@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Which contacts hold the finger's push in the local model (contact_graph.h): a chain of contacts within their
 // friction cones to static geometry holds; a loose neighbour does not.
 

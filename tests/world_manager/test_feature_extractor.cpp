@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "world_manager/features/feature_extractor.h"
 #include "world_test_support.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "world_manager/impulse_ledger.h"
 #include "common/link/shm/segment.h"
 #include "common/link/shm/seqlock.h"

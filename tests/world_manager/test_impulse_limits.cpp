@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Objects too light for impulse coupling at a world rate (world_manager/impulse_limits.h).
 
 #include "world_manager/impulse_limits.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The world's side of local coupling (world.h, paper §6.3): impulses are applied at the time they were
 // rendered (from the report's first moments), so the world's next state is what the haptic side's local model showed;
 // the impulse applied is exactly the impulse reported; and the frame carries the response model (contacts, gravity,

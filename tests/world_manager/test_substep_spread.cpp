@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Spreading an impulse over substep slots (substep_spread.h): the weights are a distribution with the asked centroid,
 // so momentum and a free body's displacement are those of the impulse at its centroid, and they are as spread as the
 // centroid allows.

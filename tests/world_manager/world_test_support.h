@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Shared set-up for the world_manager tests: ODE is initialised once per process (as the daemon's main does), and
 // scenes are built from small JSON documents.

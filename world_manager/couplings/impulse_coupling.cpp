@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "world_manager/couplings/impulse_coupling.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Impulse coupling (paper §2.2, §3.5): the impulse J the haptic side integrated over the last world period reaches the
 // object in this world step, as the velocity change v_i = v_{i−1} + J/m at the step's start, except for the part the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "world_manager/couplings/local_coupling.h"
 
 #include "world_manager/couplings/substep_spread.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Local coupling, the world's side (paper §6.3): the haptic side moves the touched objects between world frames
 // (haptic_controller/local_dynamics.h), so the world must apply each impulse when it was rendered, not all at the

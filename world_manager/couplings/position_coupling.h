@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Position coupling, the paper's previous method (§2.3, fig. 3 "d"): the world samples the finger once per step, and
 // the finger's penetration d into each dynamic object gives a penalty force k_p·d + k_d·ḋ along the inward normal,

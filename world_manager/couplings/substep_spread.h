@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Spreading one impulse over a world step's substep slots with a given centroid (local coupling, local_coupling.h).
 //

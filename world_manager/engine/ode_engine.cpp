@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "world_manager/engine/ode_engine.h"
 
 #include <ode/ode.h>

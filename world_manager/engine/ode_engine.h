@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The ODE implementation of RigidBodyEngine: a hash space, contact joints with the two materials combined
 // (scene.h combine_*), QuickStep or the direct solver as the scene asks.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Process-wide ODE set-up. ODE keeps global state (its allocator, its random generator), so the process initialises it
 // once — the daemon's main and the test programs call init_ode_once() before building any World — and a World never

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The rigid-body engine behind the world (DESIGN.md §1.3): the scene's bodies, advanced in substeps. The World and the
 // couplings see only this interface; ODE is one implementation (ode_engine.h).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "world_manager/features/body_geometry.h"
 
 #include <algorithm>

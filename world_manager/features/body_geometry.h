@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Analytic geometry of the scene's shapes: the nearest surface point to a query point and the outward normal there
 // (paper §3.1 steps 2–3), and world-frame bounding boxes for the feature query. Pure functions, no ODE.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The contacts among bodies in the world's last substep, as the haptic side's local model needs them (paper §6.3,
 // haptic_controller/local_dynamics.h): per body, its contact normals merged by direction, each flagged whether the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Paper §3.1 and DESIGN.md §1 step 4: the planes of the objects near the finger.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Which face of each object a query point met in the last world step (its contact feature), carried to the next step.
 //

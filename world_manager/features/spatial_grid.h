@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A uniform grid over object bounding boxes, so the feature query (paper §3.1 step 1) looks only at the cells around
 // the finger: its cost grows with what is near the finger, not with the size of the world.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The world link inside one process (DESIGN.md §2 "In-process"): both ends in one object, frames handed over as they
 // are, lockstep by construction. The haptic node is the master: step_world() runs the world node's step on the

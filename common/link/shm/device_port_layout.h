@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The device port segment (DESIGN.md §2): created by the haptic controller, opened by a device (spidar_sim).
 // Name on the system: "<shm>.device" (see link_names.h).

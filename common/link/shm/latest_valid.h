@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reading a channel whose writer republishes running state every tick (a haptic report's totals, a device command's
 // tensions): the newest frame is what counts, re-reading it is harmless, and a frame that fails decoding is counted

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // System names of the two segments for a `--shm NAME` (DESIGN.md §2: one segment per link).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Opening a segment whose creator may not have created it yet (processes of a trial start together).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A named shared-memory segment holding one fixed-layout struct (DESIGN.md §2).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Single-writer, many-reader channel for one trivially-copyable frame, placed in shared memory (DESIGN.md §2).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "common/link/shm/shm_device_port.h"
 
 #include "common/link/shm/names.h"

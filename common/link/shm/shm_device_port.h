@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The device port over shared memory (DESIGN.md §2): one segment "<shm>.device" (device_port_layout.h), created by
 // the haptic node, opened by the device. A device claims the port by swapping device_pid from 0 to its pid; to leave

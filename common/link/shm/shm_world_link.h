@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The world link over shared memory (DESIGN.md §2): one segment "<shm>.world" (world_link_layout.h), created by the
 // world node, opened by the haptic node. Frames cross as sealed wire frames (wire_frames.h); lockstep turns are the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The shared-memory transport's encoding of the contract frames (common/contract/frames.h): the same fields in a
 // fixed layout of whole 64-bit words, every frame sealed with a checksum of the words before it.

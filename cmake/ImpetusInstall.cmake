@@ -1,0 +1,57 @@
+# SPDX-License-Identifier: Apache-2.0
+# `cmake --install` and `cpack -G DEB`: the daemons, the static libraries as namespaced targets (Impetus::world, ...),
+# their headers under include/impetus/, the shipped scenes and device file, ImpetusConfig.cmake with a version file,
+# and a pkg-config file.
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+set(IMPETUS_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/Impetus)
+set(IMPETUS_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/impetus)
+
+# Library targets, the name each has after `Impetus::`.
+set(IMPETUS_EXPORTED impetus_common common impetus_world_manager world impetus_haptic_controller haptic
+    impetus_spidar_sim device impetus_loop loop)
+set(exported_targets "")
+while(IMPETUS_EXPORTED)
+  list(POP_FRONT IMPETUS_EXPORTED target export_name)
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${export_name})
+  list(APPEND exported_targets ${target})
+endwhile()
+# impetus_warnings is linked privately (its flags never reach a consumer) but a static library's export names it.
+install(TARGETS ${exported_targets} impetus_warnings EXPORT ImpetusTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/impetus)
+install(TARGETS world_manager haptic_controller spidar_sim RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+foreach(dir common world_manager haptic_controller spidar_sim loop)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/impetus/${dir}
+          FILES_MATCHING PATTERN "*.h")
+endforeach()
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${IMPETUS_INSTALL_DATADIR}/scenes
+        FILES_MATCHING PATTERN "*.json")
+install(FILES ${PROJECT_SOURCE_DIR}/common/spidar/desktop_spidar.json DESTINATION ${IMPETUS_INSTALL_DATADIR})
+install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/THIRD_PARTY.md
+        DESTINATION ${CMAKE_INSTALL_DOCDIR})
+
+install(EXPORT ImpetusTargets NAMESPACE Impetus:: DESTINATION ${IMPETUS_INSTALL_CMAKEDIR})
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/ImpetusConfig.cmake.in
+                              ${PROJECT_BINARY_DIR}/ImpetusConfig.cmake
+                              INSTALL_DESTINATION ${IMPETUS_INSTALL_CMAKEDIR}
+                              PATH_VARS IMPETUS_INSTALL_DATADIR)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/ImpetusConfigVersion.cmake
+                                 COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/ImpetusConfig.cmake ${PROJECT_BINARY_DIR}/ImpetusConfigVersion.cmake
+        DESTINATION ${IMPETUS_INSTALL_CMAKEDIR})
+configure_file(${PROJECT_SOURCE_DIR}/cmake/impetus.pc.in ${PROJECT_BINARY_DIR}/impetus.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/impetus.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# cpack -G DEB: one package with everything above, depending on the Debian packages the binaries and headers need.
+set(CPACK_PACKAGE_NAME impetus)
+set(CPACK_PACKAGE_VENDOR "Impetus")
+set(CPACK_PACKAGE_CONTACT "Impetus developers <impetus@localhost>")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Multi-rate haptic rendering with force integration")
+set(CPACK_RESOURCE_FILE_LICENSE ${PROJECT_SOURCE_DIR}/LICENSE)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SECTION science)
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "libode8, libode-dev, libeigen3-dev, libboost-dev, nlohmann-json3-dev, libcli11-dev")
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+include(CPack)

@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// One trial with the world, haptic and device nodes in this process over the in-process links (DESIGN.md §1.3, §2):
+// the same nodes the three daemons run, under the lockstep schedule, on the calling thread. Bitwise the same outcome
+// as the three processes in lockstep (`scripts/run.sh --clock lockstep`), without starting any process.
+//
+// This is the library's entry point for embedding Impetus (Impetus::loop): load a scene file, pick a trajectory and a
+// coupling, run, read the summary.
+
+#include "common/contract/frames.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace impetus {
+
+struct InProcessTrialOptions {
+  std::string scene_path;  // a scene file (world_manager/scene.h)
+  std::string trajectory;  // a trajectory CSV file or a built-in spec, as spidar_sim --trajectory takes
+  Coupling coupling = Coupling::impulse;
+  std::uint64_t phase_ticks = 0;  // lockstep phase of the world clock, in haptic ticks (< one world period)
+  // world.csv, haptic.csv and device.csv are written here when it is not empty; nothing is written otherwise.
+  std::filesystem::path out_dir;
+};
+
+// Runs the trial to the end of its trajectory; returns the world, haptic and device halves of summary.json merged.
+// Throws std::runtime_error (SceneError, TrajectoryError, ...) for bad input, naming the file and the field.
+nlohmann::json run_in_process_trial(const InProcessTrialOptions& options);
+
+}  // namespace impetus

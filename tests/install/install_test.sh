@@ -1,0 +1,38 @@
+#!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
+# What a user of the library does: install Impetus into a prefix, build the example project against the installed
+# package (find_package(Impetus 0.2)), run it; check the pkg-config file; make the Debian package, unpack it into a
+# scratch root (dpkg -x) and run a daemon from it.
+# usage: install_test.sh SOURCE_DIR BUILD_DIR SCRATCH_DIR
+set -euo pipefail
+src=$1 build=$2 scratch=$3
+rm -rf "$scratch" && mkdir -p "$scratch"
+prefix="$scratch/prefix"
+
+cmake --install "$build" --prefix "$prefix" > "$scratch/install.log"
+for file in bin/world_manager lib/cmake/Impetus/ImpetusConfig.cmake lib/cmake/Impetus/ImpetusConfigVersion.cmake \
+            lib/pkgconfig/impetus.pc include/impetus/loop/in_process_trial.h share/impetus/scenes/tap.json \
+            share/impetus/desktop_spidar.json; do
+  [ -e "$prefix/$file" ] || { echo "install_test: $prefix/$file was not installed" >&2; exit 1; }
+done
+
+cmake -S "$src/examples/in_process_trial" -B "$scratch/example" -DCMAKE_PREFIX_PATH="$prefix" \
+      -DCMAKE_BUILD_TYPE=Release > "$scratch/example-configure.log"
+cmake --build "$scratch/example" -j2 > "$scratch/example-build.log"
+"$scratch/example/in_process_trial" "$scratch"
+
+# A version the package does not provide is refused.
+mkdir -p "$scratch/too_new"
+printf 'cmake_minimum_required(VERSION 3.20)\nproject(t LANGUAGES CXX)\nfind_package(Impetus 9.0 REQUIRED)\n' \
+  > "$scratch/too_new/CMakeLists.txt"
+if cmake -S "$scratch/too_new" -B "$scratch/too_new/build" -DCMAKE_PREFIX_PATH="$prefix" > /dev/null 2>&1; then
+  echo "install_test: find_package(Impetus 9.0) was accepted" >&2; exit 1
+fi
+
+PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs impetus | grep -q -- "-limpetus_loop"
+
+(cd "$build" && cpack -G DEB -B "$scratch/deb" > "$scratch/cpack.log")
+deb=$(ls "$scratch"/deb/impetus_*.deb)
+dpkg -x "$deb" "$scratch/root"
+"$scratch/root/usr/bin/world_manager" --help | grep -q -- "--scene"
+echo "install_test: installed, example built and ran, package $(basename "$deb") $(du -k "$deb" | cut -f1) KiB"
