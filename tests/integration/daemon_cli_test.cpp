@@ -251,11 +251,14 @@ struct LongLockstepTrial {
   std::string shm;
   pid_t world, haptic, device;
 
+  // The world and the haptic controller write world.json and haptic.json into `dir` when they exit.
   explicit LongLockstepTrial(const std::string& name)
       : dir(test::out_dir(name)), shm("impetus_test_" + name + "_" + std::to_string(getpid())) {
     world = test::spawn({test::binary("world_manager"), "--scene", std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json",
-                         "--clock", "lockstep", "--shm", shm}, dir / "world.out");
-    haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm}, dir / "haptic.out");
+                         "--clock", "lockstep", "--shm", shm, "--summary", (dir / "world.json").string()},
+                        dir / "world.out");
+    haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm, "--summary",
+                          (dir / "haptic.json").string()}, dir / "haptic.out");
     device = test::spawn({test::binary("spidar_sim"), "--clock", "lockstep", "--shm", shm, "--attach-timeout", "5",
                           "--trajectory", "press:hold=600"}, dir / "device.out");
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -265,6 +268,26 @@ struct LongLockstepTrial {
     return std::filesystem::exists("/dev/shm/" + shm + ".world") ||
            std::filesystem::exists("/dev/shm/" + shm + ".device");
   }
+};
+
+// A trial's world link mapped read-write, as another process could map it to scribble on it.
+class MappedWorldLink {
+ public:
+  explicit MappedWorldLink(const std::string& shm) {
+    const int fd = ::open(("/dev/shm/" + shm + ".world").c_str(), O_RDWR);
+    if (fd >= 0) {
+      mapping_ = mmap(nullptr, sizeof(WorldLinkLayout), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+      ::close(fd);
+    }
+  }
+  ~MappedWorldLink() {
+    if (mapped()) munmap(mapping_, sizeof(WorldLinkLayout));
+  }
+  bool mapped() const { return mapping_ != MAP_FAILED; }
+  WorldLinkLayout& layout() const { return *static_cast<WorldLinkLayout*>(mapping_); }
+
+ private:
+  void* mapping_ = MAP_FAILED;
 };
 
 }  // namespace
@@ -342,15 +365,11 @@ namespace impetus {
 TEST_CASE("lockstep: a turn scribbled by another process ends the trial with a message, no abort, no segment left") {
   LongLockstepTrial trial("scribbled-turn");
   // Another process (here the test) writes garbage over the world link's turn while the trial runs.
-  const std::string path = "/dev/shm/" + trial.shm + ".world";
-  const int fd = ::open(path.c_str(), O_RDWR);
-  REQUIRE(fd >= 0);
-  void* mapping = mmap(nullptr, sizeof(WorldLinkLayout), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-  ::close(fd);
-  REQUIRE(mapping != MAP_FAILED);
-  auto* turn = static_cast<unsigned char*>(mapping) + offsetof(WorldLinkLayout, world_turn);
-  std::memset(turn, 0xAB, sizeof(LockstepTurn));
-  munmap(mapping, sizeof(WorldLinkLayout));
+  {
+    const MappedWorldLink link(trial.shm);
+    REQUIRE(link.mapped());
+    std::memset(static_cast<void*>(&link.layout().world_turn), 0xAB, sizeof(LockstepTurn));
+  }
   // The world and the controller each find the corrupted turn and say so; neither aborts (status -1: a signal).
   CHECK(test::wait_for(trial.world, 10) == 1);
   kill(trial.device, SIGTERM);
@@ -369,22 +388,11 @@ TEST_CASE("lockstep: a turn scribbled by another process ends the trial with a m
 namespace impetus {
 
 TEST_CASE("lockstep: odd sequence words scribbled into the running link are repaired and counted, the trial goes on") {
-  const auto dir = test::out_dir("scribbled-sequence");
-  const std::string shm = "impetus_test_seq_" + std::to_string(getpid());
-  const pid_t world = test::spawn({test::binary("world_manager"), "--scene", std::string(IMPETUS_SOURCE_DIR) +
-                                   "/scenes/tap.json", "--clock", "lockstep", "--shm", shm, "--summary",
-                                   (dir / "world.json").string()}, dir / "world.out");
-  const pid_t haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm,
-                                    "--summary", (dir / "haptic.json").string()}, dir / "haptic.out");
-  const pid_t device = test::spawn({test::binary("spidar_sim"), "--clock", "lockstep", "--shm", shm,
-                                    "--attach-timeout", "5", "--trajectory", "press:hold=600"}, dir / "device.out");
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  const int fd = ::open(("/dev/shm/" + shm + ".world").c_str(), O_RDWR);
-  REQUIRE(fd >= 0);
-  void* mapping = mmap(nullptr, sizeof(WorldLinkLayout), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-  ::close(fd);
-  REQUIRE(mapping != MAP_FAILED);
-  auto& layout = *static_cast<WorldLinkLayout*>(mapping);
+  LongLockstepTrial trial("scribbled-sequence");
+  const auto& dir = trial.dir;
+  const MappedWorldLink link(trial.shm);
+  REQUIRE(link.mapped());
+  auto& layout = link.layout();
   // The sequence word is each channel's first; an odd value at rest made every reader wait for a write that never
   // ends. A scribble that lands while the writer is mid-write is overwritten by that write, so it is done 20 times.
   const std::uint64_t before = layout.report.sequence();
@@ -395,11 +403,10 @@ TEST_CASE("lockstep: odd sequence words scribbled into the running link are repa
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   const bool still_moving = layout.report.sequence() % 2 == 0 && layout.report.sequence() != before;
-  munmap(mapping, sizeof(WorldLinkLayout));
-  for (pid_t pid : {world, haptic, device}) kill(pid, SIGINT);
-  CHECK(test::wait_for(haptic, 10) == 0);
-  CHECK(test::wait_for(world, 10) == 0);
-  CHECK(test::wait_for(device, 10) == 0);
+  for (pid_t pid : {trial.world, trial.haptic, trial.device}) kill(pid, SIGINT);
+  CHECK(test::wait_for(trial.haptic, 10) == 0);
+  CHECK(test::wait_for(trial.world, 10) == 0);
+  CHECK(test::wait_for(trial.device, 10) == 0);
   CHECK(still_moving);
   const auto haptic_summary = nlohmann::json::parse(test::read_text(dir / "haptic.json"));
   const auto world_summary = nlohmann::json::parse(test::read_text(dir / "world.json"));
