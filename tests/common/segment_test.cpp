@@ -185,6 +185,7 @@ TEST_CASE("creators racing for one name: exactly one wins, every time") {
     const std::string name = test::unique_segment_name("race");
     std::atomic<int> ready{0};
     std::atomic<int> winners{0};
+    std::atomic<int> other_errors{0};  // counted here: Catch2's assertions are not thread-safe
     std::vector<std::thread> creators;
     std::vector<std::unique_ptr<Segment<SmallLayout>>> segments(4);
     for (int c = 0; c < 4; ++c) {
@@ -196,13 +197,14 @@ TEST_CASE("creators racing for one name: exactly one wins, every time") {
           segments[c] = std::make_unique<Segment<SmallLayout>>(Segment<SmallLayout>::create(name));
           winners.fetch_add(1);
         } catch (const SegmentError& error) {
-          CHECK(error.problem() == SegmentProblem::in_use);
+          if (error.problem() != SegmentProblem::in_use) other_errors.fetch_add(1);
         }
       });
     }
     for (auto& thread : creators) thread.join();
     INFO("round " << round);
     REQUIRE(winners.load() == 1);
+    REQUIRE(other_errors.load() == 0);
   }
 }
 
