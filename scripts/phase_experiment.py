@@ -20,6 +20,7 @@ from impetus_py import logs  # noqa: E402
 from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
 from impetus_py.parallel import run_parallel  # noqa: E402
 from impetus_py.paths import ROOT  # noqa: E402
+from impetus_py.progress import ProgressBar  # noqa: E402
 from impetus_py.scene import Scene  # noqa: E402
 from impetus_py.trial import run_trial  # noqa: E402
 
@@ -69,18 +70,17 @@ def main():
     jobs.append(("reference", args.haptic_rate, 0))
 
     results = {}
-    done = 0
     tasks = []
     for label, rate, phase in jobs:
         coupling = "impulse" if label == "reference" else label
         trial_dir = args.out / f"{label}-phase{phase:03d}"
         tasks.append(((label, phase, trial_dir), run_trial,
                       (trial_dir, args.scene, args.trajectory, coupling, rate, phase)))
+    progress = ProgressBar(len(jobs), len(jobs))  # the trials cost about the same: one tap each
     for (label, phase, trial_dir), summary in run_parallel(tasks, args.jobs):
         results[(label, phase)] = (summary.final_position_m(args.object)[0], trial_dir)
-        done += 1
-        print(f"\r{done}/{len(jobs)} trials", end="", file=sys.stderr, flush=True)
-    print(file=sys.stderr)
+        progress.advance(1.0)
+    progress.close()
 
     reference = [results[("reference", 0)][0]]
     reference_mean = sum(reference) / len(reference)
