@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 # `cmake --install` and `cpack -G DEB`: the daemons, the static libraries as namespaced targets (Impetus::world, ...),
 # their headers under include/impetus/, the shipped scenes and device file, ImpetusConfig.cmake with a version file,
-# and a pkg-config file.
+# and a pkg-config file. The Python package installs itself (python/CMakeLists.txt).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -53,5 +53,8 @@ set(CPACK_RESOURCE_FILE_LICENSE ${PROJECT_SOURCE_DIR}/LICENSE)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "libode8, libode-dev, libeigen3-dev, libboost-dev, nlohmann-json3-dev, libcli11-dev")
+if(IMPETUS_PYTHON_DEB_DEPENDS)
+  string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", ${IMPETUS_PYTHON_DEB_DEPENDS}")
+endif()
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 include(CPack)

@@ -3,12 +3,17 @@
 
 #include "common/link/inproc/inproc_device_port.h"
 #include "common/link/inproc/inproc_world_link.h"
+#include "common/runtime/cli.h"
 #include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/haptic_node.h"
 #include "spidar_sim/device_node.h"
 #include "spidar_sim/trajectory.h"
 #include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world_node.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
 
 namespace impetus {
 namespace {
@@ -18,12 +23,45 @@ std::string log_path(const std::filesystem::path& dir, const char* name) {
   return dir.empty() ? std::string() : (dir / name).string();
 }
 
+// The option's text checked by the validator of the daemon flag it mirrors, so both reject the same values with the
+// same words; throws std::invalid_argument "NAME: REASON".
+void check_option(const char* name, double value, CLI::Validator validator) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  std::string input = text;
+  if (const std::string problem = validator(input); !problem.empty()) {
+    throw std::invalid_argument(std::string(name) + ": " + problem);
+  }
+}
+
+void check_options(const InProcessTrialOptions& options) {
+  if (options.world_rate_hz) {
+    check_option("world_rate_hz", *options.world_rate_hz,
+                 number_in(limits::kMinWorldRate_Hz, limits::kMaxWorldRate_Hz));
+  }
+  if (options.substeps && (*options.substeps < 1 || *options.substeps > limits::kMaxSubsteps)) {
+    throw std::invalid_argument("substeps: must be a whole number from 1 to " +
+                                std::to_string(limits::kMaxSubsteps) + ", not " + std::to_string(*options.substeps));
+  }
+  // NaN stands for "the scene's value" here, as an absent flag does for the daemon.
+  if (!std::isnan(options.stiffness_Npm)) {
+    check_option("stiffness_Npm", options.stiffness_Npm, positive_number(limits::kMaxStiffness_Npm));
+  }
+  if (!std::isnan(options.damping_Nspm)) {
+    check_option("damping_Nspm", options.damping_Nspm, number_in(0.0, limits::kMaxDamping_Nspm));
+  }
+  if (options.duration_s != 0.0) check_option("duration_s", options.duration_s, positive_number(kMaxFlagSeconds));
+}
+
 }  // namespace
 
 nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
+  check_options(options);
   init_ode_once();
   WorldNodeOptions world_options;
   world_options.scene_path = options.scene_path;
+  world_options.rate_hz = options.world_rate_hz;
+  world_options.substeps = options.substeps;
   world_options.coupling = options.coupling;
   world_options.clock = ClockMode::lockstep;
   world_options.phase_ticks = options.phase_ticks;
@@ -36,6 +74,9 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   HapticNodeOptions haptic_options;
   haptic_options.clock = ClockMode::lockstep;
   haptic_options.log_path = log_path(options.out_dir, "haptic.csv");
+  haptic_options.stiffness_Npm = options.stiffness_Npm;
+  haptic_options.damping_Nspm = options.damping_Nspm;
+  haptic_options.duration_s = options.duration_s;
   InProcessDevicePort port(1.0 / haptic_options.rate_hz);
   SpidarDriver driver(SpidarGeometry{}, port, ClockMode::lockstep, haptic_options.haptic_session);
   HapticNode haptic(haptic_options, world_link, driver);

@@ -13,6 +13,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <string>
 
 namespace impetus {
@@ -22,12 +24,19 @@ struct InProcessTrialOptions {
   std::string trajectory;  // a trajectory CSV file or a built-in spec, as spidar_sim --trajectory takes
   Coupling coupling = Coupling::impulse;
   std::uint64_t phase_ticks = 0;  // lockstep phase of the world clock, in haptic ticks (< one world period)
+  // Each has the range of the daemon flag it mirrors (common/contract/limits.h) and the same default.
+  std::optional<double> world_rate_hz;  // world_manager --rate; default: the scene's physics.world_rate_hz
+  std::optional<int> substeps;          // world_manager --substeps; default: the scene's physics.substeps
+  double stiffness_Npm = std::numeric_limits<double>::quiet_NaN();  // haptic_controller --stiffness; NaN: the scene's
+  double damping_Nspm = std::numeric_limits<double>::quiet_NaN();   // haptic_controller --damping; NaN: the scene's
+  double duration_s = 0.0;  // haptic_controller --duration: the longest trial in seconds; 0: the whole trajectory
   // world.csv, haptic.csv and device.csv are written here when it is not empty; nothing is written otherwise.
   std::filesystem::path out_dir;
 };
 
 // Runs the trial to the end of its trajectory; returns the world, haptic and device halves of summary.json merged.
-// Throws std::runtime_error (SceneError, TrajectoryError, ...) for bad input, naming the file and the field.
+// Throws std::invalid_argument for an option out of its range (naming the option, the value and the range) and
+// std::runtime_error (SceneError, TrajectoryError, ...) for a bad file, naming the file and the field.
 nlohmann::json run_in_process_trial(const InProcessTrialOptions& options);
 
 }  // namespace impetus

@@ -4,7 +4,8 @@
 # Sourced by scripts/test.sh and scripts/demo.sh; safe to run alone.
 set -euo pipefail
 IMPETUS_PACKAGES=(cmake g++ make pkg-config libeigen3-dev libode-dev libboost-dev catch2 nlohmann-json3-dev
-                  libcli11-dev python3-matplotlib python3-numpy
+                  libcli11-dev python3-matplotlib python3-numpy python3-tqdm
+                  pybind11-dev python3-dev  # the impetus Python module (python/)
                   time)  # /usr/bin/time: each process's peak RSS in scripts/bench.sh
 missing=()
 for pkg in "${IMPETUS_PACKAGES[@]}"; do

@@ -33,6 +33,7 @@ from impetus_py import logs  # noqa: E402
 from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
 from impetus_py.energy import energy_balance  # noqa: E402
 from impetus_py.parallel import run_parallel  # noqa: E402
+from impetus_py.progress import track  # noqa: E402
 from impetus_py.paths import ROOT  # noqa: E402
 from impetus_py.scene import Scene  # noqa: E402
 from impetus_py.summary import Summary  # noqa: E402
@@ -47,11 +48,12 @@ HAPTIC_PERIOD_S = 1.0 / HAPTIC_RATE_HZ
 # Running trials
 
 
-def run_case_trial(out_dir, scene, trajectory, coupling, rate_hz, haptic_flags):
+def run_case_trial(out_dir, scene, trajectory, coupling, rate_hz, stiffness_Npm=None, damping_Nspm=None):
     """run_trial into out_dir; returns None, or the RuntimeError of a trial that failed (the suite reports it in the
     case's row rather than stopping)."""
     try:
-        run_trial(out_dir, scene, trajectory, coupling, rate_hz=rate_hz, haptic_flags=haptic_flags)
+        run_trial(out_dir, scene, trajectory, coupling, rate_hz=rate_hz, stiffness_Npm=stiffness_Npm,
+                  damping_Nspm=damping_Nspm)
     except RuntimeError as error:
         return error
     return None
@@ -639,6 +641,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=pathlib.Path, default=ROOT / "out/hard_cases")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--quiet", action="store_true", help="no progress bar (it shows only on a terminal anyway)")
     parser.add_argument("--check", action="store_true", help="exit 1 if any case fails")
     parser.add_argument("--fine", action="store_true", help="stiffness sweep in 5 %% steps (default 25 %%)")
     parser.add_argument("--cases", default="", help="comma-separated case ids (default: all)")
@@ -655,19 +658,20 @@ def main():
         cid, _, scene, trajectory, rate, _ = case
         out_dirs[("case", cid)] = args.out / f"case{cid}"
         tasks.append((("case", cid), run_case_trial, (out_dirs[("case", cid)], CASES_DIR / scene,
-                                                      resolve_trajectory(trajectory), args.coupling, rate, ())))
+                                                      resolve_trajectory(trajectory), args.coupling, rate)))
     sweep = wanted is None or "1" in wanted
     policies = damping_policies(Scene(WALL_SCENE))
     if sweep:
         for policy, (_, damping, explicit) in policies.items():
             for k in sweep_grid(args.fine):
-                flags = ["--stiffness", k] + (["--damping", damping(k)] if explicit else [])
                 out_dirs[("sweep", policy, k)] = args.out / "sweep" / f"{policy}-K{int(k)}"
                 tasks.append((("sweep", policy, k), run_case_trial, (out_dirs[("sweep", policy, k)], WALL_SCENE,
-                                                                     WALL_TRAJECTORY, args.coupling, None, flags)))
+                                                                     WALL_TRAJECTORY, args.coupling, None, k,
+                                                                     damping(k) if explicit else None)))
 
     results, sweep_results, failures = {}, {}, []
-    for key, error in run_parallel(tasks, args.jobs):
+    # A trial's cost is about its trajectory's length; the cases' and the sweep's are alike, so the bar counts them.
+    for key, error in track(run_parallel(tasks, args.jobs), [key for key, _, _ in tasks], "hard cases", args.quiet):
         if error is not None:
             failures.append((key, str(error)))
         elif key[0] == "case":

@@ -30,6 +30,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from impetus_py import logs  # noqa: E402
 from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
 from impetus_py.parallel import run_parallel  # noqa: E402
+from impetus_py.progress import track  # noqa: E402
 from impetus_py.paths import ROOT  # noqa: E402
 from impetus_py.scene import Scene  # noqa: E402
 from impetus_py.trial import run_trial  # noqa: E402
@@ -64,6 +65,7 @@ def main():
     parser.add_argument("--rate", type=float, default=20.0, help="world rate under test, Hz")
     parser.add_argument("--phases", type=int, default=5, help="phases spread evenly over one world period")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--quiet", action="store_true", help="no progress bar (it shows only on a terminal anyway)")
     parser.add_argument("--check", action="store_true")
     parser.add_argument("--max-yaw-error", type=float, default=0.10,
                         help="--check: largest |mean yaw - reference yaw| / |reference yaw| of local coupling")
@@ -96,7 +98,8 @@ def main():
                               (trial_dir(index, coupling, phase), scene, trajectory, coupling, args.rate, phase,
                                substeps)))
     results = {}
-    for key, _ in run_parallel(tasks, args.jobs):
+    for key, _ in track(run_parallel(tasks, args.jobs), [key for key, _, _ in tasks], "local vs reference",
+                        args.quiet):
         results[key] = final_pose(trial_dir(*key), cases[key[0]][3])
 
     lines = [f"World {args.rate:g} Hz, {len(phases)} phases per coupling, against the {HAPTIC_RATE_HZ:g} Hz reference "

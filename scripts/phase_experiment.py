@@ -20,7 +20,7 @@ from impetus_py import logs  # noqa: E402
 from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
 from impetus_py.parallel import run_parallel  # noqa: E402
 from impetus_py.paths import ROOT  # noqa: E402
-from impetus_py.progress import ProgressBar  # noqa: E402
+from impetus_py.progress import track  # noqa: E402
 from impetus_py.scene import Scene  # noqa: E402
 from impetus_py.trial import run_trial  # noqa: E402
 
@@ -42,6 +42,7 @@ def main():
     parser.add_argument("--phases", type=int, default=10, help="phases spread evenly over one world period")
     parser.add_argument("--couplings", default="position,impulse")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--quiet", action="store_true", help="no progress bar (it shows only on a terminal anyway)")
     parser.add_argument("--plot", action=argparse.BooleanOptionalAction, default=True)
     parser.add_argument("--check", action="store_true", help="exit 1 unless the paper's claim holds")
     parser.add_argument("--max-ratio", type=float, default=0.5,
@@ -76,11 +77,10 @@ def main():
         trial_dir = args.out / f"{label}-phase{phase:03d}"
         tasks.append(((label, phase, trial_dir), run_trial,
                       (trial_dir, args.scene, args.trajectory, coupling, rate, phase)))
-    progress = ProgressBar(len(jobs), len(jobs))  # the trials cost about the same: one tap each
-    for (label, phase, trial_dir), summary in run_parallel(tasks, args.jobs):
+    # The trials cost about the same (one tap each), so the bar counts them.
+    for (label, phase, trial_dir), summary in track(run_parallel(tasks, args.jobs), [key for key, _, _ in tasks],
+                                                    "phase sweep", args.quiet):
         results[(label, phase)] = (summary.final_position_m(args.object)[0], trial_dir)
-        progress.advance(1.0)
-    progress.close()
 
     reference = [results[("reference", 0)][0]]
     reference_mean = sum(reference) / len(reference)

@@ -344,6 +344,7 @@ def main():
     parser.add_argument("--substeps-scenes", help="scenes of the substeps knob (default tap,spheres; --quick tap)")
     parser.add_argument("--substeps-coupling", default="impulse")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="trials run in parallel (nproc)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar (it shows only on a terminal anyway)")
     parser.add_argument("--keep-logs", action="store_true", help="keep each trial's CSV logs (large at 1 kHz)")
     parser.add_argument("--plot", action=argparse.BooleanOptionalAction, default=True)
     parser.add_argument("--docs", action="store_true", help="also copy the table and plots into docs/")
@@ -371,7 +372,7 @@ def main():
         if coupling not in COUPLINGS:
             parser.error(f"--couplings: unknown coupling '{coupling}' (known: {', '.join(COUPLINGS)})")
     build = build_dir()
-    # Run every trial on a private copy of the three binaries: a rebuild of build/ during the sweep (other work on
+    # Run every trial on a private copy of the three binaries and the Python package: a rebuild of build/ during the sweep (other work on
     # the same tree) would otherwise mix versions or make trials fail while the linker rewrites a binary.
     snapshot = args.out / "bin"
     for name in ("world_manager", "haptic_controller", "spidar_sim"):
@@ -380,6 +381,8 @@ def main():
             parser.error(f"{source} is missing: build first (scripts/build.sh)")
         (snapshot / name).mkdir(parents=True, exist_ok=True)
         shutil.copy2(source, snapshot / name / name)
+    if (build / "python").is_dir():  # the impetus package, which runs the trials when it is built (impetus_py/trial.py)
+        shutil.copytree(build / "python", snapshot / "python", dirs_exist_ok=True)
     os.environ["IMPETUS_BUILD_DIR"] = str(snapshot)  # read by run.sh in every trial
     scene_info = {"tap": SCENES["tap"], "spheres": (SCENES["spheres"][0], args.spheres_trajectory)}
 
@@ -427,12 +430,12 @@ def main():
                                        phase, grid_ticks, args.keep_logs)))
 
     def weight(key):
-        return 1.0 + key[2] * key[3] / 2000.0  # rough cost: fixed process start-up + world steps x substeps
+        return 1.0 + key[2] * key[3] / 2000.0  # rough cost: fixed start-up + world steps x substeps
 
     started = time.monotonic()
     print(f"speed_vs_error: {len(tasks)} trials ({', '.join(scenes)}; couplings {', '.join(couplings)}; "
           f"rates {', '.join(map(str, rates))} Hz; {phases_per_rate} phases), {args.jobs} in parallel", file=sys.stderr)
-    progress = ProgressBar(sum(weight(k) for k in trial_keys), len(trial_keys))
+    progress = ProgressBar(sum(weight(k) for k in trial_keys), len(trial_keys), "speed vs error", args.quiet)
     results = {}
     for key, result in run_parallel(tasks, args.jobs):
         results[key] = result

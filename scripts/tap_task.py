@@ -18,6 +18,7 @@ import sys
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
 from impetus_py.parallel import run_parallel  # noqa: E402
+from impetus_py.progress import track  # noqa: E402
 from impetus_py.paths import ROOT  # noqa: E402
 from impetus_py.scene import Scene  # noqa: E402
 from impetus_py.trial import run_trial  # noqa: E402
@@ -72,6 +73,7 @@ def main():
     # overshoots; 15 cm is inside the range every method reaches, so the task measures accuracy, not reach.
     parser.add_argument("--target", type=float, default=0.15, help="travel the subject aims for, m (paper: 0.30)")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--quiet", action="store_true", help="no progress bar (it shows only on a terminal anyway)")
     parser.add_argument("--methods", default="position,impulse")
     parser.add_argument("--plot", action=argparse.BooleanOptionalAction, default=True)
     parser.add_argument("--check", action="store_true",
@@ -83,7 +85,9 @@ def main():
     rng = random.Random(args.seed)
     # The same phase sequence for every method, so the methods differ only in how they couple.
     phases = [rng.randrange(ticks_per_step) for _ in range(args.trials)]
-    results = dict(run_parallel(((m, subject, (m, args, phases)) for m in methods), jobs=len(methods)))
+    # One subject per method, each a sequence of trials that adapts to the last; the bar counts finished subjects.
+    results = dict(track(run_parallel([(m, subject, (m, args, phases)) for m in methods], jobs=len(methods)), methods,
+                         "subjects", args.quiet))
 
     args.out.mkdir(parents=True, exist_ok=True)
     with open(args.out / "tap_task.csv", "w", newline="") as f:

@@ -1,9 +1,20 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Running one trial: the three daemons in lockstep through scripts/run.sh (DESIGN.md §3), into a directory of its
-own (logs, the daemons' summaries and summary.json)."""
-import subprocess
+"""Running one lockstep trial into a directory of its own (logs, summary.json), in one of two ways:
 
-from .paths import ROOT
+  module     the impetus Python package (python/, built into BUILD/python): the three nodes in this process, no
+             process started; the default whenever the package is built
+  processes  the three daemons through scripts/run.sh (DESIGN.md §3); used when the package is not built (sanitizer
+             builds do not build it: their daemons are what such a run checks) or when IMPETUS_TRIALS=processes
+
+Both give the same trial bit for bit (tests/python/test_impetus_module.py); the module is several times faster per
+trial (README, "Use it from Python").
+"""
+import importlib
+import os
+import subprocess
+import sys
+
+from .paths import ROOT, build_dir
 from .summary import Summary
 
 # The couplings world_manager --coupling accepts (README "What runs"):
@@ -14,20 +25,57 @@ from .summary import Summary
 #   local     impulse coupling plus the paper's §6.3: the haptic side moves the touched objects between world steps.
 COUPLINGS = ("impulse", "position", "local")
 
+_module = None
 
-def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=None, substeps=None, haptic_flags=()):
+
+def _impetus_module():
+    """The impetus package from BUILD/python, or None when trials are to run as processes."""
+    global _module
+    if _module is None:
+        _module = False
+        choice = os.environ.get("IMPETUS_TRIALS", "module")
+        if choice not in ("module", "processes"):
+            raise RuntimeError(f"IMPETUS_TRIALS must be 'module' or 'processes', not '{choice}'")
+        package = build_dir() / "python"
+        if choice == "module" and (package / "impetus").is_dir():
+            sys.path.insert(0, str(package))
+            _module = importlib.import_module("impetus")
+    return _module or None
+
+
+def backend():
+    """'module' or 'processes': how run_trial runs trials in this process."""
+    return "module" if _impetus_module() else "processes"
+
+
+def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=None, substeps=None,
+              stiffness_Npm=None, damping_Nspm=None):
     """Runs one lockstep trial of `scene` (a path) driven by `trajectory` (a spidar_sim --trajectory spec or file)
     into out_dir and returns its Summary. rate_hz, phase_ticks and substeps are world_manager's --rate, --phase and
-    --substeps (None: the scene's rate and substeps, phase 0); haptic_flags are extra haptic_controller flags (e.g.
-    ["--stiffness", 5000]). Raises RuntimeError with run.sh's output if the trial failed."""
+    --substeps, stiffness_Npm and damping_Nspm haptic_controller's --stiffness and --damping (None: the scene's
+    values, phase 0). Raises RuntimeError naming the trial if it failed."""
     out_dir.mkdir(parents=True, exist_ok=True)
+    module = _impetus_module()
+    if module:
+        try:
+            trial = module.run_trial(scene, trajectory, coupling, rate_hz=rate_hz, phase_ticks=phase_ticks or 0,
+                                     substeps=substeps, stiffness_Npm=stiffness_Npm, damping_Nspm=damping_Nspm,
+                                     out_dir=out_dir, logs=False)
+        except (ValueError, RuntimeError, OSError) as error:
+            raise RuntimeError(f"trial failed ({scene}, {trajectory}, {coupling} coupling, rate {rate_hz}, "
+                               f"phase {phase_ticks}): {error}") from None
+        return Summary(trial.summary)
     command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), "--trajectory", str(trajectory),
                "--coupling", coupling, "--clock", "lockstep", "--out", str(out_dir), "--quiet"]
     for flag, value in (("--rate", rate_hz), ("--phase", phase_ticks), ("--substeps", substeps)):
         if value is not None:
             command += [flag, str(value)]
+    haptic_flags = []
+    for flag, value in (("--stiffness", stiffness_Npm), ("--damping", damping_Nspm)):
+        if value is not None:
+            haptic_flags += [flag, str(value)]
     if haptic_flags:
-        command += ["--"] + [str(flag) for flag in haptic_flags]
+        command += ["--"] + haptic_flags
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
         raise RuntimeError(f"trial failed ({' '.join(command)}):\n{result.stdout}{result.stderr}")

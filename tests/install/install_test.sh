@@ -1,8 +1,9 @@
 #!/bin/bash
 # SPDX-License-Identifier: Apache-2.0
 # What a user of the library does: install Impetus into a prefix, build the example project against the installed
-# package (find_package(Impetus 0.2)), run it; check the pkg-config file; make the Debian package, unpack it into a
-# scratch root (dpkg -x) and run a daemon from it.
+# package (find_package(Impetus 0.2)), run it; import the Python package from the prefix and run a trial with a
+# shipped scene; check the pkg-config file; make the Debian package, unpack it into a scratch root (dpkg -x) and run a
+# daemon and the Python package from it.
 # usage: install_test.sh SOURCE_DIR BUILD_DIR SCRATCH_DIR
 set -euo pipefail
 src=$1 build=$2 scratch=$3
@@ -12,7 +13,7 @@ prefix="$scratch/prefix"
 cmake --install "$build" --prefix "$prefix" > "$scratch/install.log"
 for file in bin/world_manager lib/cmake/Impetus/ImpetusConfig.cmake lib/cmake/Impetus/ImpetusConfigVersion.cmake \
             lib/pkgconfig/impetus.pc include/impetus/loop/in_process_trial.h share/impetus/scenes/tap.json \
-            share/impetus/desktop_spidar.json; do
+            share/impetus/desktop_spidar.json lib/python3/dist-packages/impetus/__init__.py; do
   [ -e "$prefix/$file" ] || { echo "install_test: $prefix/$file was not installed" >&2; exit 1; }
 done
 
@@ -29,10 +30,23 @@ if cmake -S "$scratch/too_new" -B "$scratch/too_new/build" -DCMAKE_PREFIX_PATH="
   echo "install_test: find_package(Impetus 9.0) was accepted" >&2; exit 1
 fi
 
+# The installed Python package, run from a directory that holds no other copy of it.
+python_trial() {
+  (cd "$scratch" && PYTHONPATH="$1/lib/python3/dist-packages" /usr/bin/python3 -c '
+import impetus, sys
+assert impetus.__file__.startswith(sys.argv[1]), impetus.__file__
+trial = impetus.run_trial(impetus.shipped_scene("tap"), "tap", coupling="local", logs=False)
+x = trial.summary["objects"]["cube"]["position"][0]
+assert x > 0.05, trial  # the tap pushed the cube along +x
+print(trial)' "$1")
+}
+python_trial "$prefix"
+
 PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs impetus | grep -q -- "-limpetus_loop"
 
 (cd "$build" && cpack -G DEB -B "$scratch/deb" > "$scratch/cpack.log")
 deb=$(ls "$scratch"/deb/impetus_*.deb)
 dpkg -x "$deb" "$scratch/root"
 "$scratch/root/usr/bin/world_manager" --help | grep -q -- "--scene"
+python_trial "$scratch/root/usr"
 echo "install_test: installed, example built and ran, package $(basename "$deb") $(du -k "$deb" | cut -f1) KiB"

@@ -1,0 +1,134 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Impetus from Python: run a haptic trial in this process and get its outcome.
+
+    import impetus
+    trial = impetus.run_trial(impetus.shipped_scene("tap"), "tap", coupling="local")
+    print(trial)                                      # the outcome in one line per object
+    trial.summary["objects"]["cube"]["position"]      # summary.json as a dict
+    trial.logs["haptic"]["force_x"]                   # each log column as a numpy array
+
+A trial is the world, haptic and device nodes of the three daemons, run in this process under the lockstep schedule:
+bitwise the same outcome as `scripts/run.sh --clock lockstep` with the same arguments, and no process is started.
+The call releases the GIL; trials are independent, so a process pool runs several at once.
+"""
+import json
+import pathlib
+import tempfile
+import time
+
+from . import _impetus
+
+__version__ = "@PROJECT_VERSION@"
+
+# The couplings (world_manager --coupling):
+#   impulse   force integration, the paper's method: the world applies the impulse the haptic side integrated since
+#             its last step;
+#   position  the paper's previous method: a penalty force from the finger sampled at the world step, held for the
+#             whole world period;
+#   local     impulse coupling plus the paper's §6.3: the haptic side moves the touched objects between world steps.
+COUPLINGS = ("impulse", "position", "local")
+
+# The logs a trial writes, by the key Trial.logs uses.
+LOG_FILES = {"world": "world.csv", "haptic": "haptic.csv", "device": "device.csv"}
+
+# Where the shipped scenes are: the source tree's scenes/ next to the build tree's package, or
+# PREFIX/share/impetus/scenes for an installed one (both filled in by CMake).
+_SCENE_DIRS = [pathlib.Path(p) for p in "@IMPETUS_PY_SCENE_DIRS@".split(";") if p]
+
+
+def scene_dir():
+    """The directory of the shipped scenes (scenes/*.json)."""
+    here = pathlib.Path(__file__).resolve().parent
+    for directory in _SCENE_DIRS:
+        directory = directory if directory.is_absolute() else (here / directory).resolve()
+        if directory.is_dir():
+            return directory
+    raise FileNotFoundError(f"impetus: no shipped scenes next to {here} (looked in {_SCENE_DIRS})")
+
+
+def shipped_scene(name):
+    """The path of the shipped scene `name` ("tap" for scenes/tap.json)."""
+    path = scene_dir() / f"{name}.json"
+    if not path.is_file():
+        known = ", ".join(sorted(p.stem for p in scene_dir().glob("*.json")))
+        raise FileNotFoundError(f"impetus: no shipped scene '{name}'; the shipped scenes are: {known}")
+    return path
+
+
+class Trial:
+    """The outcome of one trial.
+
+    summary  summary.json's document as a dict: "objects" (each dynamic object at the end: "position", "velocity",
+             "impulse_Ns", ...), "world", "haptic", "device" and "config" (README, "What a trial leaves").
+    logs     {"world", "haptic", "device"} -> {column name -> numpy float64 array, one value per row}: the world's
+             state per step, the servo's finger, proxy and force per tick, the device's per tick. Column names carry
+             their units (DESIGN.md §4). Empty when run_trial was called with logs=False.
+    out_dir  where the logs and summary.json were written, or None (a temporary directory, removed).
+    """
+
+    def __init__(self, summary, logs, out_dir):
+        self.summary = summary
+        self.logs = logs
+        self.out_dir = out_dir
+
+    def __repr__(self):
+        config = self.summary["config"]
+        parts = [f"{config['coupling']} coupling at {config['world_rate_hz']:g} Hz, phase {config['phase_ticks']}"]
+        for name, state in self.summary["objects"].items():
+            x, y, z = state["position"]
+            jx, jy, jz = state["impulse_Ns"]
+            parts.append(f"{name} at [{x:+.4f} {y:+.4f} {z:+.4f}] m after [{jx:+.4f} {jy:+.4f} {jz:+.4f}] N·s")
+        haptic = self.summary["haptic"]
+        parts.append(f"{haptic['ticks']} haptic ticks, max force {haptic['max_force_N']:.2f} N")
+        return "Trial(" + "; ".join(parts) + ")"
+
+
+def read_log(path):
+    """A log file the nodes wrote (world.csv, haptic.csv, device.csv) as {column name -> numpy float64 array}."""
+    header, table = _impetus.read_log(str(path))
+    return {name: table[:, i] for i, name in enumerate(header)}
+
+
+def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_ticks=0, substeps=None,
+              stiffness_Npm=None, damping_Nspm=None, duration_s=60.0, out_dir=None, logs=True):
+    """Runs one trial and returns its Trial.
+
+    scene          a scene file (str or path; shipped_scene("tap") for a shipped one)
+    trajectory     the finger's path: a built-in ("tap", "tap:speed=0.2", "hold", ...) or a trajectory CSV file, as
+                   spidar_sim --trajectory takes
+    coupling       one of COUPLINGS
+    rate_hz        the world rate (world_manager --rate); None: the scene's
+    phase_ticks    the world clock's lockstep phase in haptic ticks, within one world period (world_manager --phase)
+    substeps       ODE steps per world period (world_manager --substeps); None: the scene's
+    stiffness_Npm, damping_Nspm   the contact spring and damper (haptic_controller --stiffness, --damping); None:
+                   the scene's
+    duration_s     the longest trial; it ends earlier when the trajectory does (run.sh --duration, default 60)
+    out_dir        a directory for world.csv, haptic.csv, device.csv and summary.json, created if missing; None: a
+                   temporary one, removed before returning
+    logs           whether to read the logs into Trial.logs (False saves the parsing for sweeps that need only the
+                   summary; the files are still written to out_dir)
+
+    Raises ValueError for an argument out of range (naming it, its value and the range) and RuntimeError for a file
+    that cannot be used (naming the file and the field).
+    """
+    if coupling not in COUPLINGS:
+        raise ValueError(f"coupling: must be one of {', '.join(COUPLINGS)}, not {coupling!r}")
+    if isinstance(phase_ticks, bool) or not isinstance(phase_ticks, int) or phase_ticks < 0:
+        raise ValueError(f"phase_ticks: must be a whole number of ticks, 0 or more, not {phase_ticks!r}")
+    scene = pathlib.Path(scene)
+    if not scene.is_file():
+        raise FileNotFoundError(f"scene: no such file '{scene}'")
+    with tempfile.TemporaryDirectory(prefix="impetus-trial-") as scratch:
+        directory = pathlib.Path(out_dir) if out_dir is not None else pathlib.Path(scratch)
+        directory.mkdir(parents=True, exist_ok=True)
+        start = time.monotonic()
+        summary = json.loads(_impetus.run_trial(str(scene), str(trajectory), coupling, phase_ticks, rate_hz, substeps,
+                                                stiffness_Npm, damping_Nspm, float(duration_s),
+                                                str(directory) if (out_dir is not None or logs) else ""))
+        # What run.sh adds to the daemons' config (impetus_py/summary.py): the trial's own arguments.
+        summary["config"].update({"scene": str(scene), "trajectory": str(trajectory), "duration_s": float(duration_s),
+                                  "wall_time_s": time.monotonic() - start})
+        if out_dir is not None:
+            (directory / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        table = {key: read_log(directory / name) for key, name in LOG_FILES.items()} if logs else {}
+    return Trial(summary, table, directory if out_dir is not None else None)

@@ -1,0 +1,130 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The impetus Python package against the three daemons: a trial run from Python must equal the same trial run by
+scripts/run.sh in lockstep bit for bit (logs and final state), its options must reach the nodes, and bad arguments
+must be refused with the argument's name.
+
+Run by CTest with PYTHONPATH=BUILD/python and IMPETUS_BUILD_DIR=BUILD; usage: test_impetus_module.py OUT_DIR
+"""
+import json
+import math
+import os
+import pathlib
+import subprocess
+import sys
+import unittest
+
+import numpy as np
+
+import impetus
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+OUT = pathlib.Path(sys.argv.pop(1) if len(sys.argv) > 1 else "/tmp/impetus-python-test")
+
+
+def run_sh(out_dir, scene, trajectory, coupling, rate, phase, substeps, haptic_flags):
+    command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), "--trajectory", trajectory,
+               "--coupling", coupling, "--clock", "lockstep", "--phase", str(phase), "--out", str(out_dir), "--quiet"]
+    if rate is not None:
+        command += ["--rate", str(rate)]
+    if substeps is not None:
+        command += ["--substeps", str(substeps)]
+    command += ["--"] + haptic_flags
+    subprocess.run(command, check=True, env=dict(os.environ))
+    return json.loads((out_dir / "summary.json").read_text())
+
+
+class SameAsRunSh(unittest.TestCase):
+    def check_same(self, name, scene, trajectory, coupling, rate=None, phase=0, substeps=None, stiffness=None,
+                   damping=None):
+        flags = []
+        if stiffness is not None:
+            flags += ["--stiffness", str(stiffness)]
+        if damping is not None:
+            flags += ["--damping", str(damping)]
+        processes = run_sh(OUT / f"{name}-processes", scene, trajectory, coupling, rate, phase, substeps, flags)
+        trial = impetus.run_trial(scene, trajectory, coupling, rate_hz=rate, phase_ticks=phase, substeps=substeps,
+                                  stiffness_Npm=stiffness, damping_Nspm=damping, out_dir=OUT / f"{name}-python")
+        for log in impetus.LOG_FILES.values():
+            with self.subTest(log=log):
+                text = (trial.out_dir / log).read_text()
+                self.assertGreater(len(text), 1000)  # a real trial, not two empty logs
+                self.assertEqual(text, (OUT / f"{name}-processes" / log).read_text())
+        self.assertEqual(trial.summary["objects"], processes["objects"])
+        for key in ("world_rate_hz", "substeps", "phase_ticks", "coupling"):
+            self.assertEqual(trial.summary["config"][key], processes["config"][key] if key != "phase_ticks"
+                             else phase)
+        # The arrays are the log's columns: as many rows as ticks, the same numbers as the file.
+        haptic = trial.logs["haptic"]
+        self.assertEqual(len(haptic["force_x"]), trial.summary["haptic"]["ticks"])
+        first_row = (trial.out_dir / "haptic.csv").read_text().splitlines()[1].split(",")
+        header = (trial.out_dir / "haptic.csv").read_text().splitlines()[0].split(",")
+        self.assertEqual([float(v) for v in first_row], [float(haptic[c][0]) for c in header])
+        return trial
+
+    def test_defaults(self):
+        trial = self.check_same("defaults", ROOT / "scenes/tap.json", "tap", "impulse")
+        self.assertGreater(trial.summary["objects"]["cube"]["position"][0], 0.05)  # the tap pushed the cube
+
+    def test_every_option(self):
+        # A 10 Hz world (100-tick period) at phase 37 with 12 substeps and a softer, more damped contact than the
+        # scene's: each option changes the trial, so a dropped one shows as a different log.
+        trial = self.check_same("options", ROOT / "scenes/tap.json", "tap:speed=0.15", "local", rate=10, phase=37,
+                                substeps=12, stiffness=3000, damping=4)
+        self.assertEqual(trial.summary["haptic"]["stiffness_Npm"], 3000)
+        self.assertEqual(trial.summary["haptic"]["damping_Nspm"], 4)
+        self.assertEqual(trial.summary["config"]["world_rate_hz"], 10)
+
+
+class Arguments(unittest.TestCase):
+    def scene(self):
+        return impetus.shipped_scene("tap")
+
+    def test_options_change_the_outcome(self):
+        base = impetus.run_trial(self.scene(), "tap", logs=False)
+        stiff = impetus.run_trial(self.scene(), "tap", stiffness_Npm=6000, logs=False)
+        self.assertNotEqual(base.summary["objects"], stiff.summary["objects"])
+        self.assertEqual(base.logs, {})
+        self.assertIsNone(base.out_dir)
+
+    def test_out_of_range_values_name_the_argument(self):
+        cases = [(dict(rate_hz=1e300), "world_rate_hz"), (dict(rate_hz=math.nan), "world_rate_hz"),
+                 (dict(substeps=0), "substeps"), (dict(stiffness_Npm=-5.0), "stiffness_Npm"),
+                 (dict(damping_Nspm=1e9), "damping_Nspm"), (dict(duration_s=math.inf), "duration_s"),
+                 (dict(phase_ticks=50), "phase"), (dict(phase_ticks=-1), "phase_ticks"),
+                 (dict(coupling="springy"), "coupling")]
+        for kwargs, name in cases:
+            with self.subTest(**{k: str(v) for k, v in kwargs.items()}):
+                with self.assertRaises(ValueError) as raised:
+                    impetus.run_trial(self.scene(), "tap", logs=False, **kwargs)
+                self.assertIn(name, str(raised.exception))
+
+    def test_bad_files_name_the_file(self):
+        with self.assertRaises(FileNotFoundError):
+            impetus.run_trial(OUT / "no-such-scene.json", "tap")
+        bad_scene = OUT / "bad-scene.json"
+        bad_scene.parent.mkdir(parents=True, exist_ok=True)
+        bad_scene.write_text('{"objects": [{"name": "c", "shape": "box", "size_m": [0.05, 0.05, -1]}]}')
+        with self.assertRaises(RuntimeError) as raised:
+            impetus.run_trial(bad_scene, "tap")
+        self.assertIn("bad-scene.json", str(raised.exception))
+        with self.assertRaises(RuntimeError) as raised:
+            impetus.run_trial(self.scene(), OUT / "no-such-trajectory.csv")
+        self.assertIn("no-such-trajectory.csv", str(raised.exception))
+        with self.assertRaises(FileNotFoundError) as raised:
+            impetus.shipped_scene("no_such_scene")
+        self.assertIn("tap", str(raised.exception))  # the message lists the scenes there are
+
+    def test_read_log_refuses_a_damaged_file(self):
+        damaged = OUT / "damaged.csv"
+        damaged.parent.mkdir(parents=True, exist_ok=True)
+        damaged.write_text("time_s,force_x\n0.0,1.0\n0.001,oops\n")
+        with self.assertRaises(RuntimeError) as raised:
+            impetus.read_log(damaged)
+        self.assertIn("line 3", str(raised.exception))
+        self.assertIn("force_x", str(raised.exception))
+        damaged.write_text("time_s,force_x\n0.0,1.0\n0.001,2.0\n")
+        self.assertTrue(np.array_equal(impetus.read_log(damaged)["force_x"], [1.0, 2.0]))
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
