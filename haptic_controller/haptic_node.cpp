@@ -157,6 +157,8 @@ void HapticNode::run_realtime() {
     tick(timing.index, timing.now_s, timing.elapsed_s, timing.lateness_ns);
     if (timing.index % kStatsEveryTicks == 0) publish_stats(&clock);
   }
+  // The device's minimum output as the servo stops: the last force commanded would otherwise stay on the finger.
+  device_.command(clock.ticks(), Eigen::Vector3d::Zero(), false);
   loop_done.store(true);
   supervisor.join();
   publish_stats(&clock);
