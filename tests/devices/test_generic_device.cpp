@@ -14,44 +14,19 @@
 
 #include <Eigen/Geometry>
 
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <new>
 #include <string>
 
 #include <unistd.h>
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-// The sanitizer owns operator new (tests/haptic_controller/test_no_allocation.cpp says why): no counting there.
-#define IMPETUS_COUNT_ALLOCATIONS 0
-#else
-#define IMPETUS_COUNT_ALLOCATIONS 1
-#endif
-
-#if IMPETUS_COUNT_ALLOCATIONS
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-
-void* counted_allocation(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return counted_allocation(size); }
-void* operator new[](std::size_t size) { return counted_allocation(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-#endif
+#include "tests/support/allocation_counter.h"
 
 using namespace impetus;
+using impetus::test::start_counting_allocations;
+using impetus::test::stop_counting_allocations;
 using Eigen::Vector3d;
 
 namespace {
@@ -356,8 +331,7 @@ TEST_CASE("generic device: read() and command() allocate nothing over 10^4 ticks
   SimulatedImpedanceBackend backend;
   backend.move_each_reading(Vector3d(0.001, -0.002, 0.0015));
   GenericImpedanceDevice device(mounted_on_its_side(), backend);
-  g_allocations = 0;
-  g_counting = true;
+  start_counting_allocations();
   for (int tick = 0; tick < 10000; ++tick) {
     const double now_s = tick * 1e-3;
     if (tick % 1000 == 100) backend.go_silent();
@@ -370,8 +344,7 @@ TEST_CASE("generic device: read() and command() allocate nothing over 10^4 ticks
     const double size_N = 1.0 + (tick % 7);  // some within 3 N, some saturated
     device.command(static_cast<std::uint64_t>(tick), Vector3d(size_N, -0.5 * size_N, 0.2), sample && sample->valid);
   }
-  g_counting = false;
-  CHECK(g_allocations == 0);
+  CHECK(stop_counting_allocations() == 0);
   CHECK(device.counters().saturations > 0);      // every path was taken: saturation,
   CHECK(device.counters().rejected_frames > 0);  // rejection,
   CHECK(device.counters().devices_lost == 10);   // loss,
@@ -379,12 +352,12 @@ TEST_CASE("generic device: read() and command() allocate nothing over 10^4 ticks
 }
 
 TEST_CASE("generic device: the allocation counter does count (the test above can fail)") {
-  g_allocations = 0;
-  g_counting = true;
-  auto* p = new int(3);
-  g_counting = false;
-  delete p;
-  CHECK(g_allocations == 1);
+  start_counting_allocations();
+  // A call of operator new, not a new-expression: the compiler may elide an unused new-expression.
+  void* p = ::operator new(sizeof(int));
+  const long allocations = stop_counting_allocations();
+  ::operator delete(p);
+  CHECK(allocations == 1);
 }
 #endif
 

@@ -1,49 +1,20 @@
 // SPDX-License-Identifier: Apache-2.0
 // Real-time discipline: the servo's tick() and on_plane_frame() and the SPIDAR driver's read() and command() never
-// touch the heap. Global operator new/delete are replaced for
-// the whole test binary, but count only while `g_counting` is set, so other tests are unaffected.
-//
-// Under AddressSanitizer the sanitizer owns operator new/delete (some allocations reach its own operator new, and our
-// free() of them is reported as a mismatch), so the replacement and the two counting tests are compiled only in
-// unsanitized builds; the plain Release build is the one that proves the property.
+// touch the heap (counted by tests/support/allocation_counter.h; not in sanitizer builds, which own operator new).
 
-#include <atomic>
 #include <catch2/catch.hpp>
 #include <cstdlib>
-#include <new>
 
 #include "common/link/inproc/inproc_device_port.h"
 #include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/servo.h"
 #include "test_support.h"
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define IMPETUS_COUNT_ALLOCATIONS 0
-#else
-#define IMPETUS_COUNT_ALLOCATIONS 1
-#endif
-
-#if IMPETUS_COUNT_ALLOCATIONS
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-
-void* counted_allocation(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return counted_allocation(size); }
-void* operator new[](std::size_t size) { return counted_allocation(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-#endif
+#include "tests/support/allocation_counter.h"
 
 using namespace impetus;
+using impetus::test::start_counting_allocations;
+using impetus::test::stop_counting_allocations;
 using Eigen::Vector3d;
 using impetus::test::make_frame;
 using impetus::test::wire_plane;
@@ -87,8 +58,7 @@ TEST_CASE("the servo tick and the SPIDAR driver allocate nothing over 10^4 ticks
     frame.planes[k].velocity_mps = {0.01, 0.0, 0.0};
   }
 
-  g_allocations = 0;
-  g_counting = true;
+  start_counting_allocations();
   for (int tick = 1; tick <= 10000; ++tick) {
     const double now_s = tick * 1e-3;
     if (tick % 50 == 1) {
@@ -106,17 +76,16 @@ TEST_CASE("the servo tick and the SPIDAR driver allocate nothing over 10^4 ticks
     const TickResult& result = servo.tick(tick % 997 == 0 ? nullptr : sample, now_s, 1e-3);
     driver.command(static_cast<std::uint64_t>(tick), to_eigen(result.force_N), result.render);
   }
-  g_counting = false;
-  REQUIRE(g_allocations == 0);
+  REQUIRE(stop_counting_allocations() == 0);
   REQUIRE(servo.counters().ticks == 10000);
 }
 
 TEST_CASE("the allocation counter does count (the test above can fail)") {
-  g_allocations = 0;
-  g_counting = true;
-  auto* p = new int(3);
-  g_counting = false;
-  delete p;
-  REQUIRE(g_allocations == 1);
+  start_counting_allocations();
+  // A call of operator new, not a new-expression: the compiler may elide an unused new-expression.
+  void* p = ::operator new(sizeof(int));
+  const long allocations = stop_counting_allocations();
+  ::operator delete(p);
+  REQUIRE(allocations == 1);
 }
 #endif
