@@ -372,8 +372,9 @@ def main():
         if coupling not in COUPLINGS:
             parser.error(f"--couplings: unknown coupling '{coupling}' (known: {', '.join(COUPLINGS)})")
     build = build_dir()
-    # Run every trial on a private copy of the three binaries and the Python package: a rebuild of build/ during the sweep (other work on
-    # the same tree) would otherwise mix versions or make trials fail while the linker rewrites a binary.
+    # Run every trial on a private copy of the three binaries and the Python package: a rebuild of build/ during the
+    # sweep (other work on the same tree) would otherwise mix versions or make trials fail while the linker rewrites
+    # a binary.
     snapshot = args.out / "bin"
     for name in ("world_manager", "haptic_controller", "spidar_sim"):
         source = build / name / name

@@ -86,6 +86,21 @@ SurfacePoint nearest_surface_point_body(const Shape& shape, const Eigen::Vector3
   return {Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0};
 }
 
+int nearest_box_faces(const Eigen::Vector3d& half_m, const Eigen::Vector3d& q, double tolerance_m,
+                      std::array<Eigen::Vector3d, 3>& normals) {
+  const Eigen::Vector3d gap_m = half_m - q.cwiseAbs();  // negative along an axis the point is outside of
+  if (gap_m.minCoeff() < -tolerance_m) return 0;
+  const double nearest_m = gap_m.minCoeff();
+  int count = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (gap_m[axis] > nearest_m + tolerance_m) continue;
+    normals[static_cast<std::size_t>(count)] = Eigen::Vector3d::Zero();
+    normals[static_cast<std::size_t>(count)][axis] = q[axis] >= 0.0 ? 1.0 : -1.0;
+    ++count;
+  }
+  return count;
+}
+
 SurfacePoint nearest_surface_point(const Shape& shape, const BodyPose& pose, const Eigen::Vector3d& query_m) {
   const Eigen::Vector3d query_body_m = pose.orientation.conjugate() * (query_m - pose.position_m);
   const SurfacePoint body = nearest_surface_point_body(shape, query_body_m);

@@ -10,6 +10,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <array>
+
 namespace impetus {
 
 // Pose of a body: world = orientation · body + position.
@@ -30,6 +32,14 @@ struct SurfacePoint {
 // not unique (the exact centre of a sphere, the axis of a capsule or cylinder) a fixed direction is chosen (+z for a
 // sphere, +x for the radial direction of a capsule or cylinder) so the answer is deterministic.
 SurfacePoint nearest_surface_point_body(const Shape& shape, const Eigen::Vector3d& query_m);
+
+// The faces of a box (`half_m`: half sizes) whose planes a body-frame point inside or on the box is nearest to, within
+// `tolerance_m` of the nearest: their outward unit normals, lowest axis first, + side for a point on the mid-plane.
+// One face for a point in a face's interior, two on an edge, three at a corner. A point outside by at most
+// `tolerance_m` counts as on the surface (rounding puts a point meant to be on an edge on either side of it). Returns
+// the count; 0 for a point farther outside.
+int nearest_box_faces(const Eigen::Vector3d& half_m, const Eigen::Vector3d& q, double tolerance_m,
+                      std::array<Eigen::Vector3d, 3>& normals);
 
 // The same for a body in the world: query, result point and normal in the world frame.
 SurfacePoint nearest_surface_point(const Shape& shape, const BodyPose& pose, const Eigen::Vector3d& query_m);

@@ -26,6 +26,13 @@ double choose_cell_size_m(const Scene& scene) {
   return std::max(scene.haptic.reach_radius_m, median_m);
 }
 
+// Faces nearer than this to the same query are one feature: a proxy the servo put on a box's edge or in a corner is
+// exact only to rounding (~1e-17 m at these coordinates), far below any modelled feature (0.1 mm, SceneLimits).
+constexpr double kFaceTie_m = 1e-9;
+// How far past a tied face its outside is probed for another object: far beyond the tie's rounding, far below the
+// smallest object (0.1 mm), so a neighbour whose face touches this one, or lies within a micrometre of it, occupies it.
+constexpr double kOutsideProbe_m = 1e-6;
+
 bool nearer(const ReachCandidate& a, const ReachCandidate& b) {
   if (a.surface.signed_distance_m != b.surface.signed_distance_m) {
     return a.surface.signed_distance_m < b.surface.signed_distance_m;
@@ -66,6 +73,9 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
     const ObjectState& state = states[static_cast<std::size_t>(id)];
     const Shape& shape = scene_.objects[static_cast<std::size_t>(id)].shape;
     SurfacePoint surface = nearest_surface_point(shape, state.pose, finger.position_m);
+    if (shape.kind == ShapeKind::box && surface.signed_distance_m <= kFaceTie_m) {
+      surface = open_box_face(id, surface, finger.position_m, states);
+    }
     // The frame the face is remembered in: the body's, so a face turns with it; a sphere's surface does not change
     // when it spins (a rolling ball turns half a revolution in a period), so a sphere's is the world's axes about its
     // centre.
@@ -109,6 +119,53 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
     }
   }
   std::sort(out.begin(), out.end(), nearer);
+}
+
+bool FeatureExtractor::occupied(const Eigen::Vector3d& point_m, std::int32_t self,
+                                std::span<const ObjectState> states) const {
+  if (scene_.floor.present && point_m.z() < scene_.floor.height_m) return true;
+  for (std::int32_t other : candidate_ids_) {
+    if (other == self) continue;
+    const auto i = static_cast<std::size_t>(other);
+    if (nearest_surface_point(scene_.objects[i].shape, states[i].pose, point_m).signed_distance_m < 0.0) return true;
+  }
+  return false;
+}
+
+SurfacePoint FeatureExtractor::open_box_face(std::int32_t id, const SurfacePoint& nearest,
+                                             const Eigen::Vector3d& query_m,
+                                             std::span<const ObjectState> states) const {
+  const auto i = static_cast<std::size_t>(id);
+  const Shape& shape = scene_.objects[i].shape;
+  const BodyPose& pose = states[i].pose;
+  const Eigen::Vector3d query_body_m = pose.orientation.conjugate() * (query_m - pose.position_m);
+  std::array<Eigen::Vector3d, 3> faces;
+  const int count = nearest_box_faces(0.5 * to_eigen(shape.box_size_m), query_body_m, kFaceTie_m, faces);
+  if (count == 0) return nearest;
+  // On a face within rounding, outside it or in: its plane, not the direction of a rounding-sized offset.
+  if (count == 1) return supporting_plane(shape, pose, query_m, faces[0]);
+  for (int k = 0; k < count; ++k) {
+    const Eigen::Vector3d& normal = faces[static_cast<std::size_t>(k)];
+    // Just outside face k and just inside the other tied faces: the region only face k bounds. A neighbour's face may
+    // end exactly at the query (a face half covered, half open), so the probe is also moved half as far along the
+    // face's two tangents both ways: the face is open if any of the five points is free.
+    Eigen::Vector3d direction = normal;
+    for (int j = 0; j < count; ++j) {
+      if (j != k) direction -= faces[static_cast<std::size_t>(j)];
+    }
+    const Eigen::Vector3d base_m = kOutsideProbe_m * direction.normalized();
+    const Eigen::Vector3d tangent_a = normal.unitOrthogonal();
+    const Eigen::Vector3d tangent_b = normal.cross(tangent_a);
+    for (const Eigen::Vector2d& side : {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 1), Eigen::Vector2d(1, -1),
+                                       Eigen::Vector2d(-1, 1), Eigen::Vector2d(-1, -1)}) {
+      const Eigen::Vector3d offset_body_m =
+          base_m + 0.5 * kOutsideProbe_m * (side.x() * tangent_a + side.y() * tangent_b);
+      if (!occupied(query_m + pose.orientation * offset_body_m, id, states)) {
+        return supporting_plane(shape, pose, query_m, normal);
+      }
+    }
+  }
+  return nearest;
 }
 
 Plane FeatureExtractor::make_plane(const ReachCandidate& candidate, std::span<const ObjectState> states) const {

@@ -9,6 +9,12 @@
 //
 // The extractor keeps a SpatialGrid of every object's bounding box swept by its own speed·T_w; index() rebuilds it
 // once per world step and extract() then only tests the objects in the cells around the finger.
+//
+// Touching boxes: a query on an edge or corner of a box (the proxy in a concave corner of boxes whose faces touch
+// exactly) is equally near two or three of its faces. The face given is one whose outside is free space: a face
+// pressed against another object or the floor is inside the scene's solid, not a surface the finger can meet, and its
+// plane would take the place of the face the finger does meet (the proxy then slides along the seam into the box).
+// Among free faces, or when none is, the lowest body axis is taken, as everywhere else.
 
 #include "common/contract/frames.h"
 #include "world_manager/scene.h"
@@ -65,6 +71,12 @@ class FeatureExtractor {
 
  private:
   Plane make_plane(const ReachCandidate& candidate, std::span<const ObjectState> states) const;
+  // The face of a box for a query on its surface within rounding: the face's own plane (not the direction of a
+  // rounding-sized offset), and on an edge or corner a face whose outside is free (header: touching boxes).
+  SurfacePoint open_box_face(std::int32_t id, const SurfacePoint& nearest, const Eigen::Vector3d& query_m,
+                             std::span<const ObjectState> states) const;
+  // Whether `point_m` lies inside the floor or an object of the last query other than `self`.
+  bool occupied(const Eigen::Vector3d& point_m, std::int32_t self, std::span<const ObjectState> states) const;
 
   const Scene& scene_;
   SpatialGrid grid_;
