@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <mutex>
 #include <stdexcept>
 
 namespace impetus {
@@ -57,6 +58,10 @@ void check_options(const InProcessTrialOptions& options) {
 
 nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   check_options(options);
+  // ODE keeps process-wide state that a step uses (its random generator, which QuickStep draws from, and its default
+  // threading implementation), so two worlds must not step at once: trials in one process take turns.
+  static std::mutex one_trial_at_a_time;
+  const std::lock_guard<std::mutex> turn(one_trial_at_a_time);
   init_ode_once();
   WorldNodeOptions world_options;
   world_options.scene_path = options.scene_path;

@@ -35,6 +35,8 @@ struct InProcessTrialOptions {
 };
 
 // Runs the trial to the end of its trajectory; returns the world, haptic and device halves of summary.json merged.
+// Thread-safe: concurrent calls run one after another (ODE's state is process-wide); for trials in parallel use
+// processes. Nothing else in the process may step an ODE world meanwhile.
 // Throws std::invalid_argument for an option out of its range (naming the option, the value and the range) and
 // std::runtime_error (SceneError, TrajectoryError, ...) for a bad file, naming the file and the field.
 nlohmann::json run_in_process_trial(const InProcessTrialOptions& options);

@@ -9,7 +9,8 @@
 
 A trial is the world, haptic and device nodes of the three daemons, run in this process under the lockstep schedule:
 bitwise the same outcome as `scripts/run.sh --clock lockstep` with the same arguments, and no process is started.
-The call releases the GIL; trials are independent, so a process pool runs several at once.
+The call releases the GIL while the trial runs. Trials in one process take turns (the physics engine's state is
+process-wide), so calls from several threads are safe but not parallel: a process pool runs several at once.
 """
 import json
 import pathlib

@@ -11,6 +11,7 @@ import os
 import pathlib
 import subprocess
 import sys
+import threading
 import unittest
 
 import numpy as np
@@ -113,6 +114,29 @@ class Arguments(unittest.TestCase):
         with self.assertRaises(FileNotFoundError) as raised:
             impetus.shipped_scene("no_such_scene")
         self.assertIn("tap", str(raised.exception))  # the message lists the scenes there are
+
+    def test_threads_take_turns(self):
+        # Four threads running trials at once: each gets the outcome of a trial run alone (before the turns, two
+        # worlds stepping together aborted inside ODE).
+        reference = impetus.run_trial(self.scene(), "tap", logs=False).summary["objects"]
+        outcomes, errors = [], []
+
+        def run():
+            try:
+                for _ in range(3):
+                    outcomes.append(impetus.run_trial(self.scene(), "tap", logs=False).summary["objects"])
+            except Exception as error:  # noqa: BLE001 — reported below
+                errors.append(error)
+
+        threads = [threading.Thread(target=run) for _ in range(4)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        self.assertEqual(errors, [])
+        self.assertEqual(len(outcomes), 12)
+        for outcome in outcomes:
+            self.assertEqual(outcome, reference)
 
     def test_read_log_refuses_a_damaged_file(self):
         damaged = OUT / "damaged.csv"
