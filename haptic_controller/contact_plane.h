@@ -27,6 +27,10 @@ struct ContactPlane {
   double static_friction = 0.0;
   double dynamic_friction = 0.0;
   double extent_m = 0.0;  // how far from point_m the plane describes its object; 0: unbounded (link_types.h)
+  // kPlaneBox: the box's axes (columns: body x, y, z in the world frame) and half sizes along them, m; its centre is
+  // com_m. Moved with the plane by the interpolation and the local model (shape_planes.h).
+  Eigen::Matrix3d box_axes = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d box_half_m = Eigen::Vector3d::Zero();
 
   // Velocity of the object's material point at `x` (rigid body: v + ω × (x − com)).
   Eigen::Vector3d surface_velocity_mps(const Eigen::Vector3d& x_m) const {
@@ -34,6 +38,7 @@ struct ContactPlane {
   }
   bool dynamic() const { return (flags & kPlaneDynamic) != 0; }
   bool sphere() const { return (flags & kPlaneSphere) != 0 && extent_m > 0.0; }
+  bool box() const { return (flags & kPlaneBox) != 0 && (box_half_m.array() > 0.0).all(); }
 
   // Angular impulse about the CoM of `impulse_Ns` applied by a finger at `proxy_m`. On a flat face the push acts at
   // the proxy. On a sphere its normal part acts through the centre, so only the part along the surface (friction)

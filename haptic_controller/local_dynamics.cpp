@@ -288,6 +288,8 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
       plane.point_m = body->carry_point(point);
       plane.normal = body->carry_normal(normal);  // turned for a flat face only: see the header
       plane.com_m = body->com_m();
+      // A box travels with its plane: its centre is the CoM, its axes turn with the body (shape_planes.h).
+      for (int axis = 0; axis < 3; ++axis) plane.box_axes.col(axis) = body->carry_normal(plane.box_axes.col(axis));
       plane.velocity_mps = body->velocity_mps;
       plane.angular_velocity_radps = body->angular_velocity_radps;
     } else {

@@ -54,7 +54,7 @@
 // rotation within a period is not lost: the world integrates the angular impulses, and its next frame brings the
 // rotated face, blended in like §3.2's interpolation (the lag impulse coupling has for every plane). ω is still
 // integrated: it gives the surface velocity friction sees (a sphere's plane is taken again at the proxy each tick
-// instead, sphere_planes.h).
+// instead, shape_planes.h).
 //
 // Which way a wrong model errs. A model that gives way *less* than the world (a neighbour taken as immovable, a turn
 // it stopped) has the finger press a plane that does not yield, and the world then hands the object momentum the

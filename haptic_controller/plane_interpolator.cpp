@@ -14,6 +14,18 @@ Eigen::Vector3d lerp(const Vec3& from, const Vec3& to, double w) {
   return (1.0 - w) * to_eigen(from) + w * to_eigen(to);
 }
 
+// A box's axes between frames i−1 and i: its body axes, turned part of the way (the same body's in both frames, so
+// they correspond one to one). A turn too large to interpolate (half a revolution in a period) takes frame i's.
+void interpolate_box_axes(const Plane& before, const Plane& now, double w, ContactPlane& plane) {
+  const Eigen::Vector3d x = lerp(before.box_axis_x, now.box_axis_x, w);
+  const Eigen::Vector3d y = lerp(before.box_axis_y, now.box_axis_y, w);
+  const Eigen::Vector3d y_across = y - y.dot(x) / x.squaredNorm() * x;
+  if (!(x.norm() > 0.5) || !(y_across.norm() > 0.5)) return;
+  const Eigen::Vector3d x_unit = x.normalized();
+  const Eigen::Vector3d y_unit = y_across.normalized();
+  plane.box_axes << x_unit, y_unit, x_unit.cross(y_unit);
+}
+
 }  // namespace
 
 ContactPlane to_contact_plane(const Plane& plane) {
@@ -28,6 +40,12 @@ ContactPlane to_contact_plane(const Plane& plane) {
   out.static_friction = plane.static_friction;
   out.dynamic_friction = plane.dynamic_friction;
   out.extent_m = plane.extent_m;
+  if ((plane.flags & kPlaneBox) != 0) {
+    const Eigen::Vector3d x = to_eigen(plane.box_axis_x);
+    const Eigen::Vector3d y = to_eigen(plane.box_axis_y);
+    out.box_axes << x, y, x.cross(y);
+    out.box_half_m = to_eigen(plane.box_half_m);
+  }
   return out;
 }
 
@@ -50,20 +68,23 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, d
     const int match = find_plane(previous, now.object_id, occurrence_of(current, k));
     if (match < 0) continue;  // new object: starts at frame i's value
     const Plane& before = previous.planes[match];
+    const bool box_both = plane.box() && (before.flags & kPlaneBox) != 0;
 
     if (normals_flip(to_eigen(before.normal), to_eigen(now.normal))) {
       if (!flip_switched(w)) {
         plane.point_m = to_eigen(before.point_m);
         plane.normal = to_eigen(before.normal);
         plane.com_m = to_eigen(before.com_m);
+        if (box_both) interpolate_box_axes(before, before, 0.0, plane);
       }
       continue;
     }
     plane.com_m = lerp(before.com_m, now.com_m, w);
+    if (box_both) interpolate_box_axes(before, now, w, plane);
     const Eigen::Vector3d normal = lerp(before.normal, now.normal, w);
     plane.normal = normal / normal.norm();  // |normal| ≥ 1/√2 for unit inputs with dot ≥ 0
     if (plane.sphere()) {
-      // A sphere: its centre moves between the frames, its tangent plane is taken again at the proxy (sphere_planes.h).
+      // A sphere: its centre moves between the frames, its tangent plane is taken again at the proxy (shape_planes.h).
       const double radius_m = plane.extent_m;
       const Eigen::Vector3d centre_before = to_eigen(before.point_m) - radius_m * to_eigen(before.normal);
       const Eigen::Vector3d centre_now = to_eigen(now.point_m) - radius_m * to_eigen(now.normal);

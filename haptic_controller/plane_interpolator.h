@@ -20,7 +20,7 @@
 //    whose next frame is the edge the finger slid past) drops the plane 0.3 mm at the finger in one tick, and the
 //    damper turns that into a pull on the finger (hard case 6). For planes that do not turn this is the paper's rule.
 //  * A sphere's plane (kPlaneSphere) interpolates the centre instead; the servo then takes the tangent plane at the
-//    proxy (sphere_planes.h).
+//    proxy (shape_planes.h).
 
 #include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"

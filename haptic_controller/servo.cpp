@@ -4,7 +4,7 @@
 #include "common/runtime/staleness.h"
 #include "haptic_controller/plane_interpolator.h"
 #include "haptic_controller/plane_matching.h"
-#include "haptic_controller/sphere_planes.h"
+#include "haptic_controller/shape_planes.h"
 
 #include <algorithm>
 #include <cmath>
@@ -140,8 +140,8 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   }
   result_.interpolation_weight = w;
 
-  // Spheres' tangent planes taken again at the last proxy (sphere_planes.h).
-  retake_sphere_planes(planes_, to_eigen(result_.proxy_m));
+  // Spheres' and boxes' planes taken again at the last proxy (shape_planes.h).
+  retake_shape_planes(planes_, to_eigen(result_.proxy_m));
 
   // 3. Proxy D_j (god-object with friction).
   planes_.valid_within_m =

@@ -34,12 +34,16 @@ inline constexpr std::uint32_t kMaxLocalContacts = 4;
 // Plane flags.
 inline constexpr std::uint32_t kPlaneDynamic = 1u << 0;  // the object moves; impulses on it are applied by the world
 // A sphere's tangent plane: the centre is point_m − extent_m·normal and the radius extent_m. The haptic side takes the
-// tangent plane again at its proxy every tick (haptic_controller/sphere_planes.h), as the world does every step.
+// tangent plane again at its proxy every tick (haptic_controller/shape_planes.h), as the world does every step.
 inline constexpr std::uint32_t kPlaneSphere = 1u << 1;
 // A face of a polyhedron (a box): flat, so it turns rigidly with the body about its centre of mass (the haptic side's
 // local model carries it so, haptic_controller/local_dynamics.h). Curved surfaces do not set it: their tangent plane
 // does not turn with a spin.
 inline constexpr std::uint32_t kPlaneFlat = 1u << 2;
+// A box's plane: the box itself travels with it (Plane::box_axis_x_m, box_axis_y, box_half_m; its centre is com_m),
+// so the haptic side can take the plane again at its proxy every tick (haptic_controller/shape_planes.h) and a face's
+// plane ends where the face does.
+inline constexpr std::uint32_t kPlaneBox = 1u << 3;
 
 // LocalContact flags.
 // The other side holds a push along −normal: static geometry, or a body joined to static geometry by a chain of
@@ -74,6 +78,11 @@ struct Plane {
   // How far from point_m the plane still describes the object (world_manager/features/body_geometry.h plane_extent_m): a
   // sphere's radius, a box's diagonal. 0: unbounded (the floor).
   double extent_m = 0.0;
+  // kPlaneBox only: the box's body x and y axes in the world frame (unit, orthogonal; z = x × y) and its half sizes
+  // along x, y, z (m, > 0). Zero otherwise.
+  Vec3 box_axis_x{};
+  Vec3 box_axis_y{};
+  Vec3 box_half_m{};
   // Local response model for the coming world period (paper §6.3). Zero means "not provided": the haptic
   // side must then treat the object as immovable between world steps.
   double inverse_mass_per_kg = 0.0;

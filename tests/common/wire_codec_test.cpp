@@ -78,6 +78,18 @@ TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {
           f.planes[0].local_contacts[0].other_inverse_mass_per_kg = -1.0;
         }) == FrameError::bad_mass);
   CHECK(rejected([&](PlaneFrame& f) { f.reach_radius_m = nan; }) == FrameError::not_finite);
+  // A box's plane carries the box: orthonormal axes and positive half sizes, or the frame is refused.
+  const auto box = [](PlaneFrame& f) {
+    f.planes[0].flags |= kPlaneBox;
+    f.planes[0].box_axis_x = {1.0, 0.0, 0.0};
+    f.planes[0].box_axis_y = {0.0, 1.0, 0.0};
+    f.planes[0].box_half_m = {0.025, 0.025, 0.025};
+  };
+  CHECK(rejected(box) == FrameError::ok);
+  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_axis_y = {0.0, 0.0, 1.001}; }) == FrameError::bad_box);
+  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_axis_y = {0.1, 0.995, 0.0}; }) == FrameError::bad_box);
+  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_half_m[1] = 0.0; }) == FrameError::bad_box);
+  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_half_m[2] = nan; }) == FrameError::not_finite);
   // Planes past the count are not looked at: garbage there is harmless.
   CHECK(rejected([&](PlaneFrame& f) { f.planes[5].point_m[0] = nan; }) == FrameError::ok);
 

@@ -112,7 +112,9 @@ std::vector<Eigen::Quaterniond> turns() {
   }
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  for (int k = 0; k < 6; ++k) out.push_back(Eigen::Quaterniond(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
+  for (int k = 0; k < 6; ++k) {
+    out.push_back(Eigen::Quaterniond(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
+  }
   return out;
 }
 

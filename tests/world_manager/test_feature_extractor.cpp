@@ -158,7 +158,11 @@ TEST_CASE("planes carry the object's state, friction and the floor") {
   REQUIRE(frame.plane_count == 2);
   const impetus::Plane& cube = frame.planes[0].object_id == 0 ? frame.planes[0] : frame.planes[1];
   const impetus::Plane& floor = frame.planes[0].object_id == 0 ? frame.planes[1] : frame.planes[0];
-  CHECK(cube.flags == (impetus::kPlaneDynamic | impetus::kPlaneFlat));  // a box: its faces are flat
+  // A box: its faces are flat, and the box travels with its plane (its axes and half sizes; the cube is 5 cm).
+  CHECK(cube.flags == (impetus::kPlaneDynamic | impetus::kPlaneFlat | impetus::kPlaneBox));
+  CHECK(cube.box_half_m == impetus::Vec3{0.025, 0.025, 0.025});
+  CHECK(cube.box_axis_x[0] == Approx(1.0).margin(1e-6));  // resting unturned
+  CHECK(cube.box_axis_y[1] == Approx(1.0).margin(1e-6));
   CHECK(cube.normal[0] == Approx(-1.0));
   CHECK(cube.point_m[0] == Approx(0.005).margin(1e-4));  // the −x face (the cube has barely settled)
   CHECK(cube.inverse_mass_per_kg == Approx(1.0));

@@ -55,6 +55,9 @@ void visit_plane(A& a, B& b, F&& f) {
   f(a.static_friction, b.static_friction);
   f(a.dynamic_friction, b.dynamic_friction);
   f(a.extent_m, b.extent_m);
+  f(a.box_axis_x, b.box_axis_x);
+  f(a.box_axis_y, b.box_axis_y);
+  f(a.box_half_m, b.box_half_m);
   f(a.inverse_mass_per_kg, b.inverse_mass_per_kg);
   f(a.inverse_inertia_world, b.inverse_inertia_world);
   f(a.local_contact_count, b.local_contact_count);
@@ -131,6 +134,7 @@ const char* to_string(FrameError error) {
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
     case FrameError::bad_reach: return "reach radius or plane extent is negative";
     case FrameError::bad_mass: return "a local contact's inverse mass is negative";
+    case FrameError::bad_box: return "a box's axes are not orthonormal or its sizes not positive";
   }
   return "unknown frame error";
 }
@@ -162,6 +166,18 @@ FrameError validate(const wire::PlaneFrame& frame) {
       return FrameError::not_finite;
     }
     if (plane.extent_m < 0.0) return FrameError::bad_reach;
+    if ((plane.flags & kPlaneBox) != 0) {
+      if (!all_finite(plane.box_axis_x) || !all_finite(plane.box_axis_y) || !all_finite(plane.box_half_m)) {
+        return FrameError::not_finite;
+      }
+      const auto dot = [](const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+      if (std::fabs(dot(plane.box_axis_x, plane.box_axis_x) - 1.0) > kUnitNormalTolerance ||
+          std::fabs(dot(plane.box_axis_y, plane.box_axis_y) - 1.0) > kUnitNormalTolerance ||
+          std::fabs(dot(plane.box_axis_x, plane.box_axis_y)) > kUnitNormalTolerance ||
+          !(plane.box_half_m[0] > 0.0 && plane.box_half_m[1] > 0.0 && plane.box_half_m[2] > 0.0)) {
+        return FrameError::bad_box;
+      }
+    }
     for (double value : plane.inverse_inertia_world) {
       if (!finite(value)) return FrameError::not_finite;
     }

@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "haptic_controller/shape_planes.h"
+
+#include <cmath>
+
+namespace impetus {
+namespace {
+
+// A proxy this close to a face's rim is still on the face: the god-object puts a proxy that slides up to an edge on
+// it only to rounding (~1e-17 m), and a point on the surface has no direction to take a normal from.
+constexpr double kOnSurface_m = 1e-9;
+
+void retake_sphere(ContactPlane& plane, const Eigen::Vector3d& around_m) {
+  const Eigen::Vector3d centre_m = plane.point_m - plane.extent_m * plane.normal;
+  const Eigen::Vector3d offset_m = around_m - centre_m;
+  const double distance_m = offset_m.norm();
+  if (!(distance_m > 0.0) || !std::isfinite(distance_m)) return;
+  plane.normal = offset_m / distance_m;
+  plane.point_m = centre_m + plane.extent_m * plane.normal;
+}
+
+void retake_box(ContactPlane& plane, const Eigen::Vector3d& around_m) {
+  const Eigen::Vector3d local_m = plane.box_axes.transpose() * (around_m - plane.com_m);  // box frame
+  const Eigen::Vector3d& half_m = plane.box_half_m;
+  // The plane's face: the one whose normal is nearest the plane's. The plane is that face's as the interpolation or
+  // the local model moved it, which may turn it off the box's axis a little (the local model's blend toward a new
+  // frame); an edge's plane counts as its nearer face's, as the world gave it while the proxy stays over that face.
+  const Eigen::Vector3d normal_local = plane.box_axes.transpose() * plane.normal;
+  int face_axis = 0;
+  normal_local.cwiseAbs().maxCoeff(&face_axis);
+  const double face_side = normal_local[face_axis] > 0.0 ? 1.0 : -1.0;
+
+  const Eigen::Vector3d nearest_local_m = local_m.cwiseMax(-half_m).cwiseMin(half_m);
+  Eigen::Vector3d offset_local_m = local_m - nearest_local_m;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(offset_local_m[axis]) <= kOnSurface_m) offset_local_m[axis] = 0.0;  // on the rim, to rounding
+  }
+  const double distance_m = offset_local_m.norm();
+  if (distance_m > 0.0 && std::isfinite(distance_m)) {
+    // Outside: over the plane's own face (the nearest point on it, the offset along its normal) the plane stays as
+    // the interpolation or the local model made it; anywhere else the box's nearest edge, corner or face.
+    const bool over_face = offset_local_m[face_axis] * face_side > 0.0 &&
+                           offset_local_m.squaredNorm() == offset_local_m[face_axis] * offset_local_m[face_axis];
+    if (over_face) return;
+    plane.normal = plane.box_axes * (offset_local_m / distance_m);
+    plane.point_m = plane.com_m + plane.box_axes * nearest_local_m;
+    return;
+  }
+  // On the surface (where the god-object leaves a proxy) or inside (the box moved onto it). A proxy on the plane's
+  // own face, or deep inside (the world chose the face: feature_memory.h), keeps the plane; a proxy on another face
+  // (it went round an edge) gets that face: of the faces it is on, the one nearest the plane's normal.
+  int best_axis = -1;
+  double best_side = 0.0, best_alignment = -2.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(local_m[axis]) < half_m[axis] - kOnSurface_m) continue;
+    const double side = local_m[axis] >= 0.0 ? 1.0 : -1.0;
+    if (axis == face_axis && side == face_side) return;
+    const double alignment = side * normal_local[axis];
+    if (alignment > best_alignment) {
+      best_axis = axis;
+      best_side = side;
+      best_alignment = alignment;
+    }
+  }
+  if (best_axis < 0) return;
+  Eigen::Vector3d on_face_m = local_m;
+  on_face_m[best_axis] = best_side * half_m[best_axis];
+  plane.normal = best_side * plane.box_axes.col(best_axis);
+  plane.point_m = plane.com_m + plane.box_axes * on_face_m;
+}
+
+}  // namespace
+
+void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m) {
+  for (std::uint32_t k = 0; k < planes.count; ++k) {
+    ContactPlane& plane = planes.planes[k];
+    if (plane.sphere()) {
+      retake_sphere(plane, around_m);
+    } else if (plane.box()) {
+      retake_box(plane, around_m);
+    }
+  }
+}
+
+}  // namespace impetus

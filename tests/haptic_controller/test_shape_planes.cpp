@@ -1,0 +1,179 @@
+// SPDX-License-Identifier: Apache-2.0
+// Spheres' and boxes' planes are taken again at the proxy every tick (shape_planes.h); a push on a sphere along its
+// normal turns nothing; a box's face ends at its rim.
+
+#include "haptic_controller/impulse_accumulator.h"
+#include "haptic_controller/plane_interpolator.h"
+#include "haptic_controller/servo.h"
+#include "haptic_controller/shape_planes.h"
+#include "test_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+using namespace impetus;
+using impetus::test::make_plane;
+using impetus::test::make_set;
+using Eigen::Vector3d;
+
+namespace {
+
+// A ball of radius 1 cm at `centre`, its tangent plane at its top (where the world saw the finger).
+ContactPlane ball_plane(const Vector3d& centre, int id = 4) {
+  ContactPlane plane = make_plane(centre + Vector3d(0, 0, 0.01), {0, 0, 1}, id, true);
+  plane.flags |= kPlaneSphere;
+  plane.extent_m = 0.01;
+  plane.com_m = centre;
+  return plane;
+}
+
+}  // namespace
+
+TEST_CASE("sphere planes: the tangent plane at the point nearest the proxy, same centre and radius") {
+  const Vector3d centre(0.1, 0.0, 0.01);
+  PlaneSet planes = make_set({ball_plane(centre), make_plane({0, 0, 0}, {0, 0, 1}, 9, false)});
+  const Vector3d proxy = centre + Vector3d(0.02, 0.0, 0.0);  // beside the ball, at its equator
+  retake_shape_planes(planes, proxy);
+  REQUIRE((planes.planes[0].normal - Vector3d::UnitX()).norm() < 1e-15);
+  REQUIRE((planes.planes[0].point_m - (centre + Vector3d(0.01, 0, 0))).norm() < 1e-15);
+  REQUIRE((planes.planes[0].point_m - planes.planes[0].extent_m * planes.planes[0].normal - centre).norm() < 1e-15);
+  // Not a sphere: untouched.
+  REQUIRE(planes.planes[1].normal == Vector3d::UnitZ());
+  REQUIRE(planes.planes[1].point_m == Vector3d::Zero());
+  // The proxy at the centre: no direction, the plane stays.
+  const ContactPlane before = planes.planes[0];
+  retake_shape_planes(planes, centre);
+  REQUIRE(planes.planes[0].normal == before.normal);
+}
+
+TEST_CASE("sphere planes: a push along the normal turns nothing, wherever the proxy sits on the tangent plane") {
+  const Vector3d centre(0.0, 0.0, 0.01);
+  const ContactPlane plane = ball_plane(centre);
+  // The proxy held 6 mm off the tangent point (an edge with another plane), pushed straight down: through the centre.
+  const Vector3d proxy = plane.point_m + Vector3d(0.006, 0.0, 0.0);
+  REQUIRE(plane.angular_impulse_Nms(proxy, Vector3d(0, 0, -0.002)).norm() < 1e-18);
+  // Friction along the surface does turn it: 1 mN·s at 1 cm above the centre.
+  const Vector3d turned = plane.angular_impulse_Nms(plane.point_m, Vector3d(0.001, 0, 0));
+  REQUIRE((turned - Vector3d(0, 1e-5, 0)).norm() < 1e-15);
+  // A flat face keeps the lever of the proxy.
+  ContactPlane face = plane;
+  face.flags &= ~kPlaneSphere;
+  REQUIRE(face.angular_impulse_Nms(proxy, Vector3d(0, 0, -0.002)).norm() > 1e-6);
+}
+
+namespace {
+
+// A static 10 cm box centred at `centre`, turned by `turn`, and the plane of its top face (body +z) as the world
+// sends it: at the point of the face under `query`.
+Plane box_top_plane(const Vector3d& centre, const Eigen::Quaterniond& turn, const Vector3d& query) {
+  const Eigen::Matrix3d axes = turn.toRotationMatrix();
+  const Vector3d half(0.05, 0.05, 0.05);
+  Vector3d local = axes.transpose() * (query - centre);
+  local.z() = half.z();
+  Plane plane = test::wire_plane(3, centre + axes * local, axes.col(2), false);
+  plane.flags |= kPlaneFlat | kPlaneBox;
+  plane.com_m = to_vec3(centre);
+  plane.box_axis_x = to_vec3(axes.col(0));
+  plane.box_axis_y = to_vec3(axes.col(1));
+  plane.box_half_m = to_vec3(half);
+  return plane;
+}
+
+}  // namespace
+
+TEST_CASE("box planes: a face's plane stays over the face; past its rim the box's nearest edge, corner or face") {
+  const Vector3d centre(0.01, -0.02, 0.05);
+  for (const Eigen::Quaterniond& turn :
+       {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()))}) {
+    const Eigen::Matrix3d axes = turn.toRotationMatrix();
+    const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
+    const ContactPlane top = to_contact_plane(box_top_plane(centre, turn, at(0.0, 0.0, 0.06)));
+    REQUIRE(top.box());
+    const auto retaken = [&](const Vector3d& proxy) {
+      PlaneSet planes = make_set({top});
+      retake_shape_planes(planes, proxy);
+      return planes.planes[0];
+    };
+    // Over the face, on the rim (to rounding), and inside the box: the plane as it came.
+    for (const Vector3d& proxy : {at(0.03, -0.04, 0.05), at(0.05 + 1e-12, 0.0, 0.05), at(0.0, 0.01, 0.02)}) {
+      const ContactPlane same = retaken(proxy);
+      CHECK(same.normal == top.normal);
+      CHECK(same.point_m == top.point_m);
+    }
+    // Past the +x rim, above the top: the edge, its normal from the edge to the proxy.
+    const ContactPlane edge = retaken(at(0.053, 0.01, 0.054));
+    CHECK((edge.point_m - at(0.05, 0.01, 0.05)).norm() < 1e-15);
+    CHECK((edge.normal - axes * Vector3d(0.6, 0, 0.8)).norm() < 1e-12);  // (3, 0, 4) mm from the edge
+    // Round the edge, beside the +x face below the top: that face.
+    const ContactPlane side = retaken(at(0.052, 0.01, 0.03));
+    CHECK((side.normal - axes.col(0)).norm() < 1e-12);
+    CHECK((side.point_m - at(0.05, 0.01, 0.03)).norm() < 1e-15);
+    // Past a corner: the corner.
+    const ContactPlane corner = retaken(at(0.06, -0.06, 0.06));
+    CHECK((corner.point_m - at(0.05, -0.05, 0.05)).norm() < 1e-15);
+    CHECK((corner.normal - axes * Vector3d(1, -1, 1).normalized()).norm() < 1e-12);
+    // Friction, the object and its state are the plane's own.
+    CHECK(edge.object_id == top.object_id);
+    CHECK(edge.static_friction == top.static_friction);
+  }
+}
+
+TEST_CASE("box planes: between world frames a finger that slides off an edge is let go at once, and round the "
+          "edge it meets the side face") {
+  // One world frame (the top face of a static box, 20 Hz) and a finger that, within that period, slides along the
+  // top 3 mm deep, passes the +x edge, goes down beside the box and presses 3 mm into the +x face. The world's next
+  // frame would fix the planes 50 ms later; the servo must not wait for it.
+  const Vector3d centre(0.0, 0.0, 0.0);
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.3, Vector3d::UnitZ()));
+  const Eigen::Matrix3d axes = turn.toRotationMatrix();
+  const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
+  ServoOptions options;
+  HapticServo servo(options, 5);
+  servo.on_plane_frame(test::make_frame({box_top_plane(centre, turn, at(0.0, 0.0, 0.06))}), 0.0);
+  // Waypoints (box frame, m) and the ticks between them; 1 kHz ticks, all within 46 ms.
+  const std::array<std::pair<Vector3d, int>, 6> path{{{{0.0, 0.0, 0.06}, 0},      // above the top
+                                                      {{0.0, 0.0, 0.047}, 6},     // 3 mm into it
+                                                      {{0.054, 0.0, 0.047}, 20},  // along it, past the edge
+                                                      {{0.054, 0.0, 0.02}, 10},   // down beside the box
+                                                      {{0.047, 0.0, 0.02}, 6},    // 3 mm into the +x face
+                                                      {{0.047, 0.0, 0.02}, 3}}};  // held there
+  int tick = 0;
+  std::vector<Vector3d> fingers, proxies, forces;
+  for (std::size_t leg = 1; leg < path.size(); ++leg) {
+    for (int k = 1; k <= path[leg].second; ++k) {
+      const double s = static_cast<double>(k) / path[leg].second;
+      FingerSample finger;
+      finger.position_m = at(0, 0, 0) + axes * ((1.0 - s) * path[leg - 1].first + s * path[leg].first);
+      finger.valid = true;
+      ++tick;
+      const TickResult& r = servo.tick(&finger, tick * 1e-3, 1e-3);
+      fingers.push_back(axes.transpose() * (finger.position_m - centre));
+      proxies.push_back(axes.transpose() * (to_eigen(r.proxy_m) - centre));
+      forces.push_back(axes.transpose() * to_eigen(r.force_N));
+    }
+  }
+  REQUIRE(tick < 50);  // all within the world period: no second frame was needed
+  int first_beyond = -1, last_force = -1;
+  for (std::size_t j = 0; j < fingers.size(); ++j) {
+    // The proxy never enters the box (beyond rounding).
+    CHECK((proxies[j].cwiseAbs() - Vector3d::Constant(0.05)).maxCoeff() > -1e-9);
+    if (first_beyond < 0 && fingers[j].x() > 0.05) first_beyond = static_cast<int>(j);
+    if (first_beyond < 0 || fingers[j].z() > 0.03) {
+      if (forces[j].norm() > 1e-9) last_force = static_cast<int>(j);
+    }
+  }
+  REQUIRE(first_beyond > 0);
+  // Let go within two ticks of the finger passing the edge (the face's plane used to last the whole period).
+  CHECK(last_force - first_beyond <= 1);
+  // Held 3 mm into the side face: pushed out along +x by K·3 mm (the scene's default K, 2000 N/m; at rest the damper
+  // adds nothing), nothing along z (no ghost of the top face).
+  const Vector3d final_force = forces.back();
+  CHECK(final_force.x() == Approx(2000.0 * 0.003).epsilon(1e-6));
+  CHECK(std::abs(final_force.z()) < 1e-9);
+  CHECK(proxies.back().x() == Approx(0.05).margin(1e-12));
+}
