@@ -126,6 +126,8 @@ void HapticNode::run_lockstep() {
     }
     if (t % kStatsEveryTicks == 0) publish_stats(nullptr);
   }
+  // A world that died after its last step (between two steps, as the session ended) left the trial unfinished too.
+  if (!world_lost && !world_.world_alive()) world_lost = true;
   world_.end_session();
   device_.end_session();
   // A lockstep trial is one deterministic run: a world or device that left mid-way makes it incomplete, whatever came

@@ -64,6 +64,9 @@ class WorldLinkClient {
   virtual bool step_world(std::uint64_t tick) = 0;
   // Lockstep master: ends the session; a waiting world returns from wait_turn() with `shutdown`.
   virtual void end_session() = 0;
+  // Whether the world is still there (its process alive); a transport that cannot tell says true. A lockstep world
+  // that died after its last step, before the session ended, is noticed here.
+  virtual bool world_alive() const { return true; }
 
   // Not real time: if the world died and a new one took its place, follow it. True if it switched.
   virtual bool reattach() = 0;

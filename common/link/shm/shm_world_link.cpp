@@ -100,6 +100,8 @@ bool ShmWorldLinkClient::step_world(std::uint64_t tick) {
 
 void ShmWorldLinkClient::end_session() { world().world_turn.request_shutdown(); }
 
+bool ShmWorldLinkClient::world_alive() const { return worlds_.back()->creator_alive(); }
+
 bool ShmWorldLinkClient::reattach() {
   if (worlds_.back()->creator_alive()) return false;
   try {

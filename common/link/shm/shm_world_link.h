@@ -49,6 +49,7 @@ class ShmWorldLinkClient final : public WorldLinkClient {
   void publish_stats(const LoopStats& stats) override;
   bool step_world(std::uint64_t tick) override;
   void end_session() override;
+  bool world_alive() const override;
   bool reattach() override;
   std::uint64_t rejected_frames() const override { return rejected_; }
   std::uint64_t attaches() const override { return attaches_.load(); }
