@@ -39,7 +39,11 @@ def _impetus_module():
         package = build_dir() / "python"
         if choice == "module" and (package / "impetus").is_dir():
             sys.path.insert(0, str(package))
-            _module = importlib.import_module("impetus")
+            try:
+                _module = importlib.import_module("impetus")
+            except ImportError as error:
+                raise RuntimeError(f"cannot import the impetus package built in {package}: {error}; rebuild it "
+                                   f"(scripts/build.sh) or run the trials as processes (IMPETUS_TRIALS=processes)")
     return _module or None
 
 
