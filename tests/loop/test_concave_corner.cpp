@@ -6,6 +6,7 @@
 
 #include "tests/integration/trial_support.h"
 #include "loop/in_process_trial.h"
+#include "tests/support/turns.h"
 
 #include <catch2/catch.hpp>
 
@@ -14,7 +15,6 @@
 #include <array>
 #include <cmath>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -98,25 +98,8 @@ Log read_log(const std::filesystem::path& path) {
 // though on the surface of each box alone).
 double depth_in_walls_m(const Vector3d& p) { return p.cwiseMin(0.0).norm(); }
 
-std::vector<Eigen::Quaterniond> turns() {
-  std::vector<Eigen::Quaterniond> out;
-  const std::array<Vector3d, 6> axes{Vector3d::UnitX(), -Vector3d::UnitX(), Vector3d::UnitY(),
-                                     -Vector3d::UnitY(), Vector3d::UnitZ(), -Vector3d::UnitZ()};
-  for (const Vector3d& x : axes) {
-    for (const Vector3d& y : axes) {
-      if (std::abs(x.dot(y)) > 0.5) continue;
-      Eigen::Matrix3d m;
-      m << x, y, x.cross(y);
-      out.emplace_back(m);
-    }
-  }
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  for (int k = 0; k < 6; ++k) {
-    out.push_back(Eigen::Quaterniond(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
-  }
-  return out;
-}
+// The 24 axis turns and 6 random ones (tests/support/turns.h).
+std::vector<Eigen::Quaterniond> turns() { return test::axis_and_random_turns(6, 7); }
 
 }  // namespace
 

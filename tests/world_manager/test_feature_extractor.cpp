@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/features/feature_extractor.h"
 #include "world_test_support.h"
+#include "tests/support/turns.h"
 
 #include <catch2/catch.hpp>
 
@@ -319,27 +320,8 @@ Corner make_corner(const Eigen::Quaterniond& rotation) {
   return corner;
 }
 
-// The 24 turns that map the axes onto the axes (a box's symmetries; each puts a different axis lowest), then random
-// turns, where the corner's coordinates are exact only to rounding.
-std::vector<Eigen::Quaterniond> corner_orientations() {
-  std::vector<Eigen::Quaterniond> turns;
-  const std::array<Vector3d, 6> axes{Vector3d::UnitX(), -Vector3d::UnitX(), Vector3d::UnitY(),
-                                     -Vector3d::UnitY(), Vector3d::UnitZ(), -Vector3d::UnitZ()};
-  for (const Vector3d& x : axes) {
-    for (const Vector3d& y : axes) {
-      if (std::abs(x.dot(y)) > 0.5) continue;
-      Eigen::Matrix3d m;
-      m << x, y, x.cross(y);
-      turns.emplace_back(m);
-    }
-  }
-  std::mt19937 rng(15);
-  for (int k = 0; k < 40; ++k) {
-    std::uniform_real_distribution<double> unit(-1.0, 1.0);
-    turns.push_back(Eigen::Quaterniond(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
-  }
-  return turns;
-}
+// Every orientation of the corner: the 24 axis turns and 40 random ones (tests/support/turns.h).
+std::vector<Eigen::Quaterniond> corner_orientations() { return impetus::test::axis_and_random_turns(40, 15); }
 
 // How many boxes give a plane other than their open face at `query` (body-frame point of the corner, turned).
 int wrong_faces(const Corner& corner, const Eigen::Quaterniond& rotation, const Vector3d& query, bool tie_rule) {
