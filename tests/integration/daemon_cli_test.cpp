@@ -402,7 +402,14 @@ TEST_CASE("lockstep: odd sequence words scribbled into the running link are repa
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  const bool still_moving = layout.report.sequence() % 2 == 0 && layout.report.sequence() != before;
+  // Still moving: the report's sequence word is at rest (even) again, at a value it did not have before. One sample
+  // may land inside a write (odd; a report is written every tick), so it is sampled for up to 100 ms.
+  bool still_moving = false;
+  for (int i = 0; i < 100 && !still_moving; ++i) {
+    const std::uint64_t now = layout.report.sequence();
+    still_moving = now % 2 == 0 && now != before;
+    if (!still_moving) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
   for (pid_t pid : {trial.world, trial.haptic, trial.device}) kill(pid, SIGINT);
   CHECK(test::wait_for(trial.haptic, 10) == 0);
   CHECK(test::wait_for(trial.world, 10) == 0);
