@@ -90,6 +90,7 @@ void HapticServo::idle_tick(bool fault) {
   god_object_.reset();
   renderer_.reset();
   result_.force_N = {};
+  accumulator_.report().force_N = {};
   result_.render = false;
   result_.fault = fault;
   result_.sticking = false;
@@ -181,6 +182,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   if (rendered.fault) ++counters_.faults;
   if (rendered.clamped && contact.contact.active_count > 0) ++counters_.force_clamps;
   result_.force_N = to_vec3(force_N);
+  report.force_N = result_.force_N;
 
   // 5. The reaction −f_j·Δt, shared among the touched objects (§3.4).
   accumulator_.add(planes_, contact.contact, force_N, dt_s > 0.0 && std::isfinite(dt_s) ? dt_s : 0.0,

@@ -2,12 +2,12 @@
 # SPDX-License-Identifier: Apache-2.0
 # Installs what is missing and builds Impetus.
 #   scripts/build.sh [--daemons] [BUILD_DIR [extra cmake -D options...]]     default BUILD_DIR: build (Release)
-#   --daemons   build only world_manager, haptic_controller and spidar_sim (what the demo needs), not the tests
+#   --daemons   build only world_manager, haptic_controller, spidar_sim and viewer (what the demo needs), not the tests
 set -euo pipefail
 cd "$(dirname "$0")/.."
 targets=()
 if [ "${1:-}" = "--daemons" ]; then
-  targets=(--target world_manager haptic_controller spidar_sim)
+  targets=(--target world_manager haptic_controller spidar_sim viewer)
   shift
 fi
 build_dir="${1:-build}"

@@ -6,16 +6,21 @@
 #   scripts/run.sh --scene FILE --trajectory SPEC [--coupling impulse|position|local] [--rate HZ] [--phase TICKS]
 #                  [--substeps N]
 #                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet]
+#                  [--view [--view-listen HOST:PORT] [--view-wait S]]
 #                  [-- extra haptic_controller flags, e.g. --stiffness 5000]
+# --view starts a viewer beside the trial (default address 127.0.0.1:8080) and prints where to watch it; with
+# --view-wait S the finger starts S seconds after the world, time to open the page. Afterwards
+# `build/viewer/viewer --replay DIR` plays the trial back.
 #
 # Binaries come from $IMPETUS_BUILD_DIR (default build/); build them with scripts/build.sh.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${IMPETUS_BUILD_DIR:-$root/build}"
 
-usage() { sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "run.sh: $*" >&2; exit 2; }
 
+view=0 view_listen="127.0.0.1:8080" view_wait=0
 substeps="" scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
 haptic_extra=()
 while (($#)); do
@@ -30,6 +35,9 @@ while (($#)); do
     --duration) duration="${2:?}"; shift 2 ;;
     --out) out="${2:?}"; shift 2 ;;
     --quiet) quiet=1; shift ;;
+    --view) view=1; shift ;;
+    --view-listen) view_listen="${2:?}"; shift 2 ;;
+    --view-wait) view_wait="${2:?}"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     --) shift; haptic_extra=("$@"); break ;;
     *) die "unknown argument '$1' (see --help)" ;;
@@ -39,7 +47,10 @@ done
 [ -f "$scene" ] || die "--scene: no such file '$scene'"
 [ -n "$trajectory" ] || die "--trajectory is required"
 case "$clock" in realtime|lockstep) ;; *) die "--clock must be realtime or lockstep, not '$clock'" ;; esac
-for bin in world_manager haptic_controller spidar_sim; do
+[[ "$view_wait" =~ ^[0-9]+([.][0-9]+)?$ ]] || die "--view-wait must be a number of seconds, not '$view_wait'"
+bins=(world_manager haptic_controller spidar_sim)
+((view)) && bins+=(viewer)
+for bin in "${bins[@]}"; do
   [ -x "$build/$bin/$bin" ] || die "$build/$bin/$bin is missing: run scripts/build.sh first"
 done
 [ -n "$out" ] || out="$root/out/run-$(date +%Y%m%d-%H%M%S)-$$"
@@ -57,20 +68,38 @@ device_args=(--clock "$clock" --trajectory "$trajectory" --shm "$shm" --log "$ou
              --summary "$out/device.json")
 
 pids=()
+viewer_pid=""
 stop_all() {
-  for pid in "${pids[@]}"; do kill -TERM "$pid" 2>/dev/null || true; done
+  for pid in "${pids[@]}" $viewer_pid; do kill -TERM "$pid" 2>/dev/null || true; done
 }
 on_interrupt() {
   echo "run.sh: interrupted, stopping the trial" >&2
   stop_all
   wait || true
-  rm -f "/dev/shm/$shm.world" "/dev/shm/$shm.device"
+  rm -f "/dev/shm/$shm.world" "/dev/shm/$shm.device" "/dev/shm/$shm.view"
   exit 130
 }
 trap on_interrupt INT TERM
 
 start=$(date +%s.%N)
 "$build/world_manager/world_manager" "${world_args[@]}" 2>"$out/world.err" & world=$!; pids+=("$world")
+if ((view)); then
+  # The viewer is a bystander: if it cannot start (the port is taken), the trial runs without it.
+  "$build/viewer/viewer" --shm "$shm" --listen "$view_listen" >"$out/viewer.out" 2>"$out/viewer.err" & viewer_pid=$!
+  for _ in $(seq 100); do
+    grep -q serving "$out/viewer.out" 2>/dev/null && break
+    kill -0 "$viewer_pid" 2>/dev/null || break
+    sleep 0.05
+  done
+  if grep -q serving "$out/viewer.out" 2>/dev/null; then
+    echo "run.sh: watch it live: open $(sed -n 's/.*serving \(http[^ ]*\).*/\1/p' "$out/viewer.out") in a browser" >&2
+  else
+    echo "run.sh: the viewer did not start (the trial runs without it):" >&2
+    cat "$out/viewer.err" >&2
+    viewer_pid=""
+  fi
+  sleep "$view_wait"
+fi
 "$build/haptic_controller/haptic_controller" "${haptic_args[@]}" 2>"$out/haptic.err" & haptic=$!; pids+=("$haptic")
 "$build/spidar_sim/spidar_sim" "${device_args[@]}" 2>"$out/device.err" & device=$!; pids+=("$device")
 
@@ -82,6 +111,11 @@ kill -TERM "$haptic" 2>/dev/null || true
 wait "$haptic" || haptic_status=$?
 kill -TERM "$world" 2>/dev/null || true
 wait "$world" || world_status=$?
+if [ -n "$viewer_pid" ]; then
+  kill -TERM "$viewer_pid" 2>/dev/null || true
+  wait "$viewer_pid" || echo "run.sh: the viewer exited with an error: $(tail -1 "$out/viewer.err")" >&2
+  echo "run.sh: play it back: $build/viewer/viewer --replay $out" >&2
+fi
 # Failures upstream first: a bad scene stops the world, and the others' errors (no world link, no device port) follow
 # from it.
 status=0
@@ -96,7 +130,7 @@ for name in world haptic device; do
 done
 end=$(date +%s.%N)
 trap - INT TERM
-for segment in "/dev/shm/$shm.world" "/dev/shm/$shm.device"; do
+for segment in "/dev/shm/$shm.world" "/dev/shm/$shm.device" "/dev/shm/$shm.view"; do
   [ -e "$segment" ] && { echo "run.sh: $segment was left behind; removing it" >&2; rm -f "$segment"; status=1; }
 done
 ((status == 0)) || exit "$status"

@@ -27,6 +27,7 @@ esac
 build_dir=build${sanitize:+-$sanitize}
 build_type=Release
 [ -n "$sanitize" ] && build_type=RelWithDebInfo
+bash scripts/deps.sh --browser
 bash scripts/build.sh "$build_dir" -DCMAKE_BUILD_TYPE="$build_type" -DIMPETUS_SANITIZE="$sanitize"
 cd "$build_dir"
 ctest --output-on-failure --timeout 600 -j"$(nproc)" "${ctest_args[@]}"

@@ -3,6 +3,7 @@
 // and runs a WorldNode on it; writes the world half of summary.json at exit.
 
 #include "common/link/shm/shm_world_link.h"
+#include "common/link/shm/shm_world_view.h"
 #include "common/runtime/cli.h"
 #include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world_node.h"
@@ -45,6 +46,8 @@ int main(int argc, char** argv) {
     WorldNode node(options);
     ShmWorldLinkServer link(shm, node.link_info());
     node.connect(link);
+    ShmWorldViewPublisher view(shm);  // "<shm>.view": viewers attach to it read-only
+    node.connect_view(view);
     const WorldLinkInfo info = node.link_info();
     std::fprintf(stderr, "world_manager: '%s', %zu objects, %.1f Hz, %s coupling, %s clock, link '%s'\n",
                  options.scene_path.c_str(), node.world().scene().objects.size(), info.world_rate_hz,

@@ -7,6 +7,7 @@
 #include "common/runtime/staleness.h"
 #include "common/spidar/geometry.h"
 #include "world_manager/impulse_limits.h"
+#include "world_manager/world_view.h"
 
 #include <cmath>
 #include <cstdio>
@@ -85,6 +86,15 @@ std::string WorldNode::warnings() const {
   return text;
 }
 
+void WorldNode::connect_view(WorldViewPublisher& view) {
+  view_ = &view;
+  auto scene = std::make_unique<ViewScene>();
+  describe_scene(world_.scene(), world_.coupling(), 1.0 / world_.world_period_s(), world_.frame().world_session,
+                 *scene);
+  view_->publish_scene(*scene);
+  snapshot_ = std::make_unique<WorldSnapshot>();
+}
+
 void WorldNode::step_world() {
   const std::int64_t now_ns = monotonic_now_ns();
   HapticReport incoming;
@@ -108,6 +118,13 @@ void WorldNode::step_world() {
   const PlaneFrame& frame = world_.step(have_report_ ? &report_ : nullptr);
   step_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
   link_->publish_frame(frame);
+  if (view_ != nullptr) {
+    LoopStats haptic_stats;
+    const bool have_haptic_stats = link_->latest_haptic_stats(haptic_stats);
+    take_snapshot(world_, have_report_ ? &report_ : nullptr, stats_, have_haptic_stats ? &haptic_stats : nullptr,
+                  *snapshot_);
+    view_->publish_snapshot(*snapshot_);
+  }
   // Rare and never on the haptic path: the world loop can afford a line on stderr when it happens.
   for (; escapes_reported_ < world_.escaped().size(); ++escapes_reported_) {
     const std::size_t id = world_.escaped()[escapes_reported_];

@@ -8,6 +8,7 @@
 
 #include "common/runtime/write_watch.h"
 #include "common/link/inproc/inproc_world_link.h"
+#include "common/contract/world_view.h"
 #include "common/link/world_link.h"
 #include "common/runtime/loop_stats.h"
 #include "world_manager/scene.h"
@@ -18,6 +19,7 @@
 
 #include <cstdint>
 #include <fstream>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -46,6 +48,8 @@ class WorldNode final : public WorldStepper {
   WorldLinkInfo link_info() const;
   // The link to serve; must be set before run() or the first step, and outlive the node.
   void connect(WorldLinkServer& link) { link_ = &link; }
+  // Viewers (optional): publishes the scene now and a snapshot after every step. Must outlive the node.
+  void connect_view(WorldViewPublisher& view);
 
   // Runs until the duration, a stop request, or (lockstep) the end of the session. Returns the exit status.
   int run();
@@ -66,6 +70,8 @@ class WorldNode final : public WorldStepper {
   Scene scene_;
   World world_;
   WorldLinkServer* link_ = nullptr;
+  WorldViewPublisher* view_ = nullptr;
+  std::unique_ptr<WorldSnapshot> snapshot_;  // ~120 KB at full capacity: allocated once, in connect_view
   std::optional<std::ofstream> log_file_;
   std::optional<WriteWatch> log_watch_;  // reports a failed log write when it happens
   std::optional<WorldLog> log_;

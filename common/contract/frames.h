@@ -151,6 +151,7 @@ struct HapticReport {
   // D_j, the god-object proxy: always outside every plane, so the world extracts the next planes around it rather
   // than around a finger that may have pushed deep into (or through) a thin object.
   Vec3 proxy_m{};
+  Vec3 force_N{};                   // f_j, the force on the finger at this tick (for viewers; the world never uses it)
   std::uint32_t finger_valid = 0;   // 0 while no device is attached: position coupling must not use finger_m
   std::uint32_t entry_count = 0;
   Vec3 static_impulse_Ns{};         // share of the reaction that went into static geometry (floor, fixed objects)

@@ -35,6 +35,8 @@ class WorldLinkServer {
   virtual bool latest_report(HapticReport& out) = 0;
   virtual void publish_frame(const PlaneFrame& frame) = 0;
   virtual void publish_stats(const LoopStats& stats) = 0;
+  // The attached haptic side's latest loop statistics (for viewers); false if none or the transport has none.
+  virtual bool latest_haptic_stats(LoopStats& /*out*/) { return false; }
 
   // Lockstep follower: waits for the master's go for the next world step. ok: step now, then finish_turn();
   // anything else ends the run (shutdown: the session ended; peer_gone: the master died or a stop was requested).

@@ -220,3 +220,48 @@ TEST_CASE("an owner never removes a name that no longer names its own segment") 
 }
 
 }  // namespace impetus
+
+namespace impetus {
+
+TEST_CASE("a read-only segment reads what the creator writes and is mapped without write permission") {
+  const std::string name = test::unique_segment_name("readonly");
+  auto segment = Segment<SmallLayout>::create(name);
+  segment->value.store(42);
+  const auto reader = ReadOnlySegment<SmallLayout>::open(name);
+  CHECK(reader->value.load() == 42);
+  segment->value.store(43);
+  CHECK(reader->value.load() == 43);
+  CHECK(reader.creator_alive());
+  // The kernel's view of the mapping: /proc/self/maps lists it "r--s" (read, shared, no write).
+  std::ifstream maps("/proc/self/maps");
+  std::string line;
+  int read_only_mappings = 0;
+  int writable_mappings = 0;
+  while (std::getline(maps, line)) {
+    if (line.find("/dev/shm/" + name) == std::string::npos) continue;
+    const std::string permissions = line.substr(line.find(' ') + 1, 4);
+    if (permissions == "r--s") ++read_only_mappings;
+    if (permissions == "rw-s") ++writable_mappings;
+  }
+  CHECK(read_only_mappings == 1);
+  CHECK(writable_mappings == 1);  // the creator's own
+}
+
+TEST_CASE("a read-only open refuses what a read-write open refuses: a missing segment, another kind") {
+  const std::string name = test::unique_segment_name("readonly_bad");
+  try {
+    ReadOnlySegment<SmallLayout>::open(name);
+    FAIL("opened a missing segment");
+  } catch (const SegmentError& error) {
+    CHECK(error.problem() == SegmentProblem::missing);
+  }
+  auto segment = Segment<SmallLayout>::create(name);
+  try {
+    ReadOnlySegment<OtherKindLayout>::open(name);
+    FAIL("opened a segment of another kind");
+  } catch (const SegmentError& error) {
+    CHECK(error.problem() == SegmentProblem::incompatible);
+  }
+}
+
+}  // namespace impetus

@@ -6,6 +6,8 @@
 #include <catch2/catch.hpp>
 
 #include <array>
+#include <cstddef>
+#include <memory>
 #include <atomic>
 #include <cstdint>
 
@@ -116,6 +118,36 @@ TEST_CASE("seqlock: an odd sequence word at rest (a stray write, a writer killed
   CHECK(channel.write(frame));  // settled again
   REQUIRE(channel.try_read(copy, last));
   CHECK(copy.counter == 3);
+}
+
+}  // namespace impetus
+
+namespace impetus {
+
+TEST_CASE("seqlock: a write of a prefix stores and returns only that prefix, and says how much was copied") {
+  auto channel = std::make_unique<SeqlockChannel<TestFrame>>();
+  channel->reset();
+  TestFrame frame{};
+  frame.counter = 7;
+  for (std::size_t i = 0; i < frame.body.size(); ++i) frame.body[i] = i + 1;
+  channel->write(frame, offsetof(TestFrame, body) + 3 * sizeof(std::uint64_t));  // counter and 3 body words
+
+  TestFrame out{};
+  out.body.fill(99);
+  std::uint64_t last = 0;
+  std::size_t copied = 0;
+  REQUIRE(channel->try_read(out, last, 4, &copied));
+  CHECK(copied == 4 * sizeof(std::uint64_t));
+  CHECK(out.counter == 7);
+  CHECK(out.body[0] == 1);
+  CHECK(out.body[2] == 3);
+  CHECK(out.body[3] == 99);  // beyond the prefix: left as it was
+
+  channel->write(frame);  // the whole frame again
+  REQUIRE(channel->try_read(out, last, 4, &copied));
+  CHECK(copied == sizeof(TestFrame));
+  CHECK(out.body[3] == 4);
+  CHECK(out.body.back() == frame.body.size());
 }
 
 }  // namespace impetus

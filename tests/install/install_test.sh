@@ -13,7 +13,8 @@ prefix="$scratch/prefix"
 cmake --install "$build" --prefix "$prefix" > "$scratch/install.log"
 for file in bin/world_manager lib/cmake/Impetus/ImpetusConfig.cmake lib/cmake/Impetus/ImpetusConfigVersion.cmake \
             lib/pkgconfig/impetus.pc include/impetus/loop/in_process_trial.h share/impetus/scenes/tap.json \
-            share/impetus/desktop_spidar.json; do
+            share/impetus/desktop_spidar.json bin/viewer share/impetus/viewer/web/index.html \
+            share/impetus/viewer/web/node_modules/three/build/three.module.js; do
   [ -e "$prefix/$file" ] || { echo "install_test: $prefix/$file was not installed" >&2; exit 1; }
 done
 
@@ -44,6 +45,24 @@ print(trial)' "$1")
 }
 python_trial "$prefix"
 
+# The installed viewer finds its page and three.js in the prefix (no source tree, no network).
+viewer_serves() {
+  "$1/bin/viewer" --shm "impetus_install_test_$$" --listen 127.0.0.1:0 --duration 3 > "$scratch/viewer.out" 2>&1 &
+  local pid=$! url=""
+  for _ in $(seq 100); do
+    url=$(sed -n 's/.*serving \(http[^ ]*\).*/\1/p' "$scratch/viewer.out")
+    [ -n "$url" ] && break
+    sleep 0.05
+  done
+  [ -n "$url" ] || { cat "$scratch/viewer.out" >&2; echo "install_test: the installed viewer did not start" >&2; exit 1; }
+  for target in "" viewer.js three/build/three.module.js three/build/three.core.js \
+                three/examples/jsm/controls/OrbitControls.js; do
+    curl -sf -o /dev/null "$url$target" || { echo "install_test: the installed viewer does not serve /$target" >&2; exit 1; }
+  done
+  wait "$pid"
+}
+viewer_serves "$prefix"
+
 PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs impetus | grep -q -- "-limpetus_loop"
 
 (cd "$build" && cpack -G DEB -B "$scratch/deb" > "$scratch/cpack.log")
@@ -51,4 +70,5 @@ deb=$(ls "$scratch"/deb/impetus_*.deb)
 dpkg -x "$deb" "$scratch/root"
 "$scratch/root/usr/bin/world_manager" --help | grep -q -- "--scene"
 python_trial "$scratch/root/usr"
+viewer_serves "$scratch/root/usr"
 echo "install_test: installed, example built and ran, package $(basename "$deb") $(du -k "$deb" | cut -f1) KiB"

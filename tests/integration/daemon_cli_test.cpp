@@ -29,7 +29,8 @@ Result run(const std::string& command_line, const std::string& name) {
 }
 
 bool segments_left(const std::string& shm) {
-  return std::filesystem::exists("/dev/shm/" + shm + ".world") || std::filesystem::exists("/dev/shm/" + shm + ".device");
+  return std::filesystem::exists("/dev/shm/" + shm + ".world") || std::filesystem::exists("/dev/shm/" + shm + ".device") ||
+         std::filesystem::exists("/dev/shm/" + shm + ".view");
 }
 
 }  // namespace
@@ -238,6 +239,7 @@ TEST_CASE("lockstep: a device killed mid-session is reported by the haptic contr
   CHECK(test::wait_for(world, 10) != -1);
   CHECK_FALSE(std::filesystem::exists("/dev/shm/" + shm + ".world"));
   CHECK_FALSE(std::filesystem::exists("/dev/shm/" + shm + ".device"));
+  CHECK_FALSE(std::filesystem::exists("/dev/shm/" + shm + ".view"));
 }
 
 }  // namespace impetus
@@ -266,7 +268,7 @@ struct LongLockstepTrial {
   std::string output(const char* who) const { return test::read_text(dir / (std::string(who) + ".out")); }
   bool segments_left() const {
     return std::filesystem::exists("/dev/shm/" + shm + ".world") ||
-           std::filesystem::exists("/dev/shm/" + shm + ".device");
+           std::filesystem::exists("/dev/shm/" + shm + ".device") || std::filesystem::exists("/dev/shm/" + shm + ".view");
   }
 };
 
@@ -340,7 +342,8 @@ TEST_CASE("lockstep: the haptic controller exits non-zero when the world dies mi
   const std::string haptic_out = trial.output("haptic");
   INFO(haptic_out);
   CHECK_THAT(haptic_out, Catch::Contains("the trial is incomplete") && Catch::Contains("world manager"));
-  std::filesystem::remove("/dev/shm/" + trial.shm + ".world");  // the killed world's own segment
+  std::filesystem::remove("/dev/shm/" + trial.shm + ".world");  // the killed world's own segments
+  std::filesystem::remove("/dev/shm/" + trial.shm + ".view");
   CHECK_FALSE(trial.segments_left());
 }
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// System names of the two segments for a `--shm NAME` (DESIGN.md §2: one segment per link).
+// System names of the segments for a `--shm NAME` (DESIGN.md §2: one segment per link).
 
 #include <string>
 
@@ -8,5 +8,6 @@ namespace impetus {
 
 inline std::string world_link_name(const std::string& shm) { return shm + ".world"; }
 inline std::string device_port_name(const std::string& shm) { return shm + ".device"; }
+inline std::string world_view_name(const std::string& shm) { return shm + ".view"; }
 
 }  // namespace impetus

@@ -40,6 +40,7 @@ const char* to_string(SegmentKind kind) {
   switch (kind) {
     case SegmentKind::world_link: return "world link";
     case SegmentKind::device_port: return "device port";
+    case SegmentKind::world_view: return "world view";
   }
   return "unknown segment kind";
 }
@@ -102,11 +103,11 @@ std::string foreign_reason(int fd) {
   return "";
 }
 
-// Opens an existing segment file read-write. A name that is a symbolic link (ELOOP) or that we may not open is
+// Opens an existing segment file (read-write, or read-only for a reader that must not write). A name that is a symbolic link (ELOOP) or that we may not open is
 // reported as incompatible; only a missing name is `missing`.
-OpenProblem open_existing(SegmentMapping::Impl& impl, const std::string& name) {
+OpenProblem open_existing(SegmentMapping::Impl& impl, const std::string& name, bip::mode_t mode = bip::read_write) {
   try {
-    impl.object = bip::shared_memory_object(bip::open_only, name.c_str(), bip::read_write);
+    impl.object = bip::shared_memory_object(bip::open_only, name.c_str(), mode);
   } catch (const bip::interprocess_exception& error) {
     if (error.get_error_code() == bip::not_found_error) {
       return {SegmentProblem::missing, "it does not exist (is its creator running?)"};
@@ -123,7 +124,7 @@ OpenProblem open_existing(SegmentMapping::Impl& impl, const std::string& name) {
 }
 
 // Why the header of an open segment does not match what this program expects, or "" if it does.
-OpenProblem check_header(SegmentMapping::Impl& impl, SegmentKind kind, std::size_t size_bytes) {
+OpenProblem check_header(SegmentMapping::Impl& impl, SegmentKind kind, std::size_t size_bytes, bip::mode_t mode) {
   bip::offset_t actual_size = 0;
   impl.object.get_size(actual_size);
   if (static_cast<std::size_t>(actual_size) < sizeof(SegmentHeader)) {
@@ -131,7 +132,7 @@ OpenProblem check_header(SegmentMapping::Impl& impl, SegmentKind kind, std::size
     return {SegmentProblem::under_construction,
             "it is " + std::to_string(actual_size) + " bytes, too small for a header (still being created?)"};
   }
-  impl.region = bip::mapped_region(impl.object, bip::read_write);
+  impl.region = bip::mapped_region(impl.object, mode);
   const auto& header = *static_cast<const SegmentHeader*>(impl.region.get_address());
   const std::uint64_t magic = header.magic.load(std::memory_order_acquire);
   if (magic == 0) return {SegmentProblem::under_construction, "it is still being created"};
@@ -199,16 +200,21 @@ OpenProblem stale_reason(SegmentMapping::Impl& impl) {
 
 }  // namespace
 
-SegmentMapping::SegmentMapping(const std::string& name, SegmentKind kind, std::size_t size_bytes, bool create)
+SegmentMapping::SegmentMapping(const std::string& name, SegmentKind kind, std::size_t size_bytes,
+                               SegmentAccess access)
     : impl_(std::make_unique<Impl>()), name_(name), owner_(false) {
+  const bool create = access == SegmentAccess::create;
+  const bip::mode_t mode = access == SegmentAccess::read_only ? bip::read_only : bip::read_write;
   const std::string what = std::string(to_string(kind)) + " segment '" + name + "'";
   const auto refuse = [&](const OpenProblem& problem, const char* verb) {
     throw SegmentError(problem.problem, std::string("cannot ") + verb + " " + what + ": " + problem.reason);
   };
   try {
     if (!create) {
-      if (OpenProblem problem = open_existing(*impl_, name); !problem.reason.empty()) refuse(problem, "open");
-      if (OpenProblem problem = check_header(*impl_, kind, size_bytes); !problem.reason.empty()) refuse(problem, "open");
+      if (OpenProblem problem = open_existing(*impl_, name, mode); !problem.reason.empty()) refuse(problem, "open");
+      if (OpenProblem problem = check_header(*impl_, kind, size_bytes, mode); !problem.reason.empty()) {
+        refuse(problem, "open");
+      }
       return;
     }
     bip::permissions permissions;

@@ -28,9 +28,9 @@
 namespace impetus {
 
 inline constexpr std::uint64_t kSegmentMagic = 0x31535554'45504D49ull;  // "IMPETUS1" in little-endian bytes
-inline constexpr std::uint32_t kLayoutVersion = 9;  // bump on any change to wire_frames.h or a *Layout struct
+inline constexpr std::uint32_t kLayoutVersion = 10;  // bump on any change to wire_frames.h or a *Layout struct
 
-enum class SegmentKind : std::uint32_t { world_link = 1, device_port = 2 };
+enum class SegmentKind : std::uint32_t { world_link = 1, device_port = 2, world_view = 3 };
 const char* to_string(SegmentKind kind);
 
 struct SegmentHeader {
@@ -74,10 +74,14 @@ bool creator_alive(const SegmentHeader& header);
 // Process start time of `pid` in clock ticks since boot, or 0 if the process does not exist.
 std::uint64_t process_start_ticks(int pid);
 
-// Untyped mapping; Segment<Layout> below is what code uses.
+// How a process maps a segment: its creator, a peer that writes its own channels, or a reader that cannot write a byte
+// of it (a viewer: the kernel refuses its stores, so nothing it does can disturb the link).
+enum class SegmentAccess { create, read_write, read_only };
+
+// Untyped mapping; Segment<Layout> and ReadOnlySegment<Layout> below are what code uses.
 class SegmentMapping {
  public:
-  SegmentMapping(const std::string& name, SegmentKind kind, std::size_t size_bytes, bool create);
+  SegmentMapping(const std::string& name, SegmentKind kind, std::size_t size_bytes, SegmentAccess access);
   ~SegmentMapping();
   SegmentMapping(const SegmentMapping&) = delete;
   SegmentMapping& operator=(const SegmentMapping&) = delete;
@@ -128,13 +132,37 @@ class Segment {
 
  private:
   Segment(const std::string& name, bool create)
-      : mapping_(std::make_unique<SegmentMapping>(name, Layout::kKind, sizeof(Layout), create)),
+      : mapping_(std::make_unique<SegmentMapping>(name, Layout::kKind, sizeof(Layout),
+                                                  create ? SegmentAccess::create : SegmentAccess::read_write)),
         layout_(static_cast<Layout*>(mapping_->address())) {
     if (create) new (layout_) Layout();
   }
 
   std::unique_ptr<SegmentMapping> mapping_;
   Layout* layout_;
+};
+
+// A segment mapped read-only (PROT_READ): its channels can be read (seqlock reads only load), nothing can be written.
+template <class Layout>
+class ReadOnlySegment {
+  static_assert(std::is_standard_layout_v<Layout>, "a segment layout must be standard-layout");
+
+ public:
+  // Throws SegmentError as Segment<Layout>::open does.
+  static ReadOnlySegment open(const std::string& name) { return ReadOnlySegment(name); }
+
+  const Layout& operator*() const { return *layout_; }
+  const Layout* operator->() const { return layout_; }
+  const std::string& name() const { return mapping_->name(); }
+  bool creator_alive() const { return impetus::creator_alive(layout_->header); }
+
+ private:
+  explicit ReadOnlySegment(const std::string& name)
+      : mapping_(std::make_unique<SegmentMapping>(name, Layout::kKind, sizeof(Layout), SegmentAccess::read_only)),
+        layout_(static_cast<const Layout*>(mapping_->address())) {}
+
+  std::unique_ptr<SegmentMapping> mapping_;
+  const Layout* layout_;
 };
 
 }  // namespace impetus

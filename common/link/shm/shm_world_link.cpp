@@ -35,6 +35,12 @@ void ShmWorldLinkServer::publish_stats(const LoopStats& stats) {
   if (!segment_->world_stats.write(stats)) ++repairs_;
 }
 
+bool ShmWorldLinkServer::latest_haptic_stats(LoopStats& out) {
+  segment_->haptic_stats.try_read(haptic_stats_, haptic_stats_sequence_);
+  out = haptic_stats_;
+  return haptic_stats_sequence_ != 0;
+}
+
 TurnResult ShmWorldLinkServer::wait_turn() {
   WorldLinkLayout& link = *segment_;
   // Before a haptic node attaches we wait as long as we are not stopped; once one attached, its death ends the run

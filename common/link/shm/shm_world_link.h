@@ -23,6 +23,7 @@ class ShmWorldLinkServer final : public WorldLinkServer {
   bool latest_report(HapticReport& out) override;
   void publish_frame(const PlaneFrame& frame) override;
   void publish_stats(const LoopStats& stats) override;
+  bool latest_haptic_stats(LoopStats& out) override;
   TurnResult wait_turn() override;
   void finish_turn() override;
   std::uint64_t rejected_reports() const override { return reports_.rejected(); }
@@ -35,6 +36,8 @@ class ShmWorldLinkServer final : public WorldLinkServer {
   wire::PlaneFrame frame_wire_{};
   LatestValid<wire::HapticReport, HapticReport> reports_;
   std::uint64_t repairs_ = 0;
+  std::uint64_t haptic_stats_sequence_ = 0;
+  LoopStats haptic_stats_{};
 };
 
 class ShmWorldLinkClient final : public WorldLinkClient {

@@ -103,6 +103,7 @@ void visit_report_header(A& a, B& b, F&& f) {
   f(a.finger_m, b.finger_m);
   f(a.finger_velocity_mps, b.finger_velocity_mps);
   f(a.proxy_m, b.proxy_m);
+  f(a.force_N, b.force_N);
   f(a.finger_valid, b.finger_valid);
   f(a.entry_count, b.entry_count);
   f(a.static_impulse_Ns, b.static_impulse_Ns);
@@ -209,7 +210,7 @@ FrameError validate(const wire::HapticReport& report) {
   if (report.checksum != frame_checksum(report)) return FrameError::checksum;
   if (report.entry_count > kMaxImpulseEntries) return FrameError::count_out_of_range;
   if (!finite(report.haptic_time_s) || !all_finite(report.finger_m) || !all_finite(report.finger_velocity_mps) ||
-      !all_finite(report.proxy_m) ||
+      !all_finite(report.proxy_m) || !all_finite(report.force_N) ||
       !all_finite(report.static_impulse_Ns)) {
     return FrameError::not_finite;
   }

@@ -88,6 +88,7 @@ struct HapticReport {
   Vec3 finger_m{};
   Vec3 finger_velocity_mps{};
   Vec3 proxy_m{};
+  Vec3 force_N{};
   std::uint32_t finger_valid = 0;
   std::uint32_t entry_count = 0;
   Vec3 static_impulse_Ns{};

@@ -1,0 +1,303 @@
+// SPDX-License-Identifier: Apache-2.0
+// The viewer in a real browser (headless Chromium driven by Playwright), against the project's own binaries.
+//   node tests/viewer/viewer_test.mjs --build BUILD_DIR --case live|replay|bodies|kill|bad-input [--picture FILE]
+// --picture (live only): also saves the page mid-slide as FILE (the README's picture; scripts/make_figures.sh).
+// Each case starts what it needs under a shared-memory name of its own, prints what it checks and measures, and exits
+// 0 if every check held, 1 otherwise.
+
+import fs from "node:fs";
+import net from "node:net";
+import path from "node:path";
+import { fileURLToPath } from "node:url";
+import {
+  Failure, Processes, angleDeg, changedPixels, check, colourCount, csvPose, decodePng, distance, launchBrowser,
+  readCsv, sleep, view, waitFor,
+} from "./browser.mjs";
+
+const source = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../..");
+const args = process.argv.slice(2);
+const option = (name) => { const i = args.indexOf(name); return i >= 0 ? args[i + 1] : undefined; };
+const build = path.resolve(option("--build") ?? path.join(source, "build"));
+const which = option("--case");
+const outDir = path.join(build, "test-output", `viewer-${which}`);
+fs.rmSync(outDir, { recursive: true, force: true });
+fs.mkdirSync(outDir, { recursive: true });
+const shm = `impetus_viewer_${which}_${process.pid}`;
+const tapScene = path.join(source, "scenes", "tap.json");
+
+// The page's 3-D view drawn now, decoded (impetusView.capture: faster than a page screenshot in software WebGL), and
+// where body `name` is in it.
+async function capture(page, name) {
+  const { url, at } = await page.evaluate((body) => ({ url: window.impetusView.capture(),
+    at: window.impetusView.project(body) }), name);
+  return { image: decodePng(Buffer.from(url.slice(url.indexOf(",") + 1), "base64")), at };
+}
+
+// The last row of a log the world is still writing (it flushes every step).
+function lastRow(file) {
+  const lines = fs.readFileSync(file, "utf8").split("\n").filter((line) => line.length > 0);
+  return { columns: lines[0].split(","), row: lines[lines.length - 1].split(",").map(Number) };
+}
+
+async function openPage(browser, url) {
+  const page = await browser.newPage({ viewport: { width: 960, height: 640 } });
+  page.on("pageerror", (error) => console.log(`  page error: ${error.message}`));
+  await page.goto(url);
+  return page;
+}
+
+// A real-time tap trial watched live: the page renders, shows the world's poses, and moves where the cube moves.
+async function live(procs, browser) {
+  const world = procs.start("world", "world_manager", ["--scene", tapScene, "--clock", "realtime", "--shm", shm,
+    "--log", path.join(outDir, "world.csv")]);
+  const viewer = await procs.viewer(["--shm", shm]);
+  const page = await openPage(browser, viewer.url);
+  await waitFor("the page's first frames", async () => (await view(page))?.framesReceived > 5);
+  const haptic = procs.start("haptic", "haptic_controller", ["--clock", "realtime", "--shm", shm,
+    "--summary", path.join(outDir, "haptic.json")]);
+  const device = procs.start("device", "spidar_sim", ["--clock", "realtime", "--shm", shm, "--trajectory", "tap"]);
+  // The first screenshot as the cube starts to move (seen in world.csv: the page is not polled, so the browser keeps
+  // its CPU), the second a second later, when it has slid ~25 cm further; the camera holds still on the whole slide.
+  await page.evaluate(() => window.impetusView.lookAt([0.15, 0, 0.025], 0.2));
+  const worldCsv = path.join(outDir, "world.csv");
+  await waitFor("the tap in world.csv", () => {
+    const { columns, row } = lastRow(worldCsv);
+    return row[columns.indexOf("cube.x_m")] > 0.032;  // the cube rests at x = 0.03 m
+  }, 15000, 10);
+  const first = await capture(page, "cube");
+  const samples = [];
+  for (const end = Date.now() + 1000; Date.now() < end;) {
+    samples.push((await view(page)).latest);
+    await sleep(100);
+  }
+  const second = await capture(page, "cube");
+  await page.screenshot({ path: option("--picture") ?? path.join(outDir, "page.png") });
+  for (let i = 0; i < 10; ++i) { samples.push((await view(page)).latest); await sleep(100); }
+  const state = await view(page);
+  await procs.stop(device);
+  await procs.stop(haptic);
+  await procs.stop(viewer);
+  await procs.stop(world);
+
+  const [cubeBefore, cubeAfter] = [first.at, second.at];
+  check(colourCount(first.image) > 5, `the canvas is not blank (a cleared one has 1 colour) (${colourCount(first.image)} colours)`);
+  const box = (p) => [p.x - 20, p.y - 20, p.x + 20, p.y + 20];
+  const changedAtCube = changedPixels(first.image, second.image, box(cubeBefore)) +
+    changedPixels(first.image, second.image, box(cubeAfter));
+  check(distance([cubeBefore.x, cubeBefore.y, 0], [cubeAfter.x, cubeAfter.y, 0]) > 5,
+    `the cube moved on screen between the screenshots (${cubeBefore.x.toFixed(0)},${cubeBefore.y.toFixed(0)} → ` +
+    `${cubeAfter.x.toFixed(0)},${cubeAfter.y.toFixed(0)} px)`);
+  check(changedAtCube > 400, `the screenshots a second apart differ where the cube was and is (${changedAtCube} of 3200 pixels)`);
+
+  const log = readCsv(path.join(outDir, "world.csv"));
+  const time = log.column("time_s");
+  let compared = 0, worstMm = 0, worstDeg = 0, moving = 0;
+  for (const sample of samples) {
+    const row = log.rows.find((r) => Math.abs(r[time] - sample.worldTime_s) < 1e-9);
+    if (!row) continue;
+    const logged = csvPose(log, row, "cube");
+    const shown = sample.bodies.find((b) => b.name === "cube");
+    worstMm = Math.max(worstMm, 1000 * distance(logged.position_m, shown.position_m));
+    worstDeg = Math.max(worstDeg, angleDeg(logged.orientation_wxyz, shown.orientation_wxyz));
+    if (distance(logged.position_m, log.rows[0].slice(1, 4)) > 1e-3) ++moving;
+    ++compared;
+  }
+  check(compared >= 10, `${compared} of ${samples.length} page samples found in world.csv by their world time`);
+  check(moving >= 3, `${moving} of them after the cube had moved`);
+  check(worstMm <= 1 && worstDeg <= 1,
+    `the page's cube matches world.csv at the same frame: worst ${worstMm.toFixed(4)} mm, ${worstDeg.toFixed(4)}°`);
+  check(state.rejectedFrames === 0, "no frame rejected by the page");
+  const loop = JSON.parse(fs.readFileSync(path.join(outDir, "haptic.json"), "utf8")).haptic;
+  console.log(`  measured: haptic lateness with a viewer and a page watching (and a browser rendering on the same ` +
+    `2 cores): p50 ${loop.lateness_p50_ns / 1e3} µs, p99 ${loop.lateness_p99_ns / 1e3} µs, ` +
+    `max ${loop.lateness_max_ns / 1e3} µs`);
+  console.log(`  measured: page ${state.fps.toFixed(1)} fps, ${state.framesReceived} frames received`);
+}
+
+// A lockstep trial replayed: the replay reaches the trial's final pose.
+async function replay(procs, browser) {
+  const trial = path.join(outDir, "trial");
+  await runTrial(trial, ["--clock", "lockstep"]);
+  const summary = JSON.parse(fs.readFileSync(path.join(trial, "summary.json"), "utf8"));
+  const viewer = await procs.viewer(["--replay", trial]);
+  const page = await openPage(browser, viewer.url);
+  const scene = await waitFor("the replay's scene", async () => (await view(page))?.scene);
+  check(scene.mode === "replay", "the page is in replay mode");
+  await page.evaluate(() => window.impetusView.send({ speed: 10 }));
+  const end = scene.replay.end_s;
+  const last = await waitFor("the end of the replay", async () => {
+    const state = await view(page);
+    return state?.latest && Math.abs(state.latest.worldTime_s - end) < 1e-9 ? state.latest : null;
+  }, 30000, 100);
+  const cube = last.bodies.find((b) => b.name === "cube");
+  const final = summary.objects.cube.position;
+  const errorMm = 1000 * distance(cube.position_m, final);
+  check(errorMm < 1e-6, `the replay ends at the trial's final cube position (${cube.position_m.map((v) => v.toFixed(4))}` +
+    ` m, off by ${errorMm.toExponential(1)} mm)`);
+  await page.evaluate((t) => window.impetusView.send({ seek: t }), scene.replay.start_s);
+  await waitFor("a seek back to the start", async () => {
+    const state = await view(page);
+    return state?.latest && state.latest.worldTime_s === scene.replay.start_s;
+  });
+  check(true, "seeking back to the start shows the first frame");
+  await procs.stop(viewer);
+}
+
+async function runTrial(out, extra) {
+  const { spawnSync } = await import("node:child_process");
+  const result = spawnSync("bash", [path.join(source, "scripts", "run.sh"), "--scene", tapScene, "--trajectory", "tap",
+    "--out", out, "--quiet", ...extra], { env: { ...process.env, IMPETUS_BUILD_DIR: build }, encoding: "utf8" });
+  if (result.status !== 0) throw new Failure(`run.sh failed: ${result.stderr}`);
+}
+
+// 2000 bodies: the page renders them all and reports its frame rate.
+async function bodies(procs, browser) {
+  const objects = [];
+  for (let k = 0; k < 2000; ++k) {
+    const i = k % 50, j = Math.floor(k / 50);
+    const dynamic = k % 20 === 0;  // 100 spheres fall onto 1900 static boxes and cylinders
+    const at = [(i - 25) * 0.03, (j - 20) * 0.03];
+    if (dynamic) {
+      objects.push({ name: `ball${k}`, shape: "sphere", radius_m: 0.008, dynamic: true, mass_kg: 0.05,
+        position_m: [at[0], at[1], 0.06] });
+    } else if (k % 2) {
+      objects.push({ name: `box${k}`, shape: "box", size_m: [0.02, 0.02, 0.02], dynamic: false,
+        position_m: [at[0], at[1], 0.01] });
+    } else {
+      objects.push({ name: `cyl${k}`, shape: "cylinder", radius_m: 0.01, length_m: 0.02, dynamic: false,
+        position_m: [at[0], at[1], 0.01] });
+    }
+  }
+  const scene = path.join(outDir, "bodies2000.json");
+  fs.writeFileSync(scene, JSON.stringify({ description: "2000 bodies for the viewer's frame rate", objects }));
+  const world = procs.start("world", "world_manager", ["--scene", scene, "--clock", "realtime", "--shm", shm]);
+  const viewer = await procs.viewer(["--shm", shm]);
+  const page = await openPage(browser, viewer.url);
+  await waitFor("2000 bodies on the page", async () => (await view(page))?.latest?.bodies?.length === 2000, 30000);
+  await sleep(3000);
+  const state = await view(page);
+  const image = decodePng(await page.screenshot({ path: path.join(outDir, "bodies2000.png") }));
+  await procs.stop(viewer);
+  await procs.stop(world);
+  check(state.renderedFrames > 0 && colourCount(image) > 20, `2000 bodies render (${colourCount(image)} colours)`);
+  console.log(`  measured: ${state.fps} fps with 2000 bodies in headless Chromium (software WebGL), ` +
+    `${state.framesReceived} world frames received`);
+}
+
+// A viewer killed with kill -9 mid-trial leaves a lockstep trial's outcome bitwise unchanged.
+async function kill(procs, browser) {
+  const trajectory = "press:hold=300";  // ~5 s of lockstep: time for a page to attach mid-trial
+  const runLockstep = async (name, watch) => {
+    const dir = path.join(outDir, name);
+    fs.mkdirSync(dir);
+    const world = procs.start(`${name}-world`, "world_manager", ["--scene", tapScene, "--clock", "lockstep", "--shm",
+      `${shm}_${name}`, "--log", path.join(dir, "world.csv")]);
+    const haptic = procs.start(`${name}-haptic`, "haptic_controller", ["--clock", "lockstep", "--shm", `${shm}_${name}`,
+      "--log", path.join(dir, "haptic.csv")]);
+    const device = procs.start(`${name}-device`, "spidar_sim", ["--clock", "lockstep", "--shm", `${shm}_${name}`,
+      "--trajectory", trajectory]);
+    let killed = null;
+    if (watch) {
+      const viewer = await procs.viewer(["--shm", `${shm}_${name}`]);
+      const page = await openPage(browser, viewer.url);
+      await waitFor("frames on the page", async () => (await view(page))?.framesReceived > 10);
+      viewer.kill("SIGKILL");
+      killed = (await viewer.exited).signal;
+      killed += ` at world time ${(await view(page)).latest.worldTime_s.toFixed(2)} s`;
+      await page.close();
+    }
+    const deviceExit = await device.exited;
+    await procs.stop(haptic);
+    await procs.stop(world);
+    if (deviceExit.code !== 0) throw new Failure(`${name}: spidar_sim exited ${deviceExit.code}`);
+    return { dir, killed };
+  };
+  const plain = await runLockstep("alone", false);
+  const watched = await runLockstep("watched", true);
+  check(watched.killed?.startsWith("SIGKILL"), `the viewer was killed mid-trial (${watched.killed})`);
+  for (const log of ["world.csv", "haptic.csv"]) {
+    const a = fs.readFileSync(path.join(plain.dir, log));
+    const b = fs.readFileSync(path.join(watched.dir, log));
+    check(a.equals(b), `${log} is bitwise the same with and without the killed viewer (${a.length} bytes)`);
+  }
+}
+
+// Bad requests: errors, never a crash.
+async function badInput(procs, browser) {
+  const world = procs.start("world", "world_manager", ["--scene", tapScene, "--clock", "realtime", "--shm", shm]);
+  const viewer = await procs.viewer(["--shm", shm]);
+  const status = async (target, init) => (await fetch(viewer.url.replace(/\/$/, "") + target, init)).status;
+  check(await status("/no/such/page") === 404, "an unknown path is 404");
+  check(await status("/three/build/../../package.json") === 404, "a path out of the page's folder is 404");
+  check(await status("/", { method: "POST", body: "x".repeat(100000) }) === 413, "a 100 kB request body is 413");
+  check(await status("/", { method: "DELETE" }) === 405, "DELETE is 405");
+
+  const page = await openPage(browser, viewer.url);
+  await waitFor("frames on the page", async () => (await view(page))?.framesReceived > 0);
+  const closed = await page.evaluate(() => new Promise((resolve) => {
+    const socket = new WebSocket(`ws://${location.host}/ws`);
+    socket.onopen = () => socket.send("x".repeat(1 << 20));
+    socket.onclose = (event) => resolve(event.code);
+    setTimeout(() => resolve("still open"), 10000);
+  }));
+  check(closed !== "still open", `a 1 MB WebSocket message closes that connection (close code ${closed})`);
+  const badControl = await page.evaluate(() => new Promise((resolve) => {
+    const socket = new WebSocket(`ws://${location.host}/ws`);
+    socket.onopen = () => socket.send("{not json");
+    socket.onclose = (event) => resolve(event.code);
+    setTimeout(() => resolve("still open"), 10000);
+  }));
+  check(badControl !== "still open", `a malformed control message closes that connection (close code ${badControl})`);
+
+  // A flood: 300 connections held open at once, some sending garbage.
+  const sockets = [];
+  for (let i = 0; i < 300; ++i) {
+    const socket = net.connect(Number(new URL(viewer.url).port), "127.0.0.1");
+    socket.on("error", () => {});
+    if (i % 3 === 0) socket.write("GARBAGE \x00\x01\x02\r\n\r\n");
+    sockets.push(socket);
+  }
+  await sleep(1000);
+  for (const socket of sockets) socket.destroy();
+  await sleep(200);
+  check(await status("/") === 200, "after a flood of 300 connections the page is still served");
+  const before = (await view(page)).framesReceived;
+  await sleep(500);
+  check((await view(page)).framesReceived > before, "and the open page still receives frames");
+  check(viewer.exitCode === null, "the viewer is still running");
+  const result = await procs.stop(viewer);
+  check(result.code === 0, "it exits 0 on SIGTERM");
+  console.log(`  ${procs.log(viewer.name).trim().split("\n").pop()}`);
+  await procs.stop(world);
+}
+
+const cases = { live, replay, bodies, kill, "bad-input": badInput };
+if (!cases[which]) {
+  console.error(`viewer_test: --case must be one of ${Object.keys(cases).join(", ")}`);
+  process.exit(2);
+}
+const procs = new Processes(build, outDir);
+let browser;
+let status = 0;
+try {
+  browser = await launchBrowser();
+  console.log(`viewer test '${which}':`);
+  await cases[which](procs, browser);
+  console.log("passed");
+} catch (error) {
+  console.log(`FAILED: ${error instanceof Failure ? error.message : error.stack}`);
+  for (const child of procs.children) {
+    const file = path.join(outDir, `${child.name}.log`);
+    if (fs.existsSync(file)) console.log(`--- ${child.name} stderr:\n${fs.readFileSync(file, "utf8").slice(-2000)}`);
+  }
+  status = 1;
+} finally {
+  procs.killAll();
+  if (browser) await browser.close();
+  for (const suffix of [".world", ".device", ".view"]) {
+    for (const name of fs.readdirSync("/dev/shm").filter((n) => n.startsWith(shm) && n.endsWith(suffix))) {
+      fs.rmSync(path.join("/dev/shm", name), { force: true });
+    }
+  }
+}
+process.exit(status);

@@ -1,0 +1,208 @@
+// SPDX-License-Identifier: Apache-2.0
+// The viewer's parts without a browser: what the world publishes for it, the frame encoding, which files it serves,
+// its listen address, and reading a trial back.
+
+#include "common/link/shm/shm_world_view.h"
+#include "viewer/replay.h"
+#include "viewer/view_encoding.h"
+#include "viewer/view_protocol.h"
+#include "viewer/viewer_node.h"
+#include "viewer/web_root.h"
+#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/world.h"
+#include "world_manager/world_view.h"
+
+#include <catch2/catch.hpp>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+namespace impetus {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(IMPETUS_BINARY_DIR) / "test-output" / "viewer-unit" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<double> values_of(const std::string& message) {
+  std::vector<double> values(message.size() / sizeof(double));
+  std::memcpy(values.data(), message.data(), values.size() * sizeof(double));
+  return values;
+}
+
+}  // namespace
+
+TEST_CASE("viewer: the world's snapshot carries every body's pose and the finger; the shm view passes it whole") {
+  init_ode_once();
+  const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json");
+  World world(scene, WorldOptions{});
+  HapticReport report{};
+  report.endpoint = 3;
+  report.finger_valid = 1;
+  report.finger_m = {-0.03, 0.0, 0.025};
+  report.proxy_m = {-0.03, 0.0, 0.025};
+  report.force_N = {1.0, 2.0, 3.0};
+  world.step(&report);
+  world.step(&report);
+
+  const std::string shm = "impetus_test_view_" + std::to_string(getpid());
+  ShmWorldViewPublisher publisher(shm);
+  auto described = std::make_unique<ViewScene>();
+  describe_scene(scene, Coupling::impulse, 20.0, 1, *described);
+  publisher.publish_scene(*described);
+  auto snapshot = std::make_unique<WorldSnapshot>();
+  take_snapshot(world, &report, LoopStats{}, nullptr, *snapshot);
+  CHECK(snapshot->body_count == scene.objects.size());
+  CHECK(snapshot->frame_index == world.frame().frame_index);
+  CHECK(snapshot->world_time_s == world.time_s());
+  CHECK(snapshot->used_bytes() < sizeof(WorldSnapshot) / 10);  // a 2-body scene sends a fraction of the capacity
+  publisher.publish_snapshot(*snapshot);
+
+  ShmWorldViewReader reader(shm);
+  auto scene_read = std::make_unique<ViewScene>();
+  REQUIRE(reader.read_scene(*scene_read));
+  CHECK(scene_read->body_count == scene.objects.size());
+  CHECK(std::string(scene_read->bodies[0].name.data()) == scene.objects[0].name);
+  auto read = std::make_unique<WorldSnapshot>();
+  REQUIRE(reader.read_snapshot(*read));
+  CHECK_FALSE(reader.read_snapshot(*read));  // nothing new
+  for (std::uint32_t k = 0; k < read->body_count; ++k) {
+    CHECK(read->bodies[k].position_m == to_vec3(world.states()[k].pose.position_m));
+  }
+  REQUIRE(read->endpoint_count == 1);
+  CHECK(read->endpoints[0].endpoint == 3);
+  CHECK(read->endpoints[0].force_N == Vec3{1.0, 2.0, 3.0});
+  CHECK(reader.rejected() == 0);
+}
+
+TEST_CASE("viewer: a snapshot with a bad count, a non-finite pose or a non-unit quaternion is named, not used") {
+  auto snapshot = std::make_unique<WorldSnapshot>();
+  snapshot->world_period_s = 0.05;
+  snapshot->body_count = 2;
+  CHECK(std::string(snapshot_problem(*snapshot)).empty());
+  snapshot->body_count = kMaxViewBodies + 1;
+  CHECK_THAT(snapshot_problem(*snapshot), Catch::Contains("body count"));
+  snapshot->body_count = 2;
+  snapshot->bodies[1].position_m[2] = NAN;
+  CHECK_THAT(snapshot_problem(*snapshot), Catch::Contains("not finite"));
+  snapshot->bodies[1].position_m[2] = 0.0;
+  snapshot->bodies[1].orientation_wxyz = {0.9, 0.0, 0.0, 0.0};
+  CHECK_THAT(snapshot_problem(*snapshot), Catch::Contains("unit quaternion"));
+}
+
+TEST_CASE("viewer: a frame message is the header, 7 values per body, and per endpoint 12 plus 6 per plane") {
+  auto snapshot = std::make_unique<WorldSnapshot>();
+  snapshot->frame_index = 41;
+  snapshot->world_time_s = 2.1;
+  snapshot->world_period_s = 0.05;
+  snapshot->body_count = 2;
+  snapshot->bodies[1].position_m = {0.1, 0.2, 0.3};
+  snapshot->endpoint_count = 1;
+  snapshot->endpoints[0].finger_valid = 1;
+  snapshot->endpoints[0].force_N = {0.0, 0.0, 4.5};
+  snapshot->endpoints[0].plane_count = 2;
+  snapshot->endpoints[0].planes[1].normal = {0.0, 0.0, 1.0};
+  std::string message;
+  view::encode_frame(*snapshot, true, 1.0, message);
+  const std::vector<double> v = values_of(message);
+  REQUIRE(v.size() == view::kFrameHeaderValues + 2 * view::kBodyValues + view::kEndpointValues + 2 * view::kPlaneValues);
+  CHECK(v[0] == view::kFrameKind);
+  CHECK(v[1] == 41);
+  CHECK(v[2] == 2.1);
+  CHECK(v[4] == 2);
+  CHECK(v[5] == 1);
+  CHECK(std::isnan(v[6]));  // no haptic lateness known
+  const std::size_t body1 = view::kFrameHeaderValues + view::kBodyValues;
+  CHECK(v[body1 + 2] == 0.3);
+  CHECK(v[body1 + 3] == 1.0);  // w of the identity
+  const std::size_t endpoint = view::kFrameHeaderValues + 2 * view::kBodyValues;
+  CHECK(v[endpoint + 1] == 1);
+  CHECK(v[endpoint + 10] == 4.5);
+  CHECK(v[endpoint + 11] == 2);
+  CHECK(v[endpoint + view::kEndpointValues + view::kPlaneValues + 5] == 1.0);
+}
+
+TEST_CASE("viewer: only the page's files are served; nothing outside its folder, nothing hidden") {
+  const fs::path dir = scratch("web");
+  std::ofstream(dir / "index.html") << "<html></html>";
+  std::ofstream(dir / "viewer.js") << "";
+  fs::create_directories(dir / "node_modules/three/build");
+  fs::create_directories(dir / "node_modules/three/examples/jsm/controls");
+  std::ofstream(dir / "node_modules/three/build/three.module.js") << "";
+  std::ofstream(dir / "node_modules/three/examples/jsm/controls/OrbitControls.js") << "";
+  std::ofstream(dir / "node_modules/three/package.json") << "{}";
+  std::ofstream(dir / "secret.txt") << "no";
+  const view::WebRoot web(dir);
+  CHECK(web.file_for("/") == dir / "index.html");
+  CHECK(web.file_for("/index.html?reload=1") == dir / "index.html");
+  CHECK(web.file_for("/viewer.js") == dir / "viewer.js");
+  CHECK(web.file_for("/three/build/three.module.js") == dir / "node_modules/three/build/three.module.js");
+  CHECK(web.file_for("/three/examples/jsm/controls/OrbitControls.js").has_value());
+  CHECK_FALSE(web.file_for("/secret.txt"));
+  CHECK_FALSE(web.file_for("/three/build/../package.json"));
+  CHECK_FALSE(web.file_for("/three/build/../../../secret.txt"));
+  CHECK_FALSE(web.file_for("/three/build/.hidden"));
+  CHECK_FALSE(web.file_for("/three/build//three.module.js"));
+  CHECK_FALSE(web.file_for("/three/build/three.module.js%00"));
+  CHECK_FALSE(web.file_for("/three/build/"));
+  CHECK_FALSE(web.file_for("../index.html"));
+  CHECK(view::content_type(dir / "viewer.js") == "text/javascript; charset=utf-8");
+
+  fs::remove(dir / "node_modules/three/build/three.module.js");
+  CHECK_THROWS_WITH(view::WebRoot(dir), Catch::Contains("three.js is not installed") && Catch::Contains("npm ci"));
+}
+
+TEST_CASE("viewer: --listen takes HOST:PORT on loopback; another address only with --allow-remote") {
+  CHECK(view::parse_listen("127.0.0.1:8080", false).port == 8080);
+  CHECK(view::parse_listen("[::1]:0", false).host == "::1");
+  CHECK_THROWS_WITH(view::parse_listen("0.0.0.0:8080", false), Catch::Contains("--allow-remote"));
+  CHECK(view::parse_listen("0.0.0.0:8080", true).host == "0.0.0.0");
+  CHECK_THROWS_WITH(view::parse_listen("127.0.0.1:99999", false), Catch::Contains("0 to 65535"));
+  CHECK_THROWS_WITH(view::parse_listen("localhost:80", false), Catch::Contains("not an IP address"));
+  CHECK_THROWS_WITH(view::parse_listen("8080", false), Catch::Contains("HOST:PORT"));
+}
+
+TEST_CASE("viewer: a replay reads a trial's scene and logs; a malformed log is named with its line and column") {
+  const fs::path dir = scratch("replay");
+  std::ofstream(dir / "summary.json")
+      << R"({"config": {"scene": ")" << IMPETUS_SOURCE_DIR << R"(/scenes/tap.json", "coupling": "local", "world_rate_hz": 20}})";
+  const std::string header = "time_s,cube.x_m,cube.y_m,cube.z_m,cube.qw,cube.qx,cube.qy,cube.qz\n";
+  std::ofstream(dir / "world.csv") << header << "0.05,0.03,0,0.025,1,0,0,0\n0.1,0.04,0,0.025,1,0,0,0\n";
+  std::ofstream(dir / "haptic.csv")
+      << "time_s,finger_x,finger_y,finger_z,proxy_x,proxy_y,proxy_z,force_x,force_y,force_z\n"
+      << "0.0,-0.01,0,0.025,-0.01,0,0.025,0,0,0\n0.09,0.01,0,0.025,0.005,0,0.025,10,0,0\n";
+  const view::Replay replay(dir.string());
+  REQUIRE(replay.frame_count() == 2);
+  CHECK(replay.scene().coupling == Coupling::local);
+  CHECK(replay.frame_at(0.0) == 0);
+  CHECK(replay.frame_at(0.099) == 0);
+  CHECK(replay.frame_at(0.1) == 1);
+  CHECK(replay.frame_at(5.0) == 1);
+  auto snapshot = std::make_unique<WorldSnapshot>();
+  replay.snapshot(1, *snapshot);
+  CHECK(snapshot->world_time_s == 0.1);
+  CHECK(snapshot->bodies[0].position_m[0] == 0.04);
+  REQUIRE(snapshot->endpoint_count == 1);
+  CHECK(snapshot->endpoints[0].force_N[0] == 10.0);  // the haptic row at or before 0.1 s
+  CHECK(std::string(snapshot_problem(*snapshot)).empty());
+
+  std::ofstream(dir / "world.csv") << header << "0.05,0.03,0,0.025,1,0,0,0\n0.1,0.04,oops,0.025,1,0,0,0\n";
+  CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("world.csv:3") && Catch::Contains("column 3") &&
+                                                    Catch::Contains("cube.y_m"));
+  std::ofstream(dir / "world.csv") << "time_s,other.x_m\n0.05,1\n";
+  CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("no column 'cube.x_m'"));
+  std::ofstream(dir / "summary.json") << R"({"config": {"scene": "no/such/scene.json"}})";
+  CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("/config/scene") && Catch::Contains("no such file"));
+}
+
+}  // namespace impetus

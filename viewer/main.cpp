@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: Apache-2.0
+// viewer: the graphics process (paper §6.1, DESIGN.md §1). Shows a running world live, read-only, or replays a
+// finished trial, as a 3-D page served on loopback.
+
+#include "common/runtime/cli.h"
+#include "viewer/viewer_node.h"
+
+int main(int argc, char** argv) {
+  using namespace impetus;
+  view::ViewerOptions options;
+  std::string web_dir;
+  CLI::App app{"viewer: watch an Impetus world in a browser. Attaches read-only to a running world (--shm) or replays "
+               "a finished trial (--replay), and serves a 3-D page at --listen."};
+  add_shm_flag(app, options.shm);
+  app.add_option("--replay", options.replay_dir, "replay a finished trial: its folder (scripts/run.sh --out DIR)")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--listen", options.listen, "HOST:PORT to serve the page on (port 0: any free port)")
+      ->capture_default_str();
+  app.add_flag("--allow-remote", options.allow_remote, "allow a --listen address other than loopback");
+  app.add_option("--web", web_dir, "folder with the page (default: the installed or source viewer/web)")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--duration", options.duration_s, "seconds to serve (default: until stopped)")
+      ->check(positive_number(kMaxFlagSeconds));
+  CLI11_PARSE(app, argc, argv);
+  options.web_dir = web_dir;
+  return run_node("viewer", [&] {
+    view::ViewerNode node(options, argv[0]);
+    return node.run();
+  });
+}

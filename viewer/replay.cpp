@@ -1,0 +1,206 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "viewer/replay.h"
+
+#include "world_manager/scene.h"
+#include "world_manager/world_view.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace impetus::view {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A numeric CSV log (header row, then numbers), as every node writes them (DESIGN.md §4).
+struct CsvTable {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+
+  int column(const std::string& name) const {
+    const auto found = std::find(columns.begin(), columns.end(), name);
+    return found == columns.end() ? -1 : static_cast<int>(found - columns.begin());
+  }
+};
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, ',')) fields.push_back(field);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+CsvTable read_csv(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw ReplayError("cannot read " + path.string());
+  CsvTable table;
+  std::string line;
+  if (!std::getline(in, line)) throw ReplayError(path.string() + ": empty (no header row)");
+  table.columns = split(line);
+  for (std::size_t number = 2; std::getline(in, line); ++number) {
+    if (line.empty()) continue;
+    const std::vector<std::string> fields = split(line);
+    if (fields.size() != table.columns.size()) {
+      throw ReplayError(path.string() + ":" + std::to_string(number) + ": " + std::to_string(fields.size()) +
+                        " fields, the header has " + std::to_string(table.columns.size()) +
+                        " (a log cut short by a crash ends in a partial row: delete that row)");
+    }
+    std::vector<double> row(fields.size());
+    for (std::size_t c = 0; c < fields.size(); ++c) {
+      const std::string& text = fields[c];
+      const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), row[c]);
+      if (error != std::errc() || end != text.data() + text.size()) {
+        throw ReplayError(path.string() + ":" + std::to_string(number) + ": column " + std::to_string(c + 1) + " ('" +
+                          table.columns[c] + "') is not a number: '" + text + "'");
+      }
+    }
+    table.rows.push_back(std::move(row));
+  }
+  return table;
+}
+
+nlohmann::json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw ReplayError("cannot read " + path.string() + " (is this a trial folder written by scripts/run.sh?)");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& error) {
+    throw ReplayError(path.string() + ": " + error.what());
+  }
+}
+
+// The scene a summary names: as written (absolute, or relative to where the viewer runs), else relative to the trial
+// folder, its parent or the source tree (trials are usually started from the source tree).
+fs::path find_scene(const std::string& named, const fs::path& dir) {
+  const fs::path path(named);
+  const fs::path candidates[] = {path, dir / path, dir.parent_path() / path, fs::path(IMPETUS_SOURCE_DIR) / path};
+  for (const fs::path& candidate : candidates) {
+    std::error_code error;
+    if (fs::is_regular_file(candidate, error)) return candidate;
+  }
+  throw ReplayError((dir / "summary.json").string() + ": /config/scene: no such file '" + named + "'");
+}
+
+Coupling coupling_named(const std::string& name, const fs::path& summary) {
+  for (Coupling coupling : {Coupling::impulse, Coupling::position, Coupling::local}) {
+    if (name == to_string(coupling)) return coupling;
+  }
+  throw ReplayError(summary.string() + ": /config/coupling: unknown coupling '" + name + "'");
+}
+
+}  // namespace
+
+Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<ViewScene>()) {
+  const fs::path folder(dir);
+  const fs::path summary_path = folder / "summary.json";
+  const nlohmann::json summary = read_json(summary_path);
+  const nlohmann::json config = summary.value("config", nlohmann::json::object());
+  if (!config.contains("scene") || !config["scene"].is_string()) {
+    throw ReplayError(summary_path.string() + ": /config/scene: missing (not a trial summary?)");
+  }
+  Scene scene;
+  try {
+    scene = load_scene(find_scene(config["scene"].get<std::string>(), folder).string());
+  } catch (const SceneError& error) {
+    throw ReplayError(error.what());
+  }
+  const std::string coupling = config.value("coupling", std::string("impulse"));
+  const double rate_hz = config.contains("world_rate_hz") && config["world_rate_hz"].is_number()
+                             ? config["world_rate_hz"].get<double>()
+                             : scene.physics.world_rate_hz;
+  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) {
+    throw ReplayError(summary_path.string() + ": /config/world_rate_hz: not a positive rate");
+  }
+  world_period_s_ = 1.0 / rate_hz;
+  describe_scene(scene, coupling_named(coupling, summary_path), rate_hz, 0, *scene_);
+
+  // Poses: dynamic bodies from world.csv, static ones where the scene puts them.
+  const fs::path world_path = folder / "world.csv";
+  const CsvTable world = read_csv(world_path);
+  if (world.rows.empty()) throw ReplayError(world_path.string() + ": no steps were logged");
+  const int time_column = world.column("time_s");
+  if (time_column < 0) throw ReplayError(world_path.string() + ": no time_s column");
+  const std::size_t bodies = scene_->body_count;
+  std::vector<std::array<int, 7>> columns(bodies);
+  static const char* const kSuffix[7] = {".x_m", ".y_m", ".z_m", ".qw", ".qx", ".qy", ".qz"};
+  for (std::size_t k = 0; k < bodies; ++k) {
+    for (int v = 0; v < 7; ++v) {
+      columns[k][v] = scene.objects[k].dynamic ? world.column(scene.objects[k].name + kSuffix[v]) : -1;
+      if (scene.objects[k].dynamic && columns[k][v] < 0) {
+        throw ReplayError(world_path.string() + ": no column '" + scene.objects[k].name + kSuffix[v] +
+                          "' (was the trial run with another scene?)");
+      }
+    }
+  }
+  times_s_.reserve(world.rows.size());
+  poses_.reserve(world.rows.size() * bodies);
+  for (const std::vector<double>& row : world.rows) {
+    times_s_.push_back(row[time_column]);
+    for (std::size_t k = 0; k < bodies; ++k) {
+      if (columns[k][0] < 0) {
+        poses_.push_back(scene_pose(scene.objects[k]));
+        continue;
+      }
+      ViewBodyPose pose;
+      for (int v = 0; v < 3; ++v) pose.position_m[v] = row[columns[k][v]];
+      for (int v = 0; v < 4; ++v) pose.orientation_wxyz[v] = row[columns[k][3 + v]];
+      poses_.push_back(pose);
+    }
+  }
+
+  // The finger at each step's time: the last haptic row at or before it.
+  const fs::path haptic_path = folder / "haptic.csv";
+  std::error_code missing;
+  if (!fs::is_regular_file(haptic_path, missing)) return;
+  const CsvTable haptic = read_csv(haptic_path);
+  static const char* const kHapticColumns[] = {"time_s",  "finger_x", "finger_y", "finger_z", "proxy_x",
+                                               "proxy_y", "proxy_z",  "force_x",  "force_y",  "force_z"};
+  std::array<int, 10> hc{};
+  for (int v = 0; v < 10; ++v) {
+    hc[v] = haptic.column(kHapticColumns[v]);
+    if (hc[v] < 0) throw ReplayError(haptic_path.string() + ": no column '" + kHapticColumns[v] + "'");
+  }
+  if (haptic.rows.empty()) return;
+  have_endpoint_ = true;
+  endpoints_.resize(times_s_.size());
+  std::size_t next = 0;
+  for (std::size_t f = 0; f < times_s_.size(); ++f) {
+    while (next + 1 < haptic.rows.size() && haptic.rows[next + 1][hc[0]] <= times_s_[f]) ++next;
+    const std::vector<double>& row = haptic.rows[next];
+    ViewEndpoint& endpoint = endpoints_[f];
+    endpoint.finger_m = {row[hc[1]], row[hc[2]], row[hc[3]]};
+    endpoint.proxy_m = {row[hc[4]], row[hc[5]], row[hc[6]]};
+    endpoint.force_N = {row[hc[7]], row[hc[8]], row[hc[9]]};
+    endpoint.finger_valid = all_finite(endpoint.finger_m) && all_finite(endpoint.proxy_m) && all_finite(endpoint.force_N);
+    if (!endpoint.finger_valid) endpoint = ViewEndpoint{};
+  }
+}
+
+std::size_t Replay::frame_at(double time_s) const {
+  const auto after = std::upper_bound(times_s_.begin(), times_s_.end(), time_s);
+  return after == times_s_.begin() ? 0 : static_cast<std::size_t>(after - times_s_.begin()) - 1;
+}
+
+void Replay::snapshot(std::size_t frame, WorldSnapshot& out) const {
+  out.world_session = 0;
+  out.frame_index = frame;
+  out.world_time_s = times_s_[frame];
+  out.world_period_s = world_period_s_;
+  out.world_stats = LoopStats{};
+  out.haptic_stats = LoopStats{};
+  out.body_count = scene_->body_count;
+  std::copy_n(poses_.begin() + static_cast<std::ptrdiff_t>(frame * out.body_count), out.body_count, out.bodies.begin());
+  out.endpoint_count = have_endpoint_ ? 1 : 0;
+  if (have_endpoint_) out.endpoints[0] = endpoints_[frame];
+}
+
+}  // namespace impetus::view

@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// A finished trial, read back for the viewer's replay (viewer --replay DIR): the scene its summary names, every world
+// step's poses from world.csv, and the finger, proxy and force from haptic.csv at each step's time. Planes are not
+// logged, so a replay shows none.
+
+#include "common/contract/world_view.h"
+
+#include <cstddef>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace impetus::view {
+
+class ReplayError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Replay {
+ public:
+  // Reads DIR/summary.json (config.scene, config.coupling, config.world_rate_hz), the scene file it names (as given,
+  // or relative to DIR, its parent, or the source tree), DIR/world.csv and, if present, DIR/haptic.csv. Throws
+  // ReplayError naming the file, and the line and column where a log is malformed.
+  explicit Replay(const std::string& dir);
+
+  const ViewScene& scene() const { return *scene_; }
+  const std::string& dir() const { return dir_; }
+  std::size_t frame_count() const { return times_s_.size(); }
+  double start_s() const { return times_s_.front(); }
+  double end_s() const { return times_s_.back(); }
+  double time_s(std::size_t frame) const { return times_s_[frame]; }
+  // The last frame at or before `time_s` (the first if before it).
+  std::size_t frame_at(double time_s) const;
+  // Fills `out` with frame `frame` (< frame_count()).
+  void snapshot(std::size_t frame, WorldSnapshot& out) const;
+
+ private:
+  std::string dir_;
+  std::unique_ptr<ViewScene> scene_;
+  double world_period_s_ = 0.0;
+  std::vector<double> times_s_;
+  std::vector<ViewBodyPose> poses_;  // frame_count × body_count, frame-major
+  std::vector<ViewEndpoint> endpoints_;  // one per frame; endpoint_ids_ tells whether there is one
+  bool have_endpoint_ = false;
+};
+
+}  // namespace impetus::view

@@ -1,0 +1,111 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "viewer/view_encoding.h"
+
+#include "viewer/view_protocol.h"
+
+#include <nlohmann/json.hpp>
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace impetus::view {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "frame messages are little-endian float64 (view_protocol.h)");
+
+const char* shape_name(ViewShape shape) {
+  switch (shape) {
+    case ViewShape::box: return "box";
+    case ViewShape::sphere: return "sphere";
+    case ViewShape::capsule: return "capsule";
+    case ViewShape::cylinder: return "cylinder";
+  }
+  return "box";
+}
+
+// Appends float64 values to a byte string.
+class Packer {
+ public:
+  explicit Packer(std::string& out) : out_(out) { out_.clear(); }
+  void add(double value) {
+    char bytes[sizeof value];
+    std::memcpy(bytes, &value, sizeof value);
+    out_.append(bytes, sizeof value);
+  }
+  void add(const Vec3& v) {
+    for (double x : v) add(x);
+  }
+
+ private:
+  std::string& out_;
+};
+
+}  // namespace
+
+std::string scene_message(const ViewScene& scene, const std::string& source, const std::optional<ReplayRange>& replay) {
+  nlohmann::json message = {{"type", "scene"},
+                            {"mode", replay ? "replay" : "live"},
+                            {"source", source},
+                            {"coupling", to_string(scene.coupling)},
+                            {"world_rate_hz", scene.world_rate_hz},
+                            {"floor", {{"present", scene.floor_present != 0}, {"height_m", scene.floor_height_m}}}};
+  nlohmann::json bodies = nlohmann::json::array();
+  for (std::uint32_t k = 0; k < scene.body_count; ++k) {
+    const ViewBodyInfo& body = scene.bodies[k];
+    bodies.push_back({{"name", std::string(body.name.data())},  // NUL-terminated (scene_problem checked)
+                      {"shape", shape_name(body.shape)},
+                      {"dynamic", body.dynamic != 0},
+                      {"size_m", body.box_size_m},
+                      {"radius_m", body.radius_m},
+                      {"length_m", body.length_m}});
+  }
+  message["bodies"] = std::move(bodies);
+  if (replay) {
+    message["replay"] = {{"start_s", replay->start_s}, {"end_s", replay->end_s}, {"frame_count", replay->frame_count}};
+  }
+  // Names come from scene files and may hold any bytes: replace invalid UTF-8 rather than fail.
+  return message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+void encode_frame(const WorldSnapshot& snapshot, bool playing, double speed, std::string& out) {
+  Packer pack(out);
+  const double lateness_p99_s = snapshot.haptic_stats.lateness_p99_ns > 0
+                                    ? static_cast<double>(snapshot.haptic_stats.lateness_p99_ns) * 1e-9
+                                    : std::numeric_limits<double>::quiet_NaN();
+  const double header[kFrameHeaderValues] = {static_cast<double>(kFrameKind),
+                                             static_cast<double>(snapshot.frame_index),
+                                             snapshot.world_time_s,
+                                             snapshot.world_period_s,
+                                             static_cast<double>(snapshot.body_count),
+                                             static_cast<double>(snapshot.endpoint_count),
+                                             lateness_p99_s,
+                                             static_cast<double>(snapshot.haptic_stats.faults),
+                                             static_cast<double>(snapshot.world_stats.skipped_periods),
+                                             static_cast<double>(snapshot.haptic_stats.skipped_periods),
+                                             playing ? 1.0 : 0.0,
+                                             speed,
+                                             0.0, 0.0, 0.0, 0.0};
+  for (double value : header) pack.add(value);
+  for (std::uint32_t k = 0; k < snapshot.body_count; ++k) {
+    const ViewBodyPose& body = snapshot.bodies[k];
+    pack.add(body.position_m);
+    for (double q : body.orientation_wxyz) pack.add(q);
+  }
+  for (std::uint32_t e = 0; e < snapshot.endpoint_count; ++e) {
+    const ViewEndpoint& endpoint = snapshot.endpoints[e];
+    pack.add(static_cast<double>(endpoint.endpoint));
+    pack.add(endpoint.finger_valid != 0 ? 1.0 : 0.0);
+    pack.add(endpoint.finger_m);
+    pack.add(endpoint.proxy_m);
+    pack.add(endpoint.force_N);
+    pack.add(static_cast<double>(endpoint.plane_count));
+    for (std::uint32_t p = 0; p < endpoint.plane_count; ++p) {
+      pack.add(endpoint.planes[p].point_m);
+      pack.add(endpoint.planes[p].normal);
+    }
+  }
+}
+
+}  // namespace impetus::view

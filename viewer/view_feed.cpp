@@ -1,0 +1,121 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "viewer/view_feed.h"
+
+#include "common/runtime/loop_stats.h"
+#include "viewer/view_encoding.h"
+#include "viewer/view_protocol.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace impetus::view {
+
+LiveFeed::LiveFeed(std::string shm)
+    : shm_(std::move(shm)), scene_(std::make_unique<ViewScene>()), snapshot_(std::make_unique<WorldSnapshot>()) {}
+
+std::uint64_t LiveFeed::rejected() const { return rejected_before_ + (reader_ ? reader_->rejected() : 0); }
+
+void LiveFeed::try_attach() {
+  const std::int64_t now_ns = monotonic_now_ns();
+  if (now_ns < next_attach_ns_) return;
+  next_attach_ns_ = now_ns + 100'000'000;  // a world is looked for every 100 ms while there is none
+  try {
+    reader_.emplace(shm_);
+    if (!reader_->world_alive()) {  // a segment left by a world that died: its successor will replace it
+      reader_.reset();
+      return;
+    }
+    std::fprintf(stderr, "viewer: attached to the world at '%s'\n", reader_->name().c_str());
+    last_problem_.clear();
+  } catch (const SegmentError& error) {
+    // Missing or under construction: the world has not started yet. Anything else (another build's layout) is said
+    // once, and looked for again in case the world is restarted with a matching build.
+    if (!error.transient() && last_problem_ != error.what()) {
+      last_problem_ = error.what();
+      std::fprintf(stderr, "viewer: %s\n", error.what());
+    }
+  }
+}
+
+void LiveFeed::poll() {
+  if (!reader_) try_attach();
+  if (!reader_) return;
+  if (reader_->read_scene(*scene_)) {
+    have_scene_ = true;
+    scene_message_ = std::make_shared<const std::string>(scene_message(*scene_, shm_, std::nullopt));
+    ++scene_serial_;
+  }
+  if (have_scene_ && reader_->read_snapshot(*snapshot_) && snapshot_->body_count == scene_->body_count) {
+    auto message = std::make_shared<std::string>();
+    encode_frame(*snapshot_, true, 1.0, *message);
+    frame_message_ = std::move(message);
+    ++frame_serial_;
+    ++snapshots_read_;
+  }
+  if (!reader_->world_alive()) {
+    std::fprintf(stderr, "viewer: the world at '%s' has left; waiting for one to start\n", reader_->name().c_str());
+    rejected_before_ += reader_->rejected();
+    reader_.reset();
+  }
+}
+
+std::shared_ptr<const std::string> LiveFeed::next_frame(Playback& playback, double /*elapsed_s*/) {
+  if (frame_message_ == nullptr || playback.frame_serial == frame_serial_) return nullptr;
+  playback.frame_serial = frame_serial_;
+  return frame_message_;
+}
+
+bool LiveFeed::control(Playback& /*playback*/, const nlohmann::json& message) { return message.is_object(); }
+
+ReplayFeed::ReplayFeed(const std::string& dir)
+    : replay_(dir), snapshot_(std::make_unique<WorldSnapshot>()) {
+  scene_message_ = std::make_shared<const std::string>(
+      scene_message(replay_.scene(), dir, ReplayRange{replay_.start_s(), replay_.end_s(), replay_.frame_count()}));
+}
+
+std::shared_ptr<const std::string> ReplayFeed::next_frame(Playback& playback, double elapsed_s) {
+  if (playback.frame == SIZE_MAX) playback.time_s = replay_.start_s();  // a new page starts at the beginning
+  if (playback.playing) {
+    playback.time_s += elapsed_s * playback.speed;
+    if (playback.time_s >= replay_.end_s()) {  // stop at the end, showing the trial's final state
+      playback.time_s = replay_.end_s();
+      playback.playing = false;
+      playback.frame = SIZE_MAX - 1;  // resend: the page learns it stopped
+    }
+  }
+  const std::size_t frame = replay_.frame_at(playback.time_s);
+  if (frame == playback.frame) return nullptr;
+  playback.frame = frame;
+  replay_.snapshot(frame, *snapshot_);
+  auto message = std::make_shared<std::string>();
+  encode_frame(*snapshot_, playback.playing, playback.speed, *message);
+  return message;
+}
+
+bool ReplayFeed::control(Playback& playback, const nlohmann::json& message) {
+  if (!message.is_object() || message.size() != 1) return false;
+  const auto entry = message.begin();
+  const std::string& key = entry.key();
+  const nlohmann::json& value = entry.value();
+  if (key == "play" && value.is_boolean()) {
+    playback.playing = value.get<bool>();
+    if (playback.playing && playback.time_s >= replay_.end_s()) playback.time_s = replay_.start_s();  // play again
+  } else if (key == "speed" && value.is_number()) {
+    const double speed = value.get<double>();
+    if (!(speed >= kMinReplaySpeed && speed <= kMaxReplaySpeed)) return false;
+    playback.speed = speed;
+  } else if (key == "seek" && value.is_number()) {
+    const double time_s = value.get<double>();
+    if (!std::isfinite(time_s)) return false;
+    playback.time_s = std::clamp(time_s, replay_.start_s(), replay_.end_s());
+  } else {
+    return false;
+  }
+  playback.frame = SIZE_MAX - 1;  // send the frame again: it carries the new playing flag and speed
+  return true;
+}
+
+}  // namespace impetus::view

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// What the viewer sends its page over the WebSocket at /ws, and what the page may send back. The page
+// (viewer/web/viewer.js) decodes exactly this; a change here is a change there.
+//
+// 1. On connect, and again whenever the world behind the viewer changes (a restarted world, another scene), one text
+//    message, the scene:
+//      {"type": "scene", "mode": "live" | "replay", "source": "<shm name or trial folder>",
+//       "coupling": "impulse" | "position" | "local", "world_rate_hz": 20,
+//       "floor": {"present": true, "height_m": 0.0},
+//       "bodies": [{"name": "cube", "shape": "box" | "sphere" | "capsule" | "cylinder", "dynamic": true,
+//                   "size_m": [x, y, z],   (box: full extents)   "radius_m": r, "length_m": l}, ...],
+//       "replay": {"start_s": t0, "end_s": t1, "frame_count": n}}          (replay only)
+//    Body k of every frame below is bodies[k]. Capsule and cylinder axes are body z; a capsule's length excludes its
+//    caps.
+//
+// 2. Each world frame, one binary message: little-endian float64 values (a Float64Array on the page):
+//      header, kFrameHeaderValues values:
+//        [0] kind = 1 (a frame)       [1] frame index i        [2] world time at the end of step i, s
+//        [3] world period, s          [4] body count B         [5] endpoint count E
+//        [6] haptic lateness p99, s (NaN: unknown, e.g. lockstep or replay)
+//        [7] haptic faults            [8] world skipped periods  [9] haptic skipped periods
+//        [10] playing (replay: 1 or 0; live: 1)                  [11] replay speed (live: 1)
+//        [12..15] reserved, 0
+//      then B bodies, kBodyValues each: position x, y, z (m), orientation w, x, y, z (unit quaternion, body → world)
+//      then E endpoints, each kEndpointValues followed by 6·P plane values:
+//        endpoint id, finger valid (1/0), finger x, y, z (m), proxy x, y, z (m), force on the finger x, y, z (N),
+//        plane count P; then per plane: point x, y, z (m), outward unit normal x, y, z
+//    World frame right-handed, z up, SI units.
+//
+// 3. Page → viewer (replay only; ignored live), text messages of one JSON object:
+//      {"play": true | false}   {"speed": 0.1 .. 10}   {"seek": seconds of trial time}
+//    Anything else, or a message over kMaxClientMessageBytes, closes that connection; the viewer carries on.
+
+#include <cstddef>
+
+namespace impetus::view {
+
+inline constexpr int kFrameKind = 1;
+inline constexpr std::size_t kFrameHeaderValues = 16;
+inline constexpr std::size_t kBodyValues = 7;
+inline constexpr std::size_t kEndpointValues = 12;
+inline constexpr std::size_t kPlaneValues = 6;
+inline constexpr std::size_t kMaxClientMessageBytes = 4096;
+inline constexpr double kMinReplaySpeed = 0.1;
+inline constexpr double kMaxReplaySpeed = 10.0;
+
+}  // namespace impetus::view

@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "world_manager/world_view.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace impetus {
+namespace {
+
+ViewShape view_shape(ShapeKind kind) {
+  switch (kind) {
+    case ShapeKind::box: return ViewShape::box;
+    case ShapeKind::sphere: return ViewShape::sphere;
+    case ShapeKind::capsule: return ViewShape::capsule;
+    case ShapeKind::cylinder: return ViewShape::cylinder;
+  }
+  return ViewShape::box;
+}
+
+double squared_distance(const Vec3& a, const Vec3& b) {
+  const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+  return dx * dx + dy * dy + dz * dz;
+}
+
+}  // namespace
+
+void describe_scene(const Scene& scene, Coupling coupling, double world_rate_hz, std::uint64_t world_session,
+                    ViewScene& out) {
+  out.world_session = world_session;
+  out.coupling = coupling;
+  out.floor_present = scene.floor.present ? 1 : 0;
+  out.floor_height_m = scene.floor.height_m;
+  out.world_rate_hz = world_rate_hz;
+  out.body_count = static_cast<std::uint32_t>(std::min<std::size_t>(scene.objects.size(), kMaxViewBodies));
+  for (std::uint32_t k = 0; k < out.body_count; ++k) {
+    const SceneObject& object = scene.objects[k];
+    ViewBodyInfo& body = out.bodies[k];
+    body.shape = view_shape(object.shape.kind);
+    body.dynamic = object.dynamic ? 1 : 0;
+    body.box_size_m = object.shape.box_size_m;
+    body.radius_m = object.shape.radius_m;
+    body.length_m = object.shape.length_m;
+    body.name.fill('\0');
+    std::memcpy(body.name.data(), object.name.data(), std::min(object.name.size(), body.name.size() - 1));
+  }
+}
+
+ViewBodyPose scene_pose(const SceneObject& object) {
+  return {object.position_m, object.orientation_wxyz};
+}
+
+void take_snapshot(const World& world, const HapticReport* report, const LoopStats& world_stats,
+                   const LoopStats* haptic_stats, WorldSnapshot& out) {
+  const PlaneFrame& frame = world.frame();
+  out.world_session = frame.world_session;
+  out.frame_index = frame.frame_index;
+  out.world_time_s = world.time_s();
+  out.world_period_s = world.world_period_s();
+  out.world_stats = world_stats;
+  out.haptic_stats = haptic_stats != nullptr ? *haptic_stats : LoopStats{};
+
+  const auto states = world.states();
+  out.body_count = static_cast<std::uint32_t>(std::min<std::size_t>(states.size(), kMaxViewBodies));
+  for (std::uint32_t k = 0; k < out.body_count; ++k) {
+    const BodyPose& pose = states[k].pose;
+    out.bodies[k].position_m = to_vec3(pose.position_m);
+    out.bodies[k].orientation_wxyz = {pose.orientation.w(), pose.orientation.x(), pose.orientation.y(),
+                                      pose.orientation.z()};
+  }
+
+  out.endpoint_count = 0;
+  if (report == nullptr) return;
+  ViewEndpoint& endpoint = out.endpoints[0];
+  out.endpoint_count = 1;
+  endpoint.endpoint = report->endpoint;
+  endpoint.finger_valid = report->finger_valid;
+  endpoint.finger_m = report->finger_m;
+  endpoint.proxy_m = report->proxy_m;
+  endpoint.force_N = report->force_N;
+  // The planes nearest the proxy: those the finger can be touching. Selection on at most kMaxPlanes indices.
+  std::array<std::uint32_t, kMaxPlanes> order{};
+  const std::uint32_t count = std::min(frame.plane_count, kMaxPlanes);
+  for (std::uint32_t p = 0; p < count; ++p) order[p] = p;
+  const std::uint32_t shown = std::min(count, kMaxViewPlanes);
+  std::partial_sort(order.begin(), order.begin() + shown, order.begin() + count,
+                    [&](std::uint32_t a, std::uint32_t b) {
+                      return squared_distance(frame.planes[a].point_m, report->proxy_m) <
+                             squared_distance(frame.planes[b].point_m, report->proxy_m);
+                    });
+  endpoint.plane_count = shown;
+  for (std::uint32_t p = 0; p < shown; ++p) {
+    endpoint.planes[p].point_m = frame.planes[order[p]].point_m;
+    endpoint.planes[p].normal = frame.planes[order[p]].normal;
+  }
+}
+
+}  // namespace impetus
