@@ -10,6 +10,7 @@
 #   4. 1 kHz real-time loop lateness (FIFO + mlock)    build/tests/bench_rt_loop SECONDS
 #   5. lockstep throughput of the tap trial (simulated s per wall s, target >= 50x) via scripts/run.sh
 #   6. peak RSS of each process during a tap trial
+#   7. the world view: snapshot size and cost per world step, a viewer's read and encode   build/tests/bench_world_view
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -18,7 +19,7 @@ rt_seconds=30
 while (($#)); do
   case "$1" in
     --short) rt_seconds=5; shift ;;
-    -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -119,3 +120,6 @@ for scene in tap spheres; do
     awk -v name="$name" -v kb="$kb" 'BEGIN { printf "    %-18s peak RSS %6.1f MiB\n", name, kb / 1024 }'
   done
 done
+
+section "7. World view: snapshot size and cost per world step, and a viewer's per frame, vs number of bodies"
+bench bench_world_view

@@ -17,7 +17,8 @@ bash scripts/run.sh --scene scenes/tap.json --trajectory tap --out out/figures/t
 /usr/bin/python3 scripts/tap_task.py --methods position,impulse,local --out out/figures/tap_task
 cp out/figures/tap_task/tap_task.png docs/tap_task.png
 cp out/figures/tap_task/tap_task.md docs/tap_task.md
-# The viewer watching a real-time tap trial, in headless Chromium (the browser test's live case takes the picture).
+# The viewer replaying a lockstep tap trial at its hardest push, in headless Chromium (the browser test's replay case
+# takes the picture).
 bash scripts/deps.sh --browser
-node tests/viewer/viewer_test.mjs --build build --case live --picture docs/viewer_tap.png
+node tests/viewer/viewer_test.mjs --build build --case replay --picture docs/viewer_tap.png
 echo "figures written to docs/ (speed vs error: scripts/speed_vs_error.py --docs; hard cases: scripts/hard_cases.py)"

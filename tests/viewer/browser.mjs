@@ -96,6 +96,13 @@ export class Processes {
   }
 }
 
+// CPU seconds a process has used (user + system), from /proc; its clock ticks are 100 per second on Linux.
+export function cpuSeconds(pid) {
+  const stat = fs.readFileSync(`/proc/${pid}/stat`, "utf8");
+  const fields = stat.slice(stat.lastIndexOf(")") + 2).split(" ");
+  return (Number(fields[11]) + Number(fields[12])) / 100;  // utime, stime: fields 14 and 15 of stat
+}
+
 export function readCsv(file) {
   const lines = fs.readFileSync(file, "utf8").split("\n").filter((line) => line.length > 0);
   const columns = lines[0].split(",");

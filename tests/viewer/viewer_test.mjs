@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The viewer in a real browser (headless Chromium driven by Playwright), against the project's own binaries.
 //   node tests/viewer/viewer_test.mjs --build BUILD_DIR --case live|replay|bodies|kill|bad-input [--picture FILE]
-// --picture (live only): also saves the page mid-slide as FILE (the README's picture; scripts/make_figures.sh).
+// --picture (replay only): also saves the page at the tap's hardest push as FILE (the README's picture;
+// scripts/make_figures.sh).
 // Each case starts what it needs under a shared-memory name of its own, prints what it checks and measures, and exits
 // 0 if every check held, 1 otherwise.
 
@@ -11,7 +12,7 @@ import path from "node:path";
 import { fileURLToPath } from "node:url";
 import {
   Failure, Processes, angleDeg, changedPixels, check, colourCount, csvPose, decodePng, distance, launchBrowser,
-  readCsv, sleep, view, waitFor,
+  cpuSeconds, readCsv, sleep, view, waitFor,
 } from "./browser.mjs";
 
 const source = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../..");
@@ -51,6 +52,7 @@ async function live(procs, browser) {
   const world = procs.start("world", "world_manager", ["--scene", tapScene, "--clock", "realtime", "--shm", shm,
     "--log", path.join(outDir, "world.csv")]);
   const viewer = await procs.viewer(["--shm", shm]);
+  const viewerStart = { cpu: cpuSeconds(viewer.pid), wall: Date.now() };
   const page = await openPage(browser, viewer.url);
   await waitFor("the page's first frames", async () => (await view(page))?.framesReceived > 5);
   const haptic = procs.start("haptic", "haptic_controller", ["--clock", "realtime", "--shm", shm,
@@ -71,9 +73,10 @@ async function live(procs, browser) {
     await sleep(100);
   }
   const second = await capture(page, "cube");
-  await page.screenshot({ path: option("--picture") ?? path.join(outDir, "page.png") });
+  await page.screenshot({ path: path.join(outDir, "page.png") });
   for (let i = 0; i < 10; ++i) { samples.push((await view(page)).latest); await sleep(100); }
   const state = await view(page);
+  const viewerCpu = (cpuSeconds(viewer.pid) - viewerStart.cpu) / ((Date.now() - viewerStart.wall) / 1000);
   await procs.stop(device);
   await procs.stop(haptic);
   await procs.stop(viewer);
@@ -111,7 +114,8 @@ async function live(procs, browser) {
   console.log(`  measured: haptic lateness with a viewer and a page watching (and a browser rendering on the same ` +
     `2 cores): p50 ${loop.lateness_p50_ns / 1e3} µs, p99 ${loop.lateness_p99_ns / 1e3} µs, ` +
     `max ${loop.lateness_max_ns / 1e3} µs`);
-  console.log(`  measured: page ${state.fps.toFixed(1)} fps, ${state.framesReceived} frames received`);
+  console.log(`  measured: page ${state.fps.toFixed(1)} fps, ${state.framesReceived} frames received; the viewer ` +
+    `used ${(100 * viewerCpu).toFixed(1)} % of a core serving one page`);
 }
 
 // A lockstep trial replayed: the replay reaches the trial's final pose.
@@ -140,7 +144,32 @@ async function replay(procs, browser) {
     return state?.latest && state.latest.worldTime_s === scene.replay.start_s;
   });
   check(true, "seeking back to the start shows the first frame");
+  if (option("--picture")) await picture(page, trial, option("--picture"));
   await procs.stop(viewer);
+}
+
+// The page at the frame where the finger pushes hardest, after playing up to it at half speed (so the strip charts
+// have the run-up).
+async function picture(page, trial, file) {
+  const world = readCsv(path.join(trial, "world.csv"));
+  const haptic = readCsv(path.join(trial, "haptic.csv"));
+  const [t, fx, fy, fz] = ["time_s", "force_x", "force_y", "force_z"].map((c) => haptic.column(c));
+  let hardest = haptic.rows[0];
+  for (const row of haptic.rows) {
+    if (Math.hypot(row[fx], row[fy], row[fz]) > Math.hypot(hardest[fx], hardest[fy], hardest[fz])) hardest = row;
+  }
+  // The first world frame at or after the hardest push shows the haptic row at its own time: the one just before.
+  const frameTime = world.rows.map((r) => r[world.column("time_s")]).find((time) => time >= hardest[t]);
+  await page.evaluate(() => window.impetusView.send({ seek: 0 }));
+  await page.evaluate(() => window.impetusView.send({ speed: 0.5 }));
+  await page.evaluate(() => window.impetusView.send({ play: true }));
+  await waitFor("the hardest push", async () => (await view(page))?.latest?.worldTime_s >= frameTime - 0.1, 30000, 20);
+  await page.evaluate(() => window.impetusView.send({ play: false }));
+  await page.evaluate((time) => window.impetusView.send({ seek: time }), frameTime);
+  await waitFor("the picture's frame", async () => (await view(page))?.latest?.worldTime_s === frameTime);
+  await sleep(500);
+  await page.screenshot({ path: file });
+  console.log(`  wrote ${file} (world time ${frameTime} s)`);
 }
 
 async function runTrial(out, extra) {
@@ -174,14 +203,17 @@ async function bodies(procs, browser) {
   const viewer = await procs.viewer(["--shm", shm]);
   const page = await openPage(browser, viewer.url);
   await waitFor("2000 bodies on the page", async () => (await view(page))?.latest?.bodies?.length === 2000, 30000);
+  const cpuBefore = cpuSeconds(viewer.pid);
   await sleep(3000);
+  const viewerCpu = (cpuSeconds(viewer.pid) - cpuBefore) / 3;
   const state = await view(page);
   const image = decodePng(await page.screenshot({ path: path.join(outDir, "bodies2000.png") }));
   await procs.stop(viewer);
   await procs.stop(world);
   check(state.renderedFrames > 0 && colourCount(image) > 20, `2000 bodies render (${colourCount(image)} colours)`);
-  console.log(`  measured: ${state.fps} fps with 2000 bodies in headless Chromium (software WebGL), ` +
-    `${state.framesReceived} world frames received`);
+  console.log(`  measured: ${state.fps.toFixed(1)} fps with 2000 bodies in headless Chromium (software WebGL), ` +
+    `${state.framesReceived} world frames received; the viewer used ${(100 * viewerCpu).toFixed(1)} % of a core ` +
+    `serving 112 kB frames at 20 Hz`);
 }
 
 // A viewer killed with kill -9 mid-trial leaves a lockstep trial's outcome bitwise unchanged.

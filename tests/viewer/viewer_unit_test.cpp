@@ -4,6 +4,7 @@
 
 #include "common/link/shm/shm_world_view.h"
 #include "viewer/replay.h"
+#include "viewer/view_feed.h"
 #include "viewer/view_encoding.h"
 #include "viewer/view_protocol.h"
 #include "viewer/viewer_node.h"
@@ -13,6 +14,7 @@
 #include "world_manager/world_view.h"
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <unistd.h>
 
@@ -203,6 +205,51 @@ TEST_CASE("viewer: a replay reads a trial's scene and logs; a malformed log is n
   CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("no column 'cube.x_m'"));
   std::ofstream(dir / "summary.json") << R"({"config": {"scene": "no/such/scene.json"}})";
   CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("/config/scene") && Catch::Contains("no such file"));
+}
+
+}  // namespace impetus
+
+namespace impetus {
+
+TEST_CASE("viewer: a replay page plays, pauses, seeks and changes speed on its own clock; bad controls are refused") {
+  const fs::path dir = scratch("replay_feed");
+  std::ofstream(dir / "summary.json") << R"({"config": {"scene": ")" << IMPETUS_SOURCE_DIR
+                                      << R"(/scenes/tap.json", "coupling": "impulse", "world_rate_hz": 20}})";
+  std::ofstream world(dir / "world.csv");
+  world << "time_s,cube.x_m,cube.y_m,cube.z_m,cube.qw,cube.qx,cube.qy,cube.qz\n";
+  for (int i = 1; i <= 20; ++i) world << i * 0.05 << ',' << 0.03 + 0.01 * i << ",0,0.025,1,0,0,0\n";
+  world.close();
+  view::ReplayFeed feed(dir.string());
+  const auto frame_time = [](const std::shared_ptr<const std::string>& message) {
+    REQUIRE(message != nullptr);
+    return values_of(*message)[2];
+  };
+  view::Playback page;
+  CHECK(frame_time(feed.next_frame(page, 0.0)) == 0.05);  // a new page starts at the first frame
+  CHECK(feed.next_frame(page, 0.01) == nullptr);          // nothing new within a frame
+  CHECK(frame_time(feed.next_frame(page, 0.1)) == Approx(0.15));
+  REQUIRE(feed.control(page, nlohmann::json::parse(R"({"speed": 4})")));
+  CHECK(frame_time(feed.next_frame(page, 0.1)) == Approx(0.55));  // 0.15 + 4 × 0.1
+  REQUIRE(feed.control(page, nlohmann::json::parse(R"({"play": false})")));
+  const auto paused = feed.next_frame(page, 0.0);  // sent again: it carries playing = 0
+  CHECK(values_of(*paused)[view::kFrameHeaderValues - 6] == 0.0);
+  CHECK(feed.next_frame(page, 1.0) == nullptr);  // paused: the clock stands
+  REQUIRE(feed.control(page, nlohmann::json::parse(R"({"seek": 0.5})")));
+  CHECK(frame_time(feed.next_frame(page, 1.0)) == Approx(0.5));
+  REQUIRE(feed.control(page, nlohmann::json::parse(R"({"play": true})")));
+  const auto at_end = feed.next_frame(page, 100.0);
+  CHECK(frame_time(at_end) == Approx(1.0));  // stops at the end, on the last frame, saying it stopped
+  CHECK(values_of(*at_end)[view::kFrameHeaderValues - 6] == 0.0);
+  CHECK(feed.next_frame(page, 1.0) == nullptr);
+
+  view::Playback other;  // another page keeps its own clock
+  CHECK(frame_time(feed.next_frame(other, 0.0)) == 0.05);
+
+  for (const char* bad : {R"({"speed": 0})", R"({"speed": 1e9})", R"({"seek": "x"})", R"({"play": 1})",
+                          R"({"jump": 1})", R"({"play": true, "speed": 2})", R"([1, 2])", R"("play")", "{}"}) {
+    INFO(bad);
+    CHECK_FALSE(feed.control(page, nlohmann::json::parse(bad)));
+  }
 }
 
 }  // namespace impetus
