@@ -97,3 +97,40 @@ TEST_CASE("a non-finite force commands minimum tensions and reports saturation")
   REQUIRE(s.saturated);
   for (const double t : s.tension_N) REQUIRE(t == geometry.tension_min_N);
 }
+
+TEST_CASE("the closed form on the exact-force line never renders worse than the 81 faces, and agrees at the centre") {
+  const SpidarGeometry geometry;
+  const auto m = motors(geometry);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int line_cases = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    // Fingers out to the rim of the workspace and forces up to twice the device's: both methods get used.
+    const double reach_m = trial % 2 ? 0.03 : 0.1;
+    const Vector3d finger = to_eigen(geometry.centre_m) + reach_m * Vector3d(u(rng), u(rng), u(rng));
+    const Vector3d force = 2.0 * geometry.max_force_N * std::abs(u(rng)) * Vector3d(u(rng), u(rng), u(rng)).normalized();
+    const TensionSolution fast = distribute_tension(force, finger, m, geometry.tension_min_N, geometry.tension_max_N);
+    const TensionSolution faces =
+        distribute_tension_by_faces(force, finger, m, geometry.tension_min_N, geometry.tension_max_N);
+    INFO("finger " << finger.transpose() << " force " << force.transpose());
+    const double fast_error = (fast.achieved_force_N - force).norm();
+    const double faces_error = (faces.achieved_force_N - force).norm();
+    // The faces carry the ε bias (ε·t/σ²): ~1e-5 N at the centre, but near the rim, where σ is small, enough to call a
+    // reachable force saturated. The line has no bias.
+    REQUIRE(fast_error <= faces_error + 1e-9);
+    double lowest = geometry.tension_max_N;
+    for (const double t : fast.tension_N) {
+      REQUIRE(t >= geometry.tension_min_N);
+      REQUIRE(t <= geometry.tension_max_N);
+      lowest = std::min(lowest, t);
+    }
+    if (fast_error < 1e-9) {
+      ++line_cases;
+      REQUIRE(lowest == geometry.tension_min_N);  // least tension: one string exactly at its minimum
+    }
+    if (reach_m < 0.05 && !faces.saturated) {
+      for (int i = 0; i < kStringCount; ++i) REQUIRE(fast.tension_N[i] == Approx(faces.tension_N[i]).margin(1e-3));
+    }
+  }
+  CHECK(line_cases > 10000);  // most of these requests are solved on the line
+}
