@@ -90,10 +90,11 @@ void run(const std::uint8_t* data, std::size_t size, bool sealed) {
     FUZZ_CHECK(frame.checksum == frame_checksum(frame));
     check_accepted(decoded);
   }
-  // The checksum must cover the frame: any changed byte before it must be rejected (here: the first byte, flipped).
+  // The checksum must cover the frame: a changed byte it covers must be rejected (here byte 8, which every frame's
+  // checksum covers: the second word of a frame sealed at its head, the second of one sealed at its tail).
   if (sealed) {
     WireFrame torn = frame;
-    reinterpret_cast<unsigned char*>(&torn)[0] ^= 0x01;
+    reinterpret_cast<unsigned char*>(&torn)[8] ^= 0x01;
     FUZZ_CHECK(validate(torn) == FrameError::checksum);
   }
 }

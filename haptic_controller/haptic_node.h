@@ -80,7 +80,7 @@ class HapticNode {
   double stiffness_Npm_ = 0.0;  // k_p and k_d of the last tick that rendered a force
   double damping_Nspm_ = 0.0;
   LatencyHistogram clock_stats_;
-  LatencyHistogram tick_cpu_ns_;  // CPU time of HapticServo::tick, per tick
+  LatencyHistogram tick_cpu_ns_;  // CPU time of HapticServo::tick, on every 64th tick
   std::uint64_t skipped_periods_ = 0;
 };
 

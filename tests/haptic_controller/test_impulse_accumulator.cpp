@@ -166,7 +166,7 @@ TEST_CASE("a full table evicts only entries the world has applied, else counts t
   REQUIRE(accumulator.dropped_shares() == 3);
 }
 
-TEST_CASE("a frame of a new world session starts the totals afresh; what the old world did not apply is abandoned") {
+TEST_CASE("a frame of a new world session starts the totals afresh, what the old world did not apply is abandoned") {
   ContactPlane cube_top = make_plane({0, 0, 0.05}, {0, 0, 1}, 1, true);
   cube_top.com_m = Vector3d(0, 0, 0.025);
   const PlaneSet planes = make_set({make_plane({0, 0, 0}, {0, 0, 1}, 0, false), cube_top});

@@ -136,7 +136,7 @@ TEST_CASE("local dynamics: a loose neighbour gives way to the push but carries t
   REQUIRE(model.find(1)->velocity_mps.x() >= 0.1 - 10 * 0.05 * 9.81 * 0.005);
 }
 
-TEST_CASE("local dynamics: a loose neighbour with a mass shares the push; one that comes on keeps driving the body") {
+TEST_CASE("local dynamics: a loose neighbour with a mass shares the push, one that comes on keeps driving the body") {
   // A 1 kg cube touching a 3 kg neighbour on its +x side (contact normal −x on the cube), no gravity, no friction.
   SECTION("pushed into a resting neighbour: the two move off together, momentum shared") {
     Plane face = cube_face();
@@ -335,7 +335,7 @@ Plane ball_on_floor(const Vector3d& velocity_mps, const Vector3d& spin_radps) {
 
 }  // namespace
 
-TEST_CASE("local dynamics: a ball rolling on the floor keeps its speed; a sliding one spins up to rolling at 5/7") {
+TEST_CASE("local dynamics: a ball rolling on the floor keeps its speed, a sliding one spins up to rolling at 5/7") {
   // The floor's friction acts at the contact point, as in the world: braking a rolling ball at μ·g would leave the
   // model's ball behind the world's when it comes to the finger.
   SECTION("rolling without slipping: v = ω × (r·z)") {

@@ -53,7 +53,7 @@ TEST_CASE("planes are blended between frames i−1 and i (paper 3.2), normals re
   REQUIRE((out.planes[0].point_m - Vector3d(0.01, 0, 0.02)).norm() < 1e-15);
 }
 
-TEST_CASE("planes are matched by object id, not by position in the frame; new objects start at frame i") {
+TEST_CASE("planes are matched by object id, not by position in the frame, new objects start at frame i") {
   const PlaneFrame previous =
       make_frame({wire_plane(1, {0, 0, 0}, {0, 0, 1}), wire_plane(2, {0.1, 0, 0}, {1, 0, 0})}, 0);
   PlaneFrame current = make_frame({wire_plane(2, {0.2, 0, 0}, {1, 0, 0}), wire_plane(3, {0, 0.3, 0}, {0, 1, 0}),

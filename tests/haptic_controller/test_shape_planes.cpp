@@ -86,7 +86,7 @@ Plane box_top_plane(const Vector3d& centre, const Eigen::Quaterniond& turn, cons
 
 }  // namespace
 
-TEST_CASE("box planes: a face's plane stays over the face; past its rim the box's nearest edge, corner or face") {
+TEST_CASE("box planes: a face's plane stays over the face, past its rim the box's nearest edge, corner or face") {
   const Vector3d centre(0.01, -0.02, 0.05);
   for (const Eigen::Quaterniond& turn :
        {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()))}) {

@@ -65,7 +65,7 @@ TEST_CASE("spidar driver: the encoders' finger, and tensions whose string forces
   CHECK(driver.counters().saturations == 0);
 }
 
-TEST_CASE("spidar driver: no device gives no sample; a broken reading an invalid one; both command minimum tension") {
+TEST_CASE("spidar driver: no device gives no sample, a broken reading an invalid one, both command minimum tension") {
   SpidarGeometry broken;
   broken.metres_per_count = std::nan("");  // every string length non-finite
   InProcessDevicePort port(1e-3);

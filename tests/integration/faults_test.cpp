@@ -187,8 +187,11 @@ TEST_CASE("random bytes written into a live world link are rejected and counted 
   {
     auto link = Segment<WorldLinkLayout>::open(world_link_name(daemons.shm));
     std::mt19937_64 random(11);
-    // Scribble over both channels, sequence words included, as a buggy or hostile process would.
+    // Scribble over both channels, sequence words included, as a buggy or hostile process would: over their first
+    // KiB, which holds the sequence words and every byte this trial's frames use (header, a few planes or entries;
+    // a channel carries only a frame's used bytes, so bytes beyond them are not part of any frame).
     auto scribble = [&](void* start, std::size_t size) {
+      size = std::min<std::size_t>(size, 1024);
       auto* bytes = static_cast<unsigned char*>(start);
       const std::size_t offset = random() % size;
       const std::size_t length = std::min<std::size_t>(size - offset, 1 + random() % 512);

@@ -44,7 +44,7 @@ std::vector<double> values_of(const std::string& message) {
 
 }  // namespace
 
-TEST_CASE("viewer: the world's snapshot carries every body's pose and the finger; the shm view passes it whole") {
+TEST_CASE("the world's snapshot carries every body's pose and the finger, the shm view passes it whole") {
   init_ode_once();
   const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json");
   World world(scene, WorldOptions{});
@@ -87,7 +87,7 @@ TEST_CASE("viewer: the world's snapshot carries every body's pose and the finger
   CHECK(reader.rejected() == 0);
 }
 
-TEST_CASE("viewer: a snapshot with a bad count, a non-finite pose or a non-unit quaternion is named, not used") {
+TEST_CASE("a snapshot with a bad count, a non-finite pose or a non-unit quaternion is named, not used") {
   auto snapshot = std::make_unique<WorldSnapshot>();
   snapshot->world_period_s = 0.05;
   snapshot->body_count = 2;
@@ -102,7 +102,7 @@ TEST_CASE("viewer: a snapshot with a bad count, a non-finite pose or a non-unit 
   CHECK_THAT(snapshot_problem(*snapshot), Catch::Contains("unit quaternion"));
 }
 
-TEST_CASE("viewer: a frame message is the header, 7 values per body, and per endpoint 12 plus 6 per plane") {
+TEST_CASE("a frame message is the header, 7 values per body, and per endpoint 12 plus 6 per plane") {
   auto snapshot = std::make_unique<WorldSnapshot>();
   snapshot->frame_index = 41;
   snapshot->world_time_s = 2.1;
@@ -134,7 +134,7 @@ TEST_CASE("viewer: a frame message is the header, 7 values per body, and per end
   CHECK(v[endpoint + view::kEndpointValues + view::kPlaneValues + 5] == 1.0);
 }
 
-TEST_CASE("viewer: only the page's files are served; nothing outside its folder, nothing hidden") {
+TEST_CASE("only the page's files are served, nothing outside its folder, nothing hidden") {
   const fs::path dir = scratch("web");
   std::ofstream(dir / "index.html") << "<html></html>";
   std::ofstream(dir / "viewer.js") << "";
@@ -164,7 +164,7 @@ TEST_CASE("viewer: only the page's files are served; nothing outside its folder,
   CHECK_THROWS_WITH(view::WebRoot(dir), Catch::Contains("three.js is not installed") && Catch::Contains("npm ci"));
 }
 
-TEST_CASE("viewer: --listen takes HOST:PORT on loopback; another address only with --allow-remote") {
+TEST_CASE("the listen address is HOST:PORT on loopback, another address only with --allow-remote") {
   CHECK(view::parse_listen("127.0.0.1:8080", false).port == 8080);
   CHECK(view::parse_listen("[::1]:0", false).host == "::1");
   CHECK_THROWS_WITH(view::parse_listen("0.0.0.0:8080", false), Catch::Contains("--allow-remote"));
@@ -174,7 +174,7 @@ TEST_CASE("viewer: --listen takes HOST:PORT on loopback; another address only wi
   CHECK_THROWS_WITH(view::parse_listen("8080", false), Catch::Contains("HOST:PORT"));
 }
 
-TEST_CASE("viewer: a replay reads a trial's scene and logs; a malformed log is named with its line and column") {
+TEST_CASE("a replay reads a trial's scene and logs, a malformed log is named with its line and column") {
   const fs::path dir = scratch("replay");
   std::ofstream(dir / "summary.json")
       << R"({"config": {"scene": ")" << IMPETUS_SOURCE_DIR << R"(/scenes/tap.json", "coupling": "local", "world_rate_hz": 20}})";
@@ -211,7 +211,7 @@ TEST_CASE("viewer: a replay reads a trial's scene and logs; a malformed log is n
 
 namespace impetus {
 
-TEST_CASE("viewer: a replay page plays, pauses, seeks and changes speed on its own clock; bad controls are refused") {
+TEST_CASE("a replay page plays, pauses, seeks and changes speed on its own clock, bad controls are refused") {
   const fs::path dir = scratch("replay_feed");
   std::ofstream(dir / "summary.json") << R"({"config": {"scene": ")" << IMPETUS_SOURCE_DIR
                                       << R"(/scenes/tap.json", "coupling": "impulse", "world_rate_hz": 20}})";

@@ -26,7 +26,7 @@ void touch(ContactGraph& graph, std::int32_t a, std::int32_t b, const Vector3d& 
 
 }  // namespace
 
-TEST_CASE("contact graph: a stack on the floor holds a press from above; four corner contacts are one support") {
+TEST_CASE("contact graph: a stack on the floor holds a press from above, four corner contacts are one support") {
   ContactGraph graph;
   graph.reset(2);
   for (int corner = 0; corner < 4; ++corner) graph.add(0, kStatic, Vector3d::UnitZ(), 0.3);  // box 0 on the floor
@@ -45,7 +45,7 @@ TEST_CASE("contact graph: a stack on the floor holds a press from above; four co
   }
 }
 
-TEST_CASE("contact graph: a loose row of balls gives way sideways; the same row against a wall holds") {
+TEST_CASE("contact graph: a loose row of balls gives way sideways, the same row against a wall holds") {
   ContactGraph graph;
   graph.reset(3);
   for (std::int32_t ball = 0; ball < 3; ++ball) graph.add(ball, kStatic, Vector3d::UnitZ(), 0.4);
@@ -99,7 +99,7 @@ TEST_CASE("contact graph: bad input is ignored, and a cycle of contacts ends") {
   REQUIRE(graph.local_contacts(9, {}, contacts) == 0);
 }
 
-TEST_CASE("contact graph: a contact with a dynamic body carries its velocity and inverse mass, the floor none; the "
+TEST_CASE("contact graph: a contact with a dynamic body carries its velocity and inverse mass, the floor none, the "
           "friction capacity is the sum of mu times each contact's normal force") {
   ContactGraph graph;
   graph.reset(2);

@@ -176,7 +176,7 @@ TEST_CASE("planes carry the object's state, friction and the floor") {
   CHECK(frame.stiffness_Npm == 2000.0);
 }
 
-TEST_CASE("a query an object moved onto keeps the face it met, for every shape and orientation; without memory it "
+TEST_CASE("a query an object moved onto keeps the face it met, for every shape and orientation, without memory it "
           "gets the far face") {
   // An object sweeps along -x onto a still query point, 0.6 of its x extent per step (faster than half its size in
   // one world period), starting just clear of the query. The face the query met is the one it stays on.

@@ -17,8 +17,10 @@ class LatestValid {
   // The newest valid frame into `out`; false if none was ever valid. Allocation-free.
   bool read(const SeqlockChannel<Wire>& channel, Frame& out) {
     std::uint64_t any = 0;  // the newest frame, new or not
-    if (channel.try_read(wire_, any)) {
-      if (decode(wire_, frame_) == FrameError::ok) {
+    std::size_t copied = 0;
+    if (channel.try_read(wire_, any, 4, &copied)) {
+      // The frame's count must not claim more than its writer wrote (a scribbled count).
+      if (used_bytes(wire_) <= copied && decode(wire_, frame_) == FrameError::ok) {
         have_ = true;
       } else {
         ++rejected_;

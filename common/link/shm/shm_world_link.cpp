@@ -28,7 +28,7 @@ bool ShmWorldLinkServer::latest_report(HapticReport& out) { return reports_.read
 
 void ShmWorldLinkServer::publish_frame(const PlaneFrame& frame) {
   encode(frame, frame_wire_);
-  if (!segment_->planes.write(frame_wire_)) ++repairs_;
+  if (!segment_->planes.write(frame_wire_, used_bytes(frame_wire_))) ++repairs_;
 }
 
 void ShmWorldLinkServer::publish_stats(const LoopStats& stats) {
@@ -73,8 +73,9 @@ bool ShmWorldLinkClient::receive_frame(PlaneFrame& out) {
     frames_from_ = current;
     last_frame_sequence_ = 0;
   }
-  if (!current->planes.try_read(frame_wire_, last_frame_sequence_)) return false;
-  if (decode(frame_wire_, out) != FrameError::ok) {
+  std::size_t copied = 0;
+  if (!current->planes.try_read(frame_wire_, last_frame_sequence_, 4, &copied)) return false;
+  if (used_bytes(frame_wire_) > copied || decode(frame_wire_, out) != FrameError::ok) {
     ++rejected_;
     return false;
   }
@@ -83,7 +84,7 @@ bool ShmWorldLinkClient::receive_frame(PlaneFrame& out) {
 
 void ShmWorldLinkClient::publish_report(const HapticReport& report) {
   encode(report, report_wire_);
-  if (!world().report.write(report_wire_)) ++repairs_;
+  if (!world().report.write(report_wire_, used_bytes(report_wire_))) ++repairs_;
 }
 
 void ShmWorldLinkClient::publish_stats(const LoopStats& stats) {

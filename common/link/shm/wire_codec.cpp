@@ -14,21 +14,36 @@ namespace {
 // the slack admits normals that went through a float round trip or an interpolation, and rejects garbage.
 constexpr double kUnitNormalTolerance = 1e-6;
 
-// Mixes every 64-bit word before the checksum field. Not cryptographic: it only has to make a torn or scribbled frame
-// (random bytes, half of two frames) fail with overwhelming probability, cheaply enough for a 1 kHz writer.
+// Mixes the 64-bit words of bytes [begin, end) of a frame, and the length. Not cryptographic: it only has to make a
+// torn or scribbled frame (random bytes, half of two frames) fail with overwhelming probability, cheaply enough for a
+// 1 kHz writer.
 template <class Frame>
-std::uint64_t checksum_words(const Frame& frame) {
-  constexpr std::size_t covered = offsetof(Frame, checksum);
-  static_assert(covered % 8 == 0, "checksum must follow whole 64-bit words");
+std::uint64_t checksum_words(const Frame& frame, std::size_t begin, std::size_t end) {
   const auto* bytes = reinterpret_cast<const unsigned char*>(&frame);
-  std::uint64_t hash = 0x9E3779B97F4A7C15ull ^ covered;
-  for (std::size_t offset = 0; offset < covered; offset += 8) {
+  std::uint64_t hash = 0x9E3779B97F4A7C15ull ^ (end - begin);
+  for (std::size_t offset = begin; offset < end; offset += 8) {
     std::uint64_t word;
     std::memcpy(&word, bytes + offset, 8);
     hash = (hash ^ word) * 0xBF58476D1CE4E5B9ull;
     hash ^= hash >> 31;
   }
   return hash;
+}
+
+// A frame sealed at its head: the used bytes after the checksum.
+template <class Frame>
+std::uint64_t checksum_after_head(const Frame& frame) {
+  static_assert(offsetof(Frame, checksum) == 0, "the checksum leads the frame");
+  static_assert(sizeof(Frame) % 8 == 0, "whole 64-bit words");
+  return checksum_words(frame, sizeof(frame.checksum), used_bytes(frame));
+}
+
+// A frame sealed at its tail: every byte before the checksum.
+template <class Frame>
+std::uint64_t checksum_before_tail(const Frame& frame) {
+  constexpr std::size_t covered = offsetof(Frame, checksum);
+  static_assert(covered % 8 == 0, "checksum must follow whole 64-bit words");
+  return checksum_words(frame, 0, covered);
 }
 
 bool finite(double value) { return std::isfinite(value); }
@@ -140,10 +155,20 @@ const char* to_string(FrameError error) {
   return "unknown frame error";
 }
 
-std::uint64_t frame_checksum(const wire::PlaneFrame& frame) { return checksum_words(frame); }
-std::uint64_t frame_checksum(const wire::HapticReport& report) { return checksum_words(report); }
-std::uint64_t frame_checksum(const wire::DeviceCommand& command) { return checksum_words(command); }
-std::uint64_t frame_checksum(const wire::DeviceState& state) { return checksum_words(state); }
+std::size_t used_bytes(const wire::PlaneFrame& frame) {
+  return offsetof(wire::PlaneFrame, planes) + std::min(frame.plane_count, kMaxPlanes) * sizeof(wire::Plane);
+}
+std::size_t used_bytes(const wire::HapticReport& report) {
+  return offsetof(wire::HapticReport, entries) +
+         std::min(report.entry_count, kMaxImpulseEntries) * sizeof(wire::ObjectImpulse);
+}
+std::size_t used_bytes(const wire::DeviceCommand&) { return sizeof(wire::DeviceCommand); }
+std::size_t used_bytes(const wire::DeviceState&) { return sizeof(wire::DeviceState); }
+
+std::uint64_t frame_checksum(const wire::PlaneFrame& frame) { return checksum_after_head(frame); }
+std::uint64_t frame_checksum(const wire::HapticReport& report) { return checksum_after_head(report); }
+std::uint64_t frame_checksum(const wire::DeviceCommand& command) { return checksum_before_tail(command); }
+std::uint64_t frame_checksum(const wire::DeviceState& state) { return checksum_before_tail(state); }
 
 FrameError validate(const wire::PlaneFrame& frame) {
   if (frame.checksum != frame_checksum(frame)) return FrameError::checksum;
@@ -237,16 +262,19 @@ FrameError validate(const wire::DeviceState& state) {
   return FrameError::ok;
 }
 
-// Encoding copies every slot of the fixed arrays, so the wire frame never keeps a stale entry from an earlier frame.
+// Encoding copies the counted slots only: the rest is not part of the frame (used_bytes()), never sealed, sent or read.
+// A count over capacity is copied as it is, so the reader rejects the frame rather than receive a truncated one.
 void encode(const PlaneFrame& frame, wire::PlaneFrame& out) {
   visit_frame_header(frame, out, CopyInto{});
-  for (std::size_t k = 0; k < kMaxPlanes; ++k) visit_plane(frame.planes[k], out.planes[k], CopyInto{});
+  const std::uint32_t count = std::min(frame.plane_count, kMaxPlanes);
+  for (std::size_t k = 0; k < count; ++k) visit_plane(frame.planes[k], out.planes[k], CopyInto{});
   seal(out);
 }
 
 void encode(const HapticReport& report, wire::HapticReport& out) {
   visit_report_header(report, out, CopyInto{});
-  for (std::size_t k = 0; k < kMaxImpulseEntries; ++k) visit_entry(report.entries[k], out.entries[k], CopyInto{});
+  const std::uint32_t count = std::min(report.entry_count, kMaxImpulseEntries);
+  for (std::size_t k = 0; k < count; ++k) visit_entry(report.entries[k], out.entries[k], CopyInto{});
   seal(out);
 }
 

@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The shared-memory transport's encoding of the contract frames (common/contract/frames.h): the same fields in a
-// fixed layout of whole 64-bit words, every frame sealed with a checksum of the words before it.
+// fixed layout of whole 64-bit words, every frame sealed with a checksum. A plane frame and a haptic report carry
+// their checksum first and count only their used bytes (the header and the counted planes or entries, used_bytes()):
+// those alone are sealed, written to the channel and read back, so a report of one touched object costs ~0.3 KB a
+// tick, not its 7 KB capacity. The two small device frames are sealed whole, checksum last.
 //
 // Writers encode() a contract frame into its wire form (which seals it); readers decode(), which accepts a frame only
 // if its checksum matches and its content is usable (counts within capacity, numbers finite, normals unit, friction
@@ -12,6 +15,7 @@
 #include "common/contract/frames.h"
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <type_traits>
 
@@ -49,6 +53,7 @@ struct Plane {
 };
 
 struct PlaneFrame {
+  std::uint64_t checksum = 0;  // frame_checksum() of the used bytes after it; set by encode()
   std::uint64_t frame_index = 0;
   std::uint64_t world_session = 0;
   EndpointId endpoint = 0;
@@ -64,8 +69,7 @@ struct PlaneFrame {
   Vec3 gravity_mps2{};
   double world_substep_s = 0.0;
   double reach_radius_m = 0.0;
-  std::array<Plane, kMaxPlanes> planes{};
-  std::uint64_t checksum = 0;  // frame_checksum() of everything above; set by encode()
+  std::array<Plane, kMaxPlanes> planes{};  // the first plane_count are used
 };
 
 struct ObjectImpulse {
@@ -79,6 +83,7 @@ struct ObjectImpulse {
 };
 
 struct HapticReport {
+  std::uint64_t checksum = 0;  // frame_checksum() of the used bytes after it; set by encode()
   std::uint64_t tick = 0;
   std::uint64_t haptic_session = 0;
   EndpointId endpoint = 0;
@@ -92,8 +97,7 @@ struct HapticReport {
   std::uint32_t finger_valid = 0;
   std::uint32_t entry_count = 0;
   Vec3 static_impulse_Ns{};
-  std::array<ObjectImpulse, kMaxImpulseEntries> entries{};
-  std::uint64_t checksum = 0;
+  std::array<ObjectImpulse, kMaxImpulseEntries> entries{};  // the first entry_count are used
 };
 
 struct DeviceCommand {
@@ -133,7 +137,15 @@ enum class FrameError : std::uint32_t {
 };
 const char* to_string(FrameError error);
 
-// Checksums cover every byte of the frame before the checksum field.
+// The bytes of a frame that carry it: a plane frame's or report's header and counted planes or entries (a count over
+// capacity is taken as the capacity; validate() rejects it), a device frame whole.
+std::size_t used_bytes(const wire::PlaneFrame& frame);
+std::size_t used_bytes(const wire::HapticReport& report);
+std::size_t used_bytes(const wire::DeviceCommand& command);
+std::size_t used_bytes(const wire::DeviceState& state);
+
+// Checksums cover the used bytes after the checksum field (plane frame, report) or every byte before it (device
+// frames).
 std::uint64_t frame_checksum(const wire::PlaneFrame& frame);
 std::uint64_t frame_checksum(const wire::HapticReport& report);
 std::uint64_t frame_checksum(const wire::DeviceCommand& command);
@@ -145,7 +157,7 @@ FrameError validate(const wire::HapticReport& report);
 FrameError validate(const wire::DeviceCommand& command);
 FrameError validate(const wire::DeviceState& state);
 
-// Contract → wire, sealed. Entries beyond the frame's count are written as zeros. Allocation-free.
+// Contract → wire, sealed. Only the used bytes are written; entries beyond the count keep what they held. Allocation-free.
 void encode(const PlaneFrame& frame, wire::PlaneFrame& out);
 void encode(const HapticReport& report, wire::HapticReport& out);
 void encode(const DeviceCommand& command, wire::DeviceCommand& out);

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# CTest lists are ';'-separated: a Catch test whose name holds a ';' becomes two CTest tests that each match no test
+# case and pass without running anything. This fails if any test program has such a name.
+#   check_test_names.sh PROGRAM...
+set -euo pipefail
+status=0
+for program in "$@"; do
+  while IFS= read -r name; do
+    echo "check_test_names: ${program##*/}: '$name' holds a ';' (CTest would run nothing for it)" >&2
+    status=1
+  done < <("$program" --list-test-names-only | grep ';' || true)
+done
+((status == 0)) && echo "check_test_names: $# programs, no test name holds a ';'"
+exit "$status"
