@@ -16,7 +16,7 @@ IMPETUS_PACKAGES=(cmake g++ make pkg-config libeigen3-dev libode-dev libboost-de
                   time)  # /usr/bin/time: each process's peak RSS in scripts/bench.sh
 # The viewer's page comes from the npm registry; a machine without Node.js gets Debian's.
 command -v npm >/dev/null || IMPETUS_PACKAGES+=(nodejs npm)
-((browser)) && IMPETUS_PACKAGES+=(chromium)  # headless, driven by Playwright in tests/viewer
+((browser)) && IMPETUS_PACKAGES+=(chromium fonts-liberation)  # headless, driven by Playwright in tests/viewer; a font for the page's text
 missing=()
 for pkg in "${IMPETUS_PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed' || missing+=("$pkg")
