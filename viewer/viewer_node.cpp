@@ -69,7 +69,18 @@ int ViewerNode::run() {
   }
 
   asio::io_context io(1);
-  ViewServer server(io, {asio::ip::make_address(address.host), address.port}, web, *feed);
+  std::unique_ptr<ViewServer> server_owner;
+  try {
+    server_owner = std::make_unique<ViewServer>(io, asio::ip::tcp::endpoint{asio::ip::make_address(address.host),
+                                                                            address.port},
+                                                web, *feed);
+  } catch (const boost::system::system_error& error) {
+    throw std::runtime_error("--listen " + options_.listen + ": cannot serve there: " + error.code().message() +
+                             (error.code() == boost::asio::error::address_in_use
+                                  ? " (another viewer? choose another port, or port 0 for any free one)"
+                                  : ""));
+  }
+  ViewServer& server = *server_owner;
   const auto bound = server.local_endpoint();
   const std::string host = bound.address().is_v6() ? "[" + bound.address().to_string() + "]" : bound.address().to_string();
   std::printf("viewer: serving http://%s:%u/ (%s)\n", host.c_str(), static_cast<unsigned>(bound.port()),
