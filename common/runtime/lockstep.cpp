@@ -6,6 +6,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 
 namespace impetus {
@@ -14,7 +15,25 @@ namespace {
 // How often a waiter wakes to check its peer and the shutdown flag: short enough that a dead peer is noticed quickly,
 // long enough that idle waiting costs nothing measurable.
 constexpr long kWaitSliceNs = 100'000'000;
-constexpr std::int64_t kSpinNs = 50'000;
+// A waiter polls before it blocks, for at most kMaxSpinNs: a peer's turn is usually a few microseconds of work on the
+// other core, while waking a thread blocked in the kernel costs tens of microseconds on this VM.
+constexpr std::int64_t kMaxSpinNs = 50'000;
+constexpr std::int64_t kMinSpinNs = 1'000;
+
+// How long this thread polls: twice the waits it has seen lately, within [kMinSpinNs, kMaxSpinNs]. When the peer runs
+// on a free core its turns come within a few microseconds and the poll catches them. When the cores are busy (another
+// program, or more processes than cores) the peer cannot run while we poll, turns take a scheduler slice, and the
+// poll shrinks towards kMinSpinNs instead of burning 50 µs of the peer's CPU on every turn. Per thread: each process's
+// waiter adapts to what it waits for.
+thread_local std::int64_t t_spin_ns = kMaxSpinNs;
+
+void learn_wait(std::int64_t waited_ns) {
+  if (waited_ns < kMaxSpinNs / 2) {
+    t_spin_ns = std::clamp<std::int64_t>(2 * waited_ns, kMinSpinNs, kMaxSpinNs);  // a poll this long would catch it
+  } else {
+    t_spin_ns = std::max(kMinSpinNs, t_spin_ns / 2);  // polling would not have helped: poll less
+  }
+}
 
 std::int64_t monotonic_ns() {
   timespec now{};
@@ -74,19 +93,26 @@ LockstepTurn::Wait LockstepTurn::wait_slice(std::atomic<std::uint32_t>& turn) {
     if (turn.compare_exchange_strong(expected, 0, std::memory_order_acq_rel)) return 1;
     return expected == 0 ? 0 : -1;
   };
-  // A peer's turn is usually a few microseconds of work on the other core, while waking a thread blocked in the kernel
-  // costs tens of microseconds on this VM: poll briefly first, then block. The poll is bounded (kSpinNs) so a long
-  // turn (a world step of a big scene) or a machine shared by more processes wastes at most that much per wait.
-  const std::int64_t spin_until_ns = monotonic_ns() + kSpinNs;
+  // Poll briefly first (t_spin_ns, adapted to the waits seen), then block.
+  const std::int64_t start_ns = monotonic_ns();
+  const std::int64_t spin_until_ns = start_ns + t_spin_ns;
+  std::int64_t now_ns = start_ns;
   do {
     const int taken = take();
-    if (taken != 0) return taken > 0 ? Wait::posted : Wait::corrupted;
+    if (taken != 0) {
+      learn_wait(now_ns - start_ns);
+      return taken > 0 ? Wait::posted : Wait::corrupted;
+    }
     cpu_relax();
-  } while (monotonic_ns() < spin_until_ns);
+    now_ns = monotonic_ns();
+  } while (now_ns < spin_until_ns);
   const std::int64_t deadline_ns = monotonic_ns() + kWaitSliceNs;
   for (;;) {
     const int taken = take();
-    if (taken != 0) return taken > 0 ? Wait::posted : Wait::corrupted;
+    if (taken != 0) {
+      learn_wait(monotonic_ns() - start_ns);
+      return taken > 0 ? Wait::posted : Wait::corrupted;
+    }
     const std::int64_t left_ns = deadline_ns - monotonic_ns();
     if (left_ns <= 0) return Wait::slice_over;
     const timespec timeout{static_cast<time_t>(left_ns / 1'000'000'000), static_cast<long>(left_ns % 1'000'000'000)};
