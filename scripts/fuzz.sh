@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # Builds the libFuzzer targets with clang (ASan+UBSan) in build-fuzz/ and fuzzes each for SECONDS (default 60).
-#   scripts/fuzz.sh [SECONDS] [TARGET...]     targets: scene trajectory_csv trajectory_spec frames (default: all)
+#   scripts/fuzz.sh [SECONDS] [TARGET...]     targets: scene trajectory_csv trajectory_spec frames view (default: all)
 # Each run starts from fuzz/corpus/<target> and fuzz/regressions/<target> (read only) and grows a working corpus in
 # build-fuzz/corpus/<target>. A crash or failed invariant stops that target, leaves the input in
 # build-fuzz/artifacts/<target>/ and makes the script exit non-zero after the remaining targets ran; to keep it as a
@@ -16,7 +16,7 @@ if (($#)) && [[ "$1" =~ ^[0-9]+$ ]]; then
   seconds=$1
   shift
 fi
-all_targets=(scene trajectory_csv trajectory_spec frames)
+all_targets=(scene trajectory_csv trajectory_spec frames view)
 targets=("$@")
 ((${#targets[@]})) || targets=("${all_targets[@]}")
 for target in "${targets[@]}"; do
@@ -32,7 +32,7 @@ CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInf
 cmake --build "$build_dir" -j2 --target "${targets[@]/#/fuzz_}"
 
 # PlaneFrame is ~23 kB: let the frame fuzzer grow inputs that fill all 64 planes (plus the selector byte).
-declare -A max_len=([scene]=8192 [trajectory_csv]=4096 [trajectory_spec]=512 [frames]=32768)
+declare -A max_len=([scene]=8192 [trajectory_csv]=4096 [trajectory_spec]=512 [frames]=32768 [view]=16384)
 failed=()
 for target in "${targets[@]}"; do
   work="$build_dir/corpus/$target"
