@@ -31,6 +31,7 @@ const tapScene = path.join(source, "scenes", "tap.json");
 async function capture(page, name) {
   const { url, at } = await page.evaluate((body) => ({ url: window.impetusView.capture(),
     at: window.impetusView.project(body) }), name);
+  if (!at) throw new Failure(`the page drew no body '${name}' in its capture`);
   return { image: decodePng(Buffer.from(url.slice(url.indexOf(",") + 1), "base64")), at };
 }
 

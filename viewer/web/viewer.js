@@ -91,15 +91,17 @@ const view = {
   get shown() { return { bodies: describePoses(shownPoses, shownCount) }; },
   send(message) { return sendControl(message); },
   project(name) { return projectBody(name); },   // where body `name` was drawn: {x, y} page pixels, or null
-  // The 3-D view as a PNG data URL, drawn now: a screenshot of the canvas alone that does not wait for the next
-  // animation frame (software WebGL under load can take a second to deliver one).
   // Points the camera at a sphere (centre [x, y, z] m, radius m) and stops it following the bodies, as a user's
   // own camera move does.
   lookAt(center, radius) {
     cameraTouched = true;
     aimCamera(new THREE.Vector3(center[0], center[1], center[2]), radius);
   },
+  // The 3-D view as a PNG data URL, drawn now with the bodies placed now: a screenshot of the canvas alone that does
+  // not wait for the next animation frame (software WebGL under load can take seconds to deliver one, the first
+  // after a scene longer still while shaders compile). `project` afterwards gives positions in this picture.
   capture() {
+    placeAll(performance.now());
     renderer.render(world, camera);
     return renderer.domElement.toDataURL('image/png');
   },
@@ -1275,6 +1277,14 @@ function resize() {
 }
 new ResizeObserver(resize).observe(viewElement);
 
+// Places bodies and endpoints where they are at page time `now` (ms), interpolated between the last two frames.
+function placeAll(now) {
+  if (!latest) return;
+  const alpha = interpolationAlpha(now);
+  drawBodies(alpha);
+  drawEndpoints(alpha);
+}
+
 function animate() {
   requestAnimationFrame(animate);
   const now = performance.now();
@@ -1283,11 +1293,7 @@ function animate() {
   const orbit = camera.position.distanceTo(controls.target);
   world.fog.near = orbit * 1.5;
   world.fog.far = orbit * 4;
-  if (latest) {
-    const alpha = interpolationAlpha(now);
-    drawBodies(alpha);
-    drawEndpoints(alpha);
-  }
+  placeAll(now);
   followBodies(now);
   renderer.render(world, camera);
   forceChart.draw();
