@@ -44,18 +44,35 @@ ServoOptions servo_options(const HapticNodeOptions& options, const DeviceLimits&
 
 }  // namespace
 
+std::string endpoint_log_path(const std::string& log_path, EndpointId endpoint) {
+  if (endpoint == 0 || log_path.empty()) return log_path;
+  const std::string suffix = ".endpoint" + std::to_string(endpoint);
+  const std::size_t slash = log_path.find_last_of('/');
+  const std::size_t dot = log_path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return log_path + suffix;
+  return log_path.substr(0, dot) + suffix + log_path.substr(dot);
+}
+
 HapticNode::HapticNode(const HapticNodeOptions& options, WorldLinkClient& world, HapticDevice& device)
-    : options_(options),
-      period_s_(1.0 / options.rate_hz),
-      world_(world),
-      device_(device),
-      servo_(servo_options(options, device.limits()), options.haptic_session) {
-  if (options.clock == ClockMode::lockstep) {
-    LockstepSchedule::ticks_per_world_step(world.info().world_period_s, options.rate_hz);  // throws if not whole
+    : options_(options), period_s_(1.0 / options.rate_hz), world_(world), device_(device) {
+  const std::uint32_t fingers = device.finger_count();
+  if (fingers == 0 || fingers > kMaxFingers || world.endpoints() != fingers) {
+    throw std::invalid_argument("the device has " + std::to_string(fingers) + " finger(s) but the world link was " +
+                                "opened for " + std::to_string(world.endpoints()) + " endpoint(s)");
   }
-  if (!options.log_path.empty()) {
-    log_.emplace(options.log_path, kLogHeader, format_row, kLogRows,
-                 options.clock == ClockMode::lockstep ? LogOverflow::wait : LogOverflow::drop, "haptic_controller");
+  if (options.clock == ClockMode::lockstep) {
+    schedule_.emplace(LockstepSchedule::ticks_per_world_step(world.info().world_period_s, options.rate_hz),
+                      world.info().phase_ticks);  // throws if not whole
+  }
+  const ServoOptions servo = servo_options(options, device.limits());
+  for (EndpointId k = 0; k < fingers; ++k) {
+    endpoints_.push_back(std::make_unique<Endpoint>(servo, options.haptic_session, k));
+    servos_.push_back(&endpoints_.back()->servo);
+    if (!options.log_path.empty()) {
+      endpoints_.back()->log.emplace(endpoint_log_path(options.log_path, k), kLogHeader, format_row, kLogRows,
+                                     options.clock == ClockMode::lockstep ? LogOverflow::wait : LogOverflow::drop,
+                                     "haptic_controller");
+    }
   }
 }
 
@@ -64,82 +81,104 @@ std::uint64_t HapticNode::max_ticks() const {
                                    : std::numeric_limits<std::uint64_t>::max();
 }
 
-void HapticNode::receive_frame(double now_s) {
-  if (world_.receive_frame(frame_buffer_)) servo_.on_plane_frame(frame_buffer_, now_s);
+void HapticNode::receive_frames(double now_s) {
+  for (std::size_t k = 0; k < endpoints_.size(); ++k) {
+    if (world_.receive_frame(static_cast<EndpointId>(k), frame_buffer_)) {
+      endpoints_[k]->servo.on_plane_frame(frame_buffer_, now_s);
+    }
+  }
 }
 
-// After the world's frame: the finger, the servo tick, the force to the device, the report to the world, the log.
+// After the world's frames: the fingers, a servo tick per finger, the forces to the device, the reports to the
+// world, a log row per finger.
 void HapticNode::tick(std::uint64_t tick, double now_s, double dt_s, std::int64_t lateness_ns) {
-  const FingerSample* finger = device_.read(tick, now_s);
-  // The servo's CPU time on every 64th tick: reading the thread's CPU clock is a system call (~1.4 µs here, more than
+  const FingerSample* fingers = device_.read(tick, now_s);
+  // The servos' CPU time on every 64th tick: reading the thread's CPU clock is a system call (~1.4 µs here, more than
   // the tick it would measure), and a sample of 1 in 64 gives the same percentiles over any run of seconds.
   const bool sampled = (tick & 63u) == 0;
   const std::int64_t cpu_before_ns = sampled ? thread_cpu_now_ns() : 0;
-  const TickResult& result = servo_.tick(finger, now_s, dt_s);
+  for (std::size_t k = 0; k < endpoints_.size(); ++k) {
+    const TickResult& result = endpoints_[k]->servo.tick(fingers != nullptr ? &fingers[k] : nullptr, now_s, dt_s);
+    commands_[k].force_N = to_eigen(result.force_N);
+    commands_[k].render = result.render;
+  }
+  exchange_pushes(servos_);
   if (sampled) tick_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
-  const bool saturated = !device_.command(tick, to_eigen(result.force_N), result.render);
-  const HapticReport& report = servo_.report();
-  world_.publish_report(report);
-
-  if (log_) {
-    HapticLogRow row{};
-    row.tick = tick;
-    row.time_s = now_s;
-    row.finger_m = result.finger_m;
-    row.proxy_m = result.proxy_m;
-    row.force_N = result.force_N;
-    for (std::uint32_t k = 0; k < report.entry_count; ++k) {
-      for (int a = 0; a < 3; ++a) row.object_impulse_Ns[a] += report.entries[k].impulse_Ns[a];
+  const std::uint32_t saturated = device_.command_fingers(tick, commands_.data());
+  for (std::size_t k = 0; k < endpoints_.size(); ++k) {
+    Endpoint& endpoint = *endpoints_[k];
+    world_.publish_report(endpoint.servo.report());
+    const TickResult& result = endpoint.servo.last_result();
+    log_tick(endpoint, tick, now_s, result, (saturated >> k) & 1u, lateness_ns);
+    if (result.render) {
+      endpoint.stiffness_Npm = result.stiffness_Npm;
+      endpoint.damping_Nspm = result.damping_Nspm;
     }
-    row.static_impulse_Ns = report.static_impulse_Ns;
-    row.interpolation_weight = result.interpolation_weight;
-    row.lateness_ns = lateness_ns;
-    row.active_planes = result.active_planes;
-    row.flags = (result.finger_valid ? 1u : 0u) | (saturated ? 2u : 0u) | (result.fault ? 4u : 0u) |
-                (result.world_stale ? 8u : 0u) | (result.sticking ? 16u : 0u);
-    log_->push(row);
+    endpoint.max_force_N = std::max(endpoint.max_force_N, std::sqrt(result.force_N[0] * result.force_N[0] +
+                                                                    result.force_N[1] * result.force_N[1] +
+                                                                    result.force_N[2] * result.force_N[2]));
   }
-  if (result.render) {
-    stiffness_Npm_ = result.stiffness_Npm;
-    damping_Nspm_ = result.damping_Nspm;
+}
+
+void HapticNode::log_tick(Endpoint& endpoint, std::uint64_t tick, double now_s, const TickResult& result,
+                          bool saturated, std::int64_t lateness_ns) {
+  if (!endpoint.log) return;
+  const HapticReport& report = endpoint.servo.report();
+  HapticLogRow row{};
+  row.tick = tick;
+  row.time_s = now_s;
+  row.finger_m = result.finger_m;
+  row.proxy_m = result.proxy_m;
+  row.force_N = result.force_N;
+  for (std::uint32_t k = 0; k < report.entry_count; ++k) {
+    for (int a = 0; a < 3; ++a) row.object_impulse_Ns[a] += report.entries[k].impulse_Ns[a];
   }
-  max_force_N_ = std::max(max_force_N_, std::sqrt(result.force_N[0] * result.force_N[0] +
-                                                  result.force_N[1] * result.force_N[1] +
-                                                  result.force_N[2] * result.force_N[2]));
+  row.static_impulse_Ns = report.static_impulse_Ns;
+  row.interpolation_weight = result.interpolation_weight;
+  row.lateness_ns = lateness_ns;
+  row.active_planes = result.active_planes;
+  row.flags = (result.finger_valid ? 1u : 0u) | (saturated ? 2u : 0u) | (result.fault ? 4u : 0u) |
+              (result.world_stale ? 8u : 0u) | (result.sticking ? 16u : 0u);
+  endpoint.log->push(row);
+}
+
+bool HapticNode::lockstep_tick(std::uint64_t t) {
+  if (t >= max_ticks() || g_stop_requested.load() || !device_.wait_attached()) return false;
+  // Exactly t·T: interpolation weights are then tick counts over n, the same in every run.
+  const double now_s = static_cast<double>(t) * period_s_;
+  tick(t, now_s, period_s_, 0);
+  if (schedule_->world_step_due(t)) {
+    if (world_.step_world(t)) {
+      receive_frames(now_s);
+    } else {
+      world_lost_ = true;
+    }
+  }
+  if (t % kStatsEveryTicks == 0) publish_stats(nullptr);
+  return true;
+}
+
+void HapticNode::finish_lockstep() {
+  // A world that died after its last step (between two steps, as the session ended) left the trial unfinished too.
+  if (!world_lost_ && !world_.world_alive()) world_lost_ = true;
+  world_.end_session();
+  device_.end_session();
+  // A lockstep trial is one deterministic run: a world or device that left mid-way makes it incomplete, whatever came
+  // after (each loss was reported when it happened).
+  if (world_lost_ || device_.counters().devices_lost > 0) {
+    std::fprintf(stderr, "haptic_controller: error: the trial is incomplete: the %s went away mid-trial (lockstep)\n",
+                 world_lost_ ? "world manager" : "device");
+    cut_short_ = true;
+  }
 }
 
 // Lockstep time advances only while a device is attached: a lockstep run is in step with its device, so a session
 // starts from the same state whenever the device attaches, and nothing is simulated while nobody is there.
 void HapticNode::run_lockstep() {
-  const LockstepSchedule schedule(LockstepSchedule::ticks_per_world_step(world_.info().world_period_s, options_.rate_hz),
-                                  world_.info().phase_ticks);
-  const std::uint64_t ticks = max_ticks();
-  bool world_lost = false;
   // A stop request is checked every tick: the followers' turns keep coming, so the stop must come from the master.
-  for (std::uint64_t t = 0; t < ticks && !g_stop_requested.load() && device_.wait_attached(); ++t) {
-    // Exactly t·T: interpolation weights are then tick counts over n, the same in every run.
-    const double now_s = static_cast<double>(t) * period_s_;
-    tick(t, now_s, period_s_, 0);
-    if (schedule.world_step_due(t)) {
-      if (world_.step_world(t)) {
-        receive_frame(now_s);
-      } else {
-        world_lost = true;
-      }
-    }
-    if (t % kStatsEveryTicks == 0) publish_stats(nullptr);
+  for (std::uint64_t t = 0; lockstep_tick(t); ++t) {
   }
-  // A world that died after its last step (between two steps, as the session ended) left the trial unfinished too.
-  if (!world_lost && !world_.world_alive()) world_lost = true;
-  world_.end_session();
-  device_.end_session();
-  // A lockstep trial is one deterministic run: a world or device that left mid-way makes it incomplete, whatever came
-  // after (each loss was reported when it happened).
-  if (world_lost || device_.counters().devices_lost > 0) {
-    std::fprintf(stderr, "haptic_controller: error: the trial is incomplete: the %s went away mid-trial (lockstep)\n",
-                 world_lost ? "world manager" : "device");
-    cut_short_ = true;
-  }
+  finish_lockstep();
 }
 
 void HapticNode::run_realtime() {
@@ -158,12 +197,13 @@ void HapticNode::run_realtime() {
   const std::uint64_t ticks = max_ticks();
   while (!g_stop_requested.load() && clock.ticks() < ticks) {
     const TickTiming timing = clock.wait_next();
-    receive_frame(timing.now_s);
+    receive_frames(timing.now_s);
     tick(timing.index, timing.now_s, timing.elapsed_s, timing.lateness_ns);
     if (timing.index % kStatsEveryTicks == 0) publish_stats(&clock);
   }
-  // The device's minimum output as the servo stops: the last force commanded would otherwise stay on the finger.
-  device_.command(clock.ticks(), Eigen::Vector3d::Zero(), false);
+  // The device's minimum output as the servo stops: the last force commanded would otherwise stay on the fingers.
+  commands_.fill(FingerCommand{});
+  device_.command_fingers(clock.ticks(), commands_.data());
   loop_done.store(true);
   supervisor.join();
   publish_stats(&clock);
@@ -178,64 +218,85 @@ int HapticNode::run() {
     run_realtime();
   }
   publish_stats(nullptr);
-  if (log_) log_->close();
+  bool log_failed = false;
+  for (auto& endpoint : endpoints_) {
+    if (!endpoint->log) continue;
+    endpoint->log->close();
+    log_failed = log_failed || endpoint->log->failed();
+  }
   // A failed log write was reported when it happened (rt_log.h), a trial cut short at its end.
-  return cut_short_ || (log_ && log_->failed()) ? 1 : 0;
+  return cut_short_ || log_failed ? 1 : 0;
 }
 
 void HapticNode::publish_stats(const RealtimeClock* clock) {
   LoopStats stats = loop_stats_now(clock);
-  stats.ticks = servo_.counters().ticks;
-  stats.faults = servo_.counters().faults;
+  stats.ticks = endpoints_[0]->servo.counters().ticks;
+  stats.faults = 0;
+  for (const auto& endpoint : endpoints_) stats.faults += endpoint->servo.counters().faults;
   stats.rejected_frames = world_.rejected_frames() + device_.counters().rejected_frames;
   world_.publish_stats(stats);
 }
 
-nlohmann::json HapticNode::summary() const {
-  const ServoCounters& counters = servo_.counters();
+nlohmann::json HapticNode::endpoint_summary(const Endpoint& endpoint) const {
+  const ServoCounters& counters = endpoint.servo.counters();
   nlohmann::json impulses = nlohmann::json::object();
-  const HapticReport& report = servo_.report();
+  const HapticReport& report = endpoint.servo.report();
   for (std::uint32_t k = 0; k < report.entry_count; ++k) {
     const ObjectImpulse& entry = report.entries[k];
     impulses[std::to_string(entry.object_id)] = {entry.impulse_Ns[0], entry.impulse_Ns[1], entry.impulse_Ns[2]};
   }
-  return {{"haptic",
-           {{"ticks", counters.ticks},
-            {"rate_hz", options_.rate_hz},
-            {"faults", counters.faults},
-            {"force_clamps", counters.force_clamps},
-            {"saturations", device_.counters().saturations},
-            {"devices_lost", device_.counters().devices_lost},
-            {"channel_repairs", world_.channel_repairs() + device_.counters().channel_repairs},
-            {"infeasible_contacts", counters.infeasible_contacts},
-            {"stale_world_ticks", counters.stale_world_ticks},
-            {"no_device_ticks", counters.no_device_ticks},
-            {"dropped_impulse_shares", counters.dropped_impulse_shares},
-            {"abandoned_impulse_Ns",
-             {servo_.accumulator().abandoned_impulse_Ns().x(), servo_.accumulator().abandoned_impulse_Ns().y(),
-              servo_.accumulator().abandoned_impulse_Ns().z()}},
-            {"contact_frame_boundaries", counters.contact_frame_boundaries},
-            {"frame_jump_max_m", counters.frame_jump_max_m},
-            {"local_model_error_max_m", counters.local_model_error_max_m},
-            {"rejected_frames", world_.rejected_frames() + device_.counters().rejected_frames},
-            {"world_attaches", world_.attaches()},
-            {"log_rows_dropped", log_ ? log_->dropped() : 0},
-            {"max_force_N", max_force_N_},
-            {"force_limit_N", device_.limits().max_force_N},
-            {"stiffness_Npm", stiffness_Npm_},
-            {"damping_Nspm", damping_Nspm_},
-            {"skipped_periods", skipped_periods_},
-            {"lateness_p50_ns", clock_stats_.percentile_ns(0.5)},
-            {"lateness_p99_ns", clock_stats_.percentile_ns(0.99)},
-            {"lateness_p999_ns", clock_stats_.percentile_ns(0.999)},
-            {"lateness_max_ns", clock_stats_.max_ns()},
-            {"cpu_per_tick_p50_ns", tick_cpu_ns_.percentile_ns(0.5)},
-            {"cpu_per_tick_p99_ns", tick_cpu_ns_.percentile_ns(0.99)},
-            {"cpu_per_tick_mean_ns", tick_cpu_ns_.mean_ns()},
-            {"cpu_per_tick_samples", tick_cpu_ns_.count()},  // every 64th tick
-            {"impulse_by_object_Ns", impulses},
-            {"static_impulse_Ns",
-             {report.static_impulse_Ns[0], report.static_impulse_Ns[1], report.static_impulse_Ns[2]}}}}};
+  const Eigen::Vector3d& abandoned = endpoint.servo.accumulator().abandoned_impulse_Ns();
+  return {{"endpoint", report.endpoint},
+          {"faults", counters.faults},
+          {"force_clamps", counters.force_clamps},
+          {"infeasible_contacts", counters.infeasible_contacts},
+          {"stale_world_ticks", counters.stale_world_ticks},
+          {"no_device_ticks", counters.no_device_ticks},
+          {"dropped_impulse_shares", counters.dropped_impulse_shares},
+          {"abandoned_impulse_Ns", {abandoned.x(), abandoned.y(), abandoned.z()}},
+          {"contact_frame_boundaries", counters.contact_frame_boundaries},
+          {"frame_jump_max_m", counters.frame_jump_max_m},
+          {"local_model_error_max_m", counters.local_model_error_max_m},
+          {"log_rows_dropped", endpoint.log ? endpoint.log->dropped() : 0},
+          {"max_force_N", endpoint.max_force_N},
+          {"stiffness_Npm", endpoint.stiffness_Npm},
+          {"damping_Nspm", endpoint.damping_Nspm},
+          {"impulse_by_object_Ns", impulses},
+          {"static_impulse_Ns", {report.static_impulse_Ns[0], report.static_impulse_Ns[1], report.static_impulse_Ns[2]}}};
+}
+
+nlohmann::json HapticNode::summary() const {
+  // The first endpoint's figures at the top level (a one-finger trial's summary, as it always was), every
+  // endpoint's under "endpoints"; the node's own (ticks, clock, device) once.
+  nlohmann::json haptic = endpoint_summary(*endpoints_[0]);
+  haptic.erase("endpoint");
+  std::uint64_t faults = 0;
+  nlohmann::json all = nlohmann::json::array();
+  for (const auto& endpoint : endpoints_) {
+    all.push_back(endpoint_summary(*endpoint));
+    faults += endpoint->servo.counters().faults;
+  }
+  haptic.update(nlohmann::json{
+      {"ticks", endpoints_[0]->servo.counters().ticks},
+      {"rate_hz", options_.rate_hz},
+      {"faults", faults},
+      {"saturations", device_.counters().saturations},
+      {"devices_lost", device_.counters().devices_lost},
+      {"channel_repairs", world_.channel_repairs() + device_.counters().channel_repairs},
+      {"rejected_frames", world_.rejected_frames() + device_.counters().rejected_frames},
+      {"world_attaches", world_.attaches()},
+      {"force_limit_N", device_.limits().max_force_N},
+      {"skipped_periods", skipped_periods_},
+      {"lateness_p50_ns", clock_stats_.percentile_ns(0.5)},
+      {"lateness_p99_ns", clock_stats_.percentile_ns(0.99)},
+      {"lateness_p999_ns", clock_stats_.percentile_ns(0.999)},
+      {"lateness_max_ns", clock_stats_.max_ns()},
+      {"cpu_per_tick_p50_ns", tick_cpu_ns_.percentile_ns(0.5)},
+      {"cpu_per_tick_p99_ns", tick_cpu_ns_.percentile_ns(0.99)},
+      {"cpu_per_tick_mean_ns", tick_cpu_ns_.mean_ns()},
+      {"cpu_per_tick_samples", tick_cpu_ns_.count()},  // every 64th tick
+      {"endpoints", all}});
+  return {{"haptic", haptic}};
 }
 
 }  // namespace impetus

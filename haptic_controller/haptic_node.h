@@ -9,6 +9,7 @@
 // Owns the servo, its log and statistics; its summary is the haptic half of summary.json (DESIGN.md §4).
 
 #include "common/link/world_link.h"
+#include "common/runtime/lockstep_schedule.h"
 #include "common/runtime/loop_stats.h"
 #include "common/runtime/rt_log.h"
 #include "haptic_controller/device/haptic_device.h"
@@ -16,10 +17,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace impetus {
 
@@ -47,38 +51,65 @@ struct HapticLogRow {
   std::uint32_t flags;  // bit 0 finger valid, 1 saturated, 2 fault, 3 world stale, 4 sticking
 };
 
+// The log of endpoint `endpoint` given the node's --log path: the path itself for endpoint 0, and for the others the
+// same name with ".endpointK" before the extension (haptic.csv → haptic.endpoint1.csv).
+std::string endpoint_log_path(const std::string& log_path, EndpointId endpoint);
+
+// A haptic node serves one endpoint per finger of its device (HapticDevice::finger_count()): a servo each, ticked in
+// finger order every tick, their forces commanded to the device together.
 class HapticNode {
  public:
   // The link and the device must outlive the node. Throws std::invalid_argument for a lockstep world period that is
-  // not a whole number of ticks, std::runtime_error if the log cannot be opened.
+  // not a whole number of ticks or a link whose endpoints do not match the device's fingers, std::runtime_error if a
+  // log cannot be opened.
   HapticNode(const HapticNodeOptions& options, WorldLinkClient& world, HapticDevice& device);
 
   // Runs until the duration, a stop request, or (lockstep) no device. Returns the exit status.
   int run();
 
-  // The haptic half of summary.json.
+  // Lockstep, driven from outside (several nodes in one process, the first the master): tick `t` of this node, with
+  // the world step due at it if this node's link is the master. False when the device has left or a stop was
+  // requested: the run is over; then finish_lockstep() ends it.
+  bool lockstep_tick(std::uint64_t t);
+  void finish_lockstep();
+
+  // The haptic half of summary.json; per endpoint under "endpoints".
   nlohmann::json summary() const;
-  const HapticServo& servo() const { return servo_; }
+  const HapticServo& servo(EndpointId endpoint = 0) const { return endpoints_[endpoint]->servo; }
+  std::uint32_t endpoint_count() const { return static_cast<std::uint32_t>(endpoints_.size()); }
 
  private:
+  // One finger's servo and what the node records about it.
+  struct Endpoint {
+    Endpoint(const ServoOptions& options, std::uint64_t session, EndpointId id) : servo(options, session, id) {}
+    HapticServo servo;
+    std::optional<RtLog<HapticLogRow>> log;
+    double max_force_N = 0.0;
+    double stiffness_Npm = 0.0;  // k_p and k_d of the last tick that rendered a force
+    double damping_Nspm = 0.0;
+  };
+
   void tick(std::uint64_t tick, double now_s, double dt_s, std::int64_t lateness_ns);
-  void receive_frame(double now_s);
+  void log_tick(Endpoint& endpoint, std::uint64_t tick, double now_s, const TickResult& result, bool saturated,
+                std::int64_t lateness_ns);
+  void receive_frames(double now_s);
   void run_lockstep();
   void run_realtime();
   void publish_stats(const class RealtimeClock* clock);
   std::uint64_t max_ticks() const;
+  nlohmann::json endpoint_summary(const Endpoint& endpoint) const;
 
   HapticNodeOptions options_;
   double period_s_;
   WorldLinkClient& world_;
   bool cut_short_ = false;  // lockstep: the world or the device went away mid-trial
+  bool world_lost_ = false;
   HapticDevice& device_;
-  HapticServo servo_;
-  std::optional<RtLog<HapticLogRow>> log_;
+  std::vector<std::unique_ptr<Endpoint>> endpoints_;
+  std::vector<HapticServo*> servos_;  // endpoints_[k]->servo, for exchange_pushes
+  std::array<FingerCommand, kMaxFingers> commands_{};
   PlaneFrame frame_buffer_{};
-  double max_force_N_ = 0.0;
-  double stiffness_Npm_ = 0.0;  // k_p and k_d of the last tick that rendered a force
-  double damping_Nspm_ = 0.0;
+  std::optional<LockstepSchedule> schedule_;  // lockstep only
   LatencyHistogram clock_stats_;
   LatencyHistogram tick_cpu_ns_;  // CPU time of HapticServo::tick, on every 64th tick
   std::uint64_t skipped_periods_ = 0;

@@ -69,7 +69,10 @@ std::array<Eigen::Vector3d, kMaxActiveConstraints + 1> split_by_normals(const Pl
 }  // namespace
 
 
-ImpulseAccumulator::ImpulseAccumulator(std::uint64_t haptic_session) { report_.haptic_session = haptic_session; }
+ImpulseAccumulator::ImpulseAccumulator(std::uint64_t haptic_session, EndpointId endpoint) {
+  report_.haptic_session = haptic_session;
+  report_.endpoint = endpoint;
+}
 
 void ImpulseAccumulator::on_plane_frame(const PlaneFrame& frame) {
   if (frame.world_session != report_.world_session) {

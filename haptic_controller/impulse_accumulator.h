@@ -55,7 +55,8 @@ struct ImpulseShare {
 
 class ImpulseAccumulator {
  public:
-  explicit ImpulseAccumulator(std::uint64_t haptic_session);
+  // The report names `endpoint` (the finger these totals belong to) of `haptic_session`.
+  explicit ImpulseAccumulator(std::uint64_t haptic_session, EndpointId endpoint = 0);
 
   // Learns how far the world has applied our reports (eviction rule), and starts the totals afresh for a frame of a
   // new world session.

@@ -21,8 +21,8 @@ double signed_distance_m(const Eigen::Vector3d& x_m, const Eigen::Vector3d& poin
 
 }  // namespace
 
-HapticServo::HapticServo(const ServoOptions& options, std::uint64_t haptic_session)
-    : options_(options), renderer_(options.max_force_N), accumulator_(haptic_session) {}
+HapticServo::HapticServo(const ServoOptions& options, std::uint64_t haptic_session, EndpointId endpoint)
+    : options_(options), renderer_(options.max_force_N), accumulator_(haptic_session, endpoint) {}
 
 void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   // Interpolate from the previous frame of the same world session only; the first frame starts where it is.
@@ -194,6 +194,16 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   // 6. The device renders it (DESIGN.md §1.2 step 6: the haptic node commands the device).
   result_.render = true;
   return result_;
+}
+
+void exchange_pushes(std::span<HapticServo* const> servos) {
+  if (servos.size() < 2) return;
+  for (HapticServo* receiver : servos) {
+    for (const HapticServo* pusher : servos) {
+      if (pusher == receiver) continue;
+      receiver->take_other_shares(pusher->accumulator().last_shares(), pusher->accumulator().last_share_count());
+    }
+  }
 }
 
 }  // namespace impetus

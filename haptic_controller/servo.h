@@ -19,6 +19,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <span>
 
 namespace impetus {
 
@@ -72,7 +73,8 @@ struct ServoCounters {
 
 class HapticServo {
  public:
-  HapticServo(const ServoOptions& options, std::uint64_t haptic_session);
+  // Serves endpoint `endpoint` of `haptic_session` (its reports name them).
+  HapticServo(const ServoOptions& options, std::uint64_t haptic_session, EndpointId endpoint = 0);
 
   // A validated world frame arrived at servo time now_s. Frames of a new world session restart interpolation.
   void on_plane_frame(const PlaneFrame& frame, double now_s);
@@ -82,6 +84,15 @@ class HapticServo {
   // invalid sample is the same plus a counted fault.
   const TickResult& tick(const FingerSample* finger, double now_s, double dt_s);
 
+  // Another endpoint of the same controller pushed these shares in this tick (its accumulator().last_shares()):
+  // local coupling's model moves the objects by them too, so each finger feels the others' pushes at once (paper
+  // §6.3; without it a grasped object gives way to each finger as if the other were not there). Other couplings
+  // ignore them: their planes move only with the world's frames. Call after this tick's tick().
+  void take_other_shares(const ImpulseShare* shares, int count) {
+    if (have_frame_) motion_->take_shares(shares, count);
+  }
+  // What the last tick gave (as tick() returned it).
+  const TickResult& last_result() const { return result_; }
   // Cumulative impulses and the finger, updated by every tick; the caller seals and publishes it.
   const HapticReport& report() const { return accumulator_.report(); }
   const ServoCounters& counters() const { return counters_; }
@@ -124,5 +135,9 @@ class HapticServo {
   TickResult result_{};
   ServoCounters counters_{};
 };
+
+// After every servo of one controller has ticked: hands each servo the others' shares of this tick
+// (HapticServo::take_other_shares), in order. Allocation-free.
+void exchange_pushes(std::span<HapticServo* const> servos);
 
 }  // namespace impetus

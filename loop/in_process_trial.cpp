@@ -84,7 +84,7 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   haptic_options.duration_s = options.duration_s;
   InProcessDevicePort port(1.0 / haptic_options.rate_hz);
   SpidarDriver driver(SpidarGeometry{}, port, ClockMode::lockstep, haptic_options.haptic_session);
-  HapticNode haptic(haptic_options, world_link, driver);
+  HapticNode haptic(haptic_options, world_link.attach(1), driver);
 
   DeviceSim sim(SpidarGeometry{}, HardwareParams{}, FingerParams{}, load_trajectory(options.trajectory));
   DeviceNode device(sim, port, log_path(options.out_dir, "device.csv"), 1);

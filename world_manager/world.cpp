@@ -18,7 +18,9 @@ World::World(const Scene& scene, const WorldOptions& options)
       ledger_(scene.objects.size() + 1),
       moment_ledger_(scene.objects.size() + 1),
       features_(scene_),
-      applied_(scene.objects.size()) {
+      applied_(scene.objects.size()),
+      endpoints_(kMaxEndpoints),
+      frames_(kMaxEndpoints) {
   if (options.world_rate_hz && !(*options.world_rate_hz > 0.0 && std::isfinite(*options.world_rate_hz))) {
     throw std::invalid_argument("world rate must be positive and finite, got " +
                                 std::to_string(*options.world_rate_hz));
@@ -39,43 +41,58 @@ World::World(const Scene& scene, const WorldOptions& options)
 
   refresh_states();
   features_.index(states_, period_s_);
-  frame_.world_session = options_.world_session;
-  frame_.world_period_s = period_s_;
-  frame_.coupling = options_.coupling;
-  frame_.gravity_mps2 = scene_.gravity_mps2;
-  frame_.world_substep_s = period_s_ / scene_.physics.substeps;
-  frame_.reach_radius_m = scene_.haptic.reach_radius_m;
+  for (PlaneFrame& frame : frames_) {
+    frame.world_session = options_.world_session;
+    frame.world_period_s = period_s_;
+    frame.coupling = options_.coupling;
+    frame.gravity_mps2 = scene_.gravity_mps2;
+    frame.world_substep_s = period_s_ / scene_.physics.substeps;
+    frame.reach_radius_m = scene_.haptic.reach_radius_m;
+  }
 }
 
 World::~World() = default;
 
-const PlaneFrame& World::step(const HapticReport* report) {
-  // Step 1: the finger, only if a device is attached. Without a new report the last sample stays the latest one.
-  if (report != nullptr) {
-    finger_.valid = report->finger_valid != 0 && all_finite(report->finger_m) &&
-                    all_finite(report->finger_velocity_mps);
-    if (finger_.valid) {
-      finger_.finger.position_m = to_eigen(report->finger_m);
-      finger_.finger.velocity_mps = to_eigen(report->finger_velocity_mps);
-      // Planes come from around the proxy (feature_extractor.h, ReachQuery); a report without a finite proxy
-      // falls back to the finger.
-      plane_query_ = finger_.finger;
-      if (all_finite(report->proxy_m)) {
-        plane_query_.position_m = to_eigen(report->proxy_m);
-        plane_query_.reach_extra_m = (finger_.finger.position_m - plane_query_.position_m).norm();
-      }
+std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> reports) {
+  if (reports.size() > kMaxEndpoints) {
+    throw std::invalid_argument("a world serves at most " + std::to_string(kMaxEndpoints) + " endpoints, not " +
+                                std::to_string(reports.size()));
+  }
+  slots_used_ = reports.size();
+  // Step 1: each slot's finger, only where a device is attached. Without a new report the last sample stays the
+  // latest one. A slot taken over by another endpoint (a controller restarted, another user) starts afresh.
+  for (std::size_t slot = 0; slot < reports.size(); ++slot) {
+    const HapticReport* report = reports[slot];
+    if (report == nullptr) continue;
+    Endpoint& endpoint = endpoints_[slot];
+    if (report->haptic_session != endpoint.haptic_session || report->endpoint != endpoint.endpoint) {
+      endpoint.haptic_session = report->haptic_session;
+      endpoint.endpoint = report->endpoint;
+      endpoint.finger = FingerState{};
+      endpoint.plane_faces = FeatureMemory{};
     }
+    take_finger(endpoint, *report);
   }
 
-  // Step 2: the coupling.
+  // Step 2: the coupling. Only totals counted against this world's own frames: a report counted against another
+  // world session (a world that died, or none yet) carries impulse this world never showed, and its objects started
+  // afresh from the scene. Slots are taken in order, so a run is reproducible whatever the reports hold.
   applied_.begin_step();
-  // Only totals counted against this world's own frames: a report counted against another world session (a world
-  // that died, or none yet) carries impulse this world never showed, and its objects started afresh from the scene.
-  const HapticReport* applied_report =
-      report != nullptr && report->world_session == options_.world_session ? report : nullptr;
-  if (report != nullptr && applied_report == nullptr) ++foreign_reports_;
-  if (applied_report != nullptr) take_report(*applied_report);
-  coupling_->before_step(finger_, features_);
+  std::array<const HapticReport*, kMaxEndpoints> applied{};
+  for (std::size_t slot = 0; slot < reports.size(); ++slot) {
+    const HapticReport* report = reports[slot];
+    if (report == nullptr) continue;
+    if (report->world_session != options_.world_session) {
+      ++foreign_reports_;
+      continue;
+    }
+    applied[slot] = report;
+    take_report(endpoints_[slot], *report);
+  }
+  for (std::size_t slot = 0; slot < kMaxEndpoints; ++slot) {
+    fingers_[slot] = slot < reports.size() ? endpoints_[slot].finger : FingerState{};
+  }
+  coupling_->before_step(std::span<const FingerState>(fingers_.data(), reports.size()), features_);
 
   // Step 3: the engine, with the coupling's forces before every substep.
   engine_->step(scene_.physics.substeps, period_s_ / scene_.physics.substeps, coupling_->needs_contacts(), *coupling_);
@@ -86,21 +103,39 @@ const PlaneFrame& World::step(const HapticReport* report) {
 
   // Step 4: planes and publication.
   features_.index(states_, period_s_);
-  publish(applied_report);
-  return frame_;
+  for (std::size_t slot = 0; slot < reports.size(); ++slot) publish(slot, applied[slot]);
+  return {frames_.data(), reports.size()};
 }
 
-void World::take_report(const HapticReport& report) {
+void World::take_finger(Endpoint& endpoint, const HapticReport& report) {
+  FingerState& finger = endpoint.finger;
+  finger.valid = report.finger_valid != 0 && all_finite(report.finger_m) && all_finite(report.finger_velocity_mps);
+  if (!finger.valid) return;
+  finger.finger.position_m = to_eigen(report.finger_m);
+  finger.finger.velocity_mps = to_eigen(report.finger_velocity_mps);
+  // Planes come from around the proxy (feature_extractor.h, ReachQuery); a report without a finite proxy falls back
+  // to the finger.
+  endpoint.plane_query = finger.finger;
+  if (all_finite(report.proxy_m)) {
+    endpoint.plane_query.position_m = to_eigen(report.proxy_m);
+    endpoint.plane_query.reach_extra_m = (finger.finger.position_m - endpoint.plane_query.position_m).norm();
+  }
+}
+
+void World::take_report(Endpoint& endpoint, const HapticReport& report) {
   // The impulses of this report were rendered after the previous report applied and up to this one: that window
   // maps onto this step (local coupling places each impulse in it).
-  const bool known_start = last_report_session_ == report.haptic_session && report.haptic_time_s > last_report_time_s_;
+  const bool known_start =
+      endpoint.last_report_session == report.haptic_session && report.haptic_time_s > endpoint.last_report_time_s;
   RenderWindow window;
-  window.length_s = known_start ? report.haptic_time_s - last_report_time_s_ : period_s_;
+  window.length_s = known_start ? report.haptic_time_s - endpoint.last_report_time_s : period_s_;
   window.start_s = report.haptic_time_s - window.length_s;
-  last_report_session_ = report.haptic_session;
-  last_report_time_s_ = report.haptic_time_s;
+  endpoint.last_report_session = report.haptic_session;
+  endpoint.last_report_time_s = report.haptic_time_s;
   const std::size_t floor_id = scene_.objects.size();
   const CounterOwner owner{report.haptic_session, report.endpoint};
+  std::vector<Eigen::Vector3d>& applied = applied_by_owner_[owner];
+  if (applied.empty()) applied.assign(floor_id + 1, Eigen::Vector3d::Zero());
   const std::uint32_t count = std::min(report.entry_count, kMaxImpulseEntries);
   for (std::uint32_t i = 0; i < count; ++i) {
     const ObjectImpulse& entry = report.entries[i];
@@ -111,6 +146,7 @@ void World::take_report(const HapticReport& report) {
     }
     const auto id = static_cast<std::size_t>(entry.object_id);
     const ImpulseDelta delta = ledger_.take(owner, entry);
+    applied[id] += delta.impulse_Ns;
     ObjectImpulse moments = entry;  // the moments through the same ledger rules (owner, epoch, baseline)
     moments.impulse_Ns = entry.impulse_moment_Nss;
     moments.angular_impulse_Nms = entry.angular_impulse_moment_Nmss;
@@ -125,6 +161,17 @@ void World::take_report(const HapticReport& report) {
   if (all_finite(report.static_impulse_Ns)) {
     total_static_impulse_Ns_ += ledger_.take_static(owner, report.static_impulse_Ns);
   }
+}
+
+Eigen::Vector3d World::applied_by(const CounterOwner& owner, std::size_t id) const {
+  const auto found = applied_by_owner_.find(owner);
+  return found != applied_by_owner_.end() && id < found->second.size() ? found->second[id] : Eigen::Vector3d::Zero();
+}
+
+std::vector<CounterOwner> World::impulse_owners() const {
+  std::vector<CounterOwner> owners;
+  for (const auto& [owner, impulses] : applied_by_owner_) owners.push_back(owner);
+  return owners;
 }
 
 const std::vector<std::size_t>& World::escaped() const { return engine_->escaped(); }
@@ -146,21 +193,25 @@ void World::refresh_states() {
   }
 }
 
-void World::publish(const HapticReport* applied_report) {
-  frame_.frame_index = steps_taken_ - 1;
+void World::publish(std::size_t slot, const HapticReport* applied_report) {
+  Endpoint& endpoint = endpoints_[slot];
+  PlaneFrame& frame = frames_[slot];
+  frame.frame_index = steps_taken_ - 1;
+  frame.endpoint = endpoint.endpoint;
   if (applied_report != nullptr) {
-    frame_.report_tick_applied = applied_report->tick;
-    frame_.report_session_applied = applied_report->haptic_session;
+    frame.report_tick_applied = applied_report->tick;
+    frame.report_session_applied = applied_report->haptic_session;
   }
-  frame_.world_time_s = time_s_;
-  frame_.stiffness_Npm = scene_.haptic.stiffness_Npm;
-  frame_.damping_Nspm = scene_.haptic.damping_Nspm;
+  frame.world_time_s = time_s_;
+  frame.stiffness_Npm = scene_.haptic.stiffness_Npm;
+  frame.damping_Nspm = scene_.haptic.damping_Nspm;
   // Without a finger there is nothing to be near: no planes until a device reports one.
-  plane_faces_.begin_step(states_.size());
-  frame_.plane_count =
-      finger_.valid ? features_.extract(plane_query_, states_, period_s_, frame_.planes, &plane_faces_) : 0;
-  if (!finger_.valid) frame_.planes.fill(Plane{});
-  coupling_->annotate(frame_);
+  endpoint.plane_faces.begin_step(states_.size());
+  const bool valid = endpoint.finger.valid;
+  frame.plane_count =
+      valid ? features_.extract(endpoint.plane_query, states_, period_s_, frame.planes, &endpoint.plane_faces) : 0;
+  if (!valid) frame.planes.fill(Plane{});
+  coupling_->annotate(frame);
 }
 
 double World::mechanical_energy_J() const {

@@ -20,7 +20,9 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -49,17 +51,25 @@ class World {
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
-  // One world step (DESIGN.md §1.1): read `report` (nullptr: none yet; the transport has validated it), hand its new
-  // impulses to the coupling (only if it counts against this world's session), advance the engine by T_w in `substeps` substeps, extract the planes around the finger
-  // and return the frame. The reference stays valid until the next step.
-  const PlaneFrame& step(const HapticReport* report);
+  // One world step (DESIGN.md §1.1) for every endpoint slot at once. `reports[k]` is the newest report of slot k
+  // (nullptr: none yet, or none new — the slot keeps its last finger); the transport has validated them. Each report's
+  // new impulses go to the coupling (only those counted against this world's session), the engine advances by T_w in
+  // the scene's substeps, and each slot gets a frame of the planes around its proxy. A slot taken over by another
+  // (haptic session, endpoint) starts afresh. At most kMaxEndpoints slots (std::invalid_argument otherwise); the
+  // returned frames, one per slot, stay valid until the next step.
+  std::span<const PlaneFrame> step(std::span<const HapticReport* const> reports);
+  // The same with a single endpoint slot: the one-finger trial.
+  const PlaneFrame& step(const HapticReport* report) { return step(std::span<const HapticReport* const>(&report, 1))[0]; }
 
   const Scene& scene() const { return scene_; }
   Coupling coupling() const { return options_.coupling; }
   double world_period_s() const { return period_s_; }
   double time_s() const { return time_s_; }
   std::uint64_t steps_taken() const { return steps_taken_; }
-  const PlaneFrame& frame() const { return frame_; }
+  // The frame of endpoint slot `slot` after the last step (slot 0 before any step: the frame header alone).
+  const PlaneFrame& frame(std::size_t slot = 0) const { return frames_[slot]; }
+  // The slots the last step served.
+  std::size_t endpoint_slots() const { return slots_used_; }
   // Objects the engine took out of the simulation after the solver threw them out of range (RigidBodyEngine::escaped).
   const std::vector<std::size_t>& escaped() const;
 
@@ -70,6 +80,11 @@ class World {
   const Eigen::Vector3d& step_impulse_Ns(std::size_t id) const { return applied_.step_Ns(id); }
   const Eigen::Vector3d& total_impulse_Ns(std::size_t id) const { return applied_.total_Ns(id); }
   const Eigen::Vector3d& total_angular_impulse_Nms(std::size_t id) const { return applied_.total_angular_Nms(id); }
+  // Impulse on object `id` taken from the reports of one endpoint of one haptic session, since it first reported
+  // (N·s; the ledger's differences, summed): per endpoint, what the world applied of what it rendered.
+  Eigen::Vector3d applied_by(const CounterOwner& owner, std::size_t id) const;
+  // Every (haptic session, endpoint) that has had impulse applied, in order.
+  std::vector<CounterOwner> impulse_owners() const;
   // Reaction into static geometry reported by the haptic side (cumulative over all its sessions), N·s.
   const Eigen::Vector3d& total_static_impulse_Ns() const { return total_static_impulse_Ns_; }
   // Report entries ignored because their object id was out of range or their numbers not finite.
@@ -82,9 +97,22 @@ class World {
   double mechanical_energy_J() const;
 
  private:
-  void take_report(const HapticReport& report);
+  // What the world keeps per endpoint slot between steps.
+  struct Endpoint {
+    std::uint64_t haptic_session = 0;  // the (session, endpoint) its reports came from; 0: none yet
+    EndpointId endpoint = 0;
+    FingerState finger;        // the sampled finger: position coupling's penetration
+    ReachQuery plane_query;    // where planes are extracted: the proxy, reach widened to cover the finger
+    FeatureMemory plane_faces; // the face of each object the plane query (the proxy) met, step to step
+    // The haptic time of the previous report applied: the impulses of the next one were rendered after it.
+    std::uint64_t last_report_session = 0;
+    double last_report_time_s = 0.0;
+  };
+
+  void take_finger(Endpoint& endpoint, const HapticReport& report);
+  void take_report(Endpoint& endpoint, const HapticReport& report);
   void refresh_states();
-  void publish(const HapticReport* applied_report);
+  void publish(std::size_t slot, const HapticReport* applied_report);
 
   Scene scene_;
   WorldOptions options_;
@@ -95,22 +123,20 @@ class World {
   // The same running totals' first moments in time (ObjectImpulse::impulse_moment_Nss), differenced with the same
   // owner/epoch rules as the impulses themselves: when within its window each impulse was rendered.
   ImpulseLedger moment_ledger_;
-  // The haptic time of the previous report applied: the impulses of the next one were rendered after it.
-  std::uint64_t last_report_session_ = 0;
-  double last_report_time_s_ = 0.0;
   FeatureExtractor features_;
-  FeatureMemory plane_faces_;  // the face of each object the plane query (the proxy) met, step to step
   AppliedImpulses applied_;
   std::unique_ptr<CouplingStrategy> coupling_;
   Eigen::Vector3d total_static_impulse_Ns_ = Eigen::Vector3d::Zero();
+  std::map<CounterOwner, std::vector<Eigen::Vector3d>> applied_by_owner_;  // per object (scene ids and the floor)
   std::uint64_t rejected_entries_ = 0;
   std::uint64_t foreign_reports_ = 0;
 
-  FingerState finger_;     // the sampled finger: position coupling's penetration
-  ReachQuery plane_query_;  // where planes are extracted: the proxy, reach widened to cover the finger
+  std::vector<Endpoint> endpoints_;   // kMaxEndpoints, allocated once
+  std::vector<PlaneFrame> frames_;    // per slot; kMaxEndpoints, allocated once (a frame is ~40 KB)
+  std::array<FingerState, kMaxEndpoints> fingers_{};  // each slot's finger, as the coupling takes them
+  std::size_t slots_used_ = 0;
   double time_s_ = 0.0;
   std::uint64_t steps_taken_ = 0;
-  PlaneFrame frame_{};
 };
 
 }  // namespace impetus

@@ -36,7 +36,10 @@ nlohmann::json to_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()};
 }  // namespace
 
 WorldNode::WorldNode(const WorldNodeOptions& options)
-    : options_(options), scene_(scene_with_overrides(options)), world_(scene_, world_options(options)) {
+    : options_(options),
+      scene_(scene_with_overrides(options)),
+      world_(scene_, world_options(options)),
+      reports_(kMaxEndpoints) {
   if (options.clock == ClockMode::lockstep) {
     const std::uint64_t ticks = LockstepSchedule::ticks_per_world_step(world_.world_period_s(), options.haptic_rate_hz);
     // Step i happens at tick i·n + phase: a phase of n or more only delays every step by whole periods, and a trial
@@ -97,32 +100,43 @@ void WorldNode::connect_view(WorldViewPublisher& view) {
 
 void WorldNode::step_world() {
   const std::int64_t now_ns = monotonic_now_ns();
-  HapticReport incoming;
-  if (link_->latest_report(incoming)) {
-    if (!have_report_ || incoming.haptic_session != report_session_ || incoming.tick != report_tick_) {
-      report_fresh_ns_ = now_ns;
-      report_session_ = incoming.haptic_session;
-      report_tick_ = incoming.tick;
+  const std::uint32_t slots = std::min(link_->endpoint_slots(), kMaxEndpoints);
+  // Slots past the last one that ever reported carry nothing: the world serves up to the last used slot.
+  std::uint32_t used = 0;
+  for (std::uint32_t slot = 0; slot < slots; ++slot) {
+    SlotReport& slot_report = reports_[slot];
+    HapticReport& incoming = incoming_;
+    if (link_->latest_report(slot, incoming)) {
+      if (!slot_report.have || incoming.haptic_session != slot_report.session || incoming.tick != slot_report.tick) {
+        slot_report.fresh_ns = now_ns;
+        slot_report.session = incoming.haptic_session;
+        slot_report.tick = incoming.tick;
+      }
+      slot_report.report = incoming;
+      slot_report.have = true;
     }
-    report_ = incoming;
-    have_report_ = true;
+    // An endpoint that stopped reporting (killed, stalled) no longer knows where the finger is: drop its finger so
+    // position coupling stops pushing with a stale sample. Its impulse totals stay as they were, so the ledger
+    // applies nothing more from them; a restarted controller starts a new session from zero.
+    if (options_.clock == ClockMode::realtime && slot_report.have &&
+        static_cast<double>(now_ns - slot_report.fresh_ns) * 1e-9 > endpoint_stale_s(world_.world_period_s())) {
+      slot_report.report.finger_valid = 0;
+    }
+    report_of_slot_[slot] = slot_report.have ? &slot_report.report : nullptr;
+    if (slot_report.have) used = slot + 1;
   }
-  // An endpoint that stopped reporting (killed, stalled) no longer knows where the finger is: drop its finger so
-  // position coupling stops pushing with a stale sample. Its impulse totals stay as they were, so the ledger applies
-  // nothing more from them; a restarted controller starts a new session from zero.
-  if (options_.clock == ClockMode::realtime && have_report_ &&
-      static_cast<double>(now_ns - report_fresh_ns_) * 1e-9 > endpoint_stale_s(world_.world_period_s())) {
-    report_.finger_valid = 0;
-  }
+  // Slot 0 is always served, so a world with no haptic side yet still steps and publishes its first frames.
+  used = std::max(used, 1u);
   const std::int64_t cpu_before_ns = thread_cpu_now_ns();
-  const PlaneFrame& frame = world_.step(have_report_ ? &report_ : nullptr);
+  const std::span<const PlaneFrame> frames =
+      world_.step(std::span<const HapticReport* const>(report_of_slot_.data(), used));
   step_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
-  link_->publish_frame(frame);
+  for (std::uint32_t slot = 0; slot < used && slot < slots; ++slot) link_->publish_frame(slot, frames[slot]);
   if (view_ != nullptr) {
     LoopStats haptic_stats;
-    const bool have_haptic_stats = link_->latest_haptic_stats(haptic_stats);
-    take_snapshot(world_, have_report_ ? &report_ : nullptr, stats_, have_haptic_stats ? &haptic_stats : nullptr,
-                  *snapshot_);
+    const bool have_haptic_stats = link_->latest_haptic_stats(0, haptic_stats);
+    take_snapshot(world_, std::span<const HapticReport* const>(report_of_slot_.data(), used), stats_,
+                  have_haptic_stats ? &haptic_stats : nullptr, *snapshot_);
     view_->publish_snapshot(*snapshot_);
   }
   // Rare and never on the haptic path: the world loop can afford a line on stderr when it happens.
@@ -210,7 +224,19 @@ nlohmann::json WorldNode::summary() const {
                             {"impulse_Ns", to_json(world_.total_impulse_Ns(id))},
                             {"angular_impulse_Nms", to_json(world_.total_angular_impulse_Nms(id))}};
   }
+  // Per endpoint of each haptic session: the impulse applied from its reports, by object id (as the haptic summary
+  // lists what each endpoint rendered), dynamic objects only.
+  nlohmann::json endpoints = nlohmann::json::array();
+  for (const CounterOwner& owner : world_.impulse_owners()) {
+    nlohmann::json impulses = nlohmann::json::object();
+    for (std::size_t id = 0; id < scene_.objects.size(); ++id) {
+      if (scene_.objects[id].dynamic) impulses[std::to_string(id)] = to_json(world_.applied_by(owner, id));
+    }
+    endpoints.push_back({{"haptic_session", owner.haptic_session}, {"endpoint", owner.endpoint},
+                         {"impulse_by_object_Ns", impulses}});
+  }
   return {{"objects", objects},
+          {"endpoints", endpoints},
           {"world",
            {{"steps", world_.steps_taken()},
             {"time_s", world_.time_s()},

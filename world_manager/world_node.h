@@ -17,7 +17,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cstdint>
+#include <vector>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -75,12 +77,18 @@ class WorldNode final : public WorldStepper {
   std::optional<std::ofstream> log_file_;
   std::optional<WriteWatch> log_watch_;  // reports a failed log write when it happens
   std::optional<WorldLog> log_;
-  HapticReport report_{};
-  bool have_report_ = false;
+  // Per endpoint slot of the link: its newest report, and when it last changed (staleness).
+  struct SlotReport {
+    HapticReport report{};
+    bool have = false;
+    std::uint64_t tick = 0;
+    std::uint64_t session = 0;
+    std::int64_t fresh_ns = 0;
+  };
+  std::vector<SlotReport> reports_;  // kMaxEndpoints (~7 KB each: on the heap)
+  HapticReport incoming_{};
+  std::array<const HapticReport*, kMaxEndpoints> report_of_slot_{};
   std::size_t escapes_reported_ = 0;  // world_.escaped() entries already announced on stderr
-  std::uint64_t report_tick_ = 0;
-  std::uint64_t report_session_ = 0;
-  std::int64_t report_fresh_ns_ = 0;
   LoopStats stats_;
   LatencyHistogram step_cpu_ns_;  // CPU time of World::step (coupling + engine + features), per step
 };

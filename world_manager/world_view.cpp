@@ -49,11 +49,11 @@ ViewBodyPose scene_pose(const SceneObject& object) {
   return {object.position_m, object.orientation_wxyz};
 }
 
-void take_snapshot(const World& world, const HapticReport* report, const LoopStats& world_stats,
+void take_snapshot(const World& world, std::span<const HapticReport* const> reports, const LoopStats& world_stats,
                    const LoopStats* haptic_stats, WorldSnapshot& out) {
-  const PlaneFrame& frame = world.frame();
-  out.world_session = frame.world_session;
-  out.frame_index = frame.frame_index;
+  const PlaneFrame& header = world.frame();
+  out.world_session = header.world_session;
+  out.frame_index = header.frame_index;
   out.world_time_s = world.time_s();
   out.world_period_s = world.world_period_s();
   out.world_stats = world_stats;
@@ -69,28 +69,31 @@ void take_snapshot(const World& world, const HapticReport* report, const LoopSta
   }
 
   out.endpoint_count = 0;
-  if (report == nullptr) return;
-  ViewEndpoint& endpoint = out.endpoints[0];
-  out.endpoint_count = 1;
-  endpoint.endpoint = report->endpoint;
-  endpoint.finger_valid = report->finger_valid;
-  endpoint.finger_m = report->finger_m;
-  endpoint.proxy_m = report->proxy_m;
-  endpoint.force_N = report->force_N;
-  // The planes nearest the proxy: those the finger can be touching. Selection on at most kMaxPlanes indices.
-  std::array<std::uint32_t, kMaxPlanes> order{};
-  const std::uint32_t count = std::min(frame.plane_count, kMaxPlanes);
-  for (std::uint32_t p = 0; p < count; ++p) order[p] = p;
-  const std::uint32_t shown = std::min(count, kMaxViewPlanes);
-  std::partial_sort(order.begin(), order.begin() + shown, order.begin() + count,
-                    [&](std::uint32_t a, std::uint32_t b) {
-                      return squared_distance(frame.planes[a].point_m, report->proxy_m) <
-                             squared_distance(frame.planes[b].point_m, report->proxy_m);
-                    });
-  endpoint.plane_count = shown;
-  for (std::uint32_t p = 0; p < shown; ++p) {
-    endpoint.planes[p].point_m = frame.planes[order[p]].point_m;
-    endpoint.planes[p].normal = frame.planes[order[p]].normal;
+  for (std::size_t slot = 0; slot < reports.size() && slot < world.endpoint_slots(); ++slot) {
+    const HapticReport* report = reports[slot];
+    if (report == nullptr || out.endpoint_count >= kMaxViewEndpoints) continue;
+    const PlaneFrame& frame = world.frame(slot);
+    ViewEndpoint& endpoint = out.endpoints[out.endpoint_count++];
+    endpoint.endpoint = report->endpoint;
+    endpoint.finger_valid = report->finger_valid;
+    endpoint.finger_m = report->finger_m;
+    endpoint.proxy_m = report->proxy_m;
+    endpoint.force_N = report->force_N;
+    // The planes nearest the proxy: those the finger can be touching. Selection on at most kMaxPlanes indices.
+    std::array<std::uint32_t, kMaxPlanes> order{};
+    const std::uint32_t count = std::min(frame.plane_count, kMaxPlanes);
+    for (std::uint32_t p = 0; p < count; ++p) order[p] = p;
+    const std::uint32_t shown = std::min(count, kMaxViewPlanes);
+    std::partial_sort(order.begin(), order.begin() + shown, order.begin() + count,
+                      [&](std::uint32_t a, std::uint32_t b) {
+                        return squared_distance(frame.planes[a].point_m, report->proxy_m) <
+                               squared_distance(frame.planes[b].point_m, report->proxy_m);
+                      });
+    endpoint.plane_count = shown;
+    for (std::uint32_t p = 0; p < shown; ++p) {
+      endpoint.planes[p].point_m = frame.planes[order[p]].point_m;
+      endpoint.planes[p].normal = frame.planes[order[p]].normal;
+    }
   }
 }
 

@@ -19,6 +19,9 @@ namespace impetus {
 using EndpointId = std::uint32_t;
 
 inline constexpr std::uint32_t kMaxPlanes = 64;          // planes in one world → haptic frame
+// Endpoints one world serves at once, over all its haptic controllers (DESIGN.md §1): two hands of four fingers, or
+// several users with a finger or two each.
+inline constexpr std::uint32_t kMaxEndpoints = 8;
 inline constexpr std::uint32_t kMaxImpulseEntries = 64;  // objects with a running impulse total in one report
 
 enum class Coupling : std::uint32_t {

@@ -25,18 +25,23 @@ struct WorldLinkInfo {
   Coupling coupling = Coupling::impulse;
 };
 
-// The world node's end.
+// The world node's end. It serves endpoint slots 0..endpoint_slots()−1; each slot carries one endpoint's reports in
+// and its frames out, whichever haptic controller holds it (slots are taken in order as controllers attach).
 class WorldLinkServer {
  public:
   virtual ~WorldLinkServer() = default;
 
-  // The newest valid report since the world started (whether or not it is new since the last call); false if none
-  // has arrived yet. Invalid reports are dropped and counted.
-  virtual bool latest_report(HapticReport& out) = 0;
-  virtual void publish_frame(const PlaneFrame& frame) = 0;
+  // How many endpoint slots the link has (at most kMaxEndpoints).
+  virtual std::uint32_t endpoint_slots() const = 0;
+  // The newest valid report in slot `slot` since the world started (whether or not it is new since the last call);
+  // false if none has arrived yet. Invalid reports are dropped and counted.
+  virtual bool latest_report(std::uint32_t slot, HapticReport& out) = 0;
+  // The frame for the endpoint in slot `slot`.
+  virtual void publish_frame(std::uint32_t slot, const PlaneFrame& frame) = 0;
   virtual void publish_stats(const LoopStats& stats) = 0;
-  // The attached haptic side's latest loop statistics (for viewers); false if none or the transport has none.
-  virtual bool latest_haptic_stats(LoopStats& /*out*/) { return false; }
+  // The loop statistics of the haptic controller in slot `slot` (for viewers); false if none or the transport has
+  // none.
+  virtual bool latest_haptic_stats(std::uint32_t /*slot*/, LoopStats& /*out*/) { return false; }
 
   // Lockstep follower: waits for the master's go for the next world step. ok: step now, then finish_turn();
   // anything else ends the run (shutdown: the session ended; peer_gone: the master died or a stop was requested).
@@ -49,20 +54,23 @@ class WorldLinkServer {
   virtual std::uint64_t channel_repairs() const { return 0; }
 };
 
-// A haptic node's end.
+// A haptic node's end, for its endpoints 0..endpoints()−1 (one per finger of its device).
 class WorldLinkClient {
  public:
   virtual ~WorldLinkClient() = default;
 
   virtual const WorldLinkInfo& info() const = 0;
-  // The newest valid frame published since the last call; false if none. A restarted world's frames follow on
-  // (PlaneFrame::world_session tells them apart). Invalid frames are dropped and counted.
-  virtual bool receive_frame(PlaneFrame& out) = 0;
+  virtual std::uint32_t endpoints() const = 0;
+  // The newest valid frame for `endpoint` published since the last call; false if none. A restarted world's frames
+  // follow on (PlaneFrame::world_session tells them apart). Invalid frames are dropped and counted.
+  virtual bool receive_frame(EndpointId endpoint, PlaneFrame& out) = 0;
+  // Publishes the report of endpoint report.endpoint (< endpoints()).
   virtual void publish_report(const HapticReport& report) = 0;
   virtual void publish_stats(const LoopStats& stats) = 0;
 
   // Lockstep master: the world takes its step for haptic tick `tick`; false if the world is gone (its last frames
-  // stay in force until reattach() finds a new one).
+  // stay in force until reattach() finds a new one). A follower (another controller in a lockstep run whose master
+  // steps the world) returns true at once.
   virtual bool step_world(std::uint64_t tick) = 0;
   // Lockstep master: ends the session; a waiting world returns from wait_turn() with `shutdown`.
   virtual void end_session() = 0;

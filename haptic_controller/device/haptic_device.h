@@ -7,6 +7,8 @@
 // Called from the servo thread once per tick: read() first, then command(). Implementations do not allocate, lock or
 // throw there; read() may block only in lockstep (the device's turn).
 
+#include "common/contract/frames.h"
+
 #include <Eigen/Core>
 
 #include <cstdint>
@@ -25,6 +27,15 @@ struct DeviceLimits {
   double max_force_N = 0.0;
 };
 
+// Fingers one device may serve (a SPIDAR with a string set per finger, two hands): each is an endpoint of the world.
+inline constexpr std::uint32_t kMaxFingers = kMaxEndpoints;
+
+// What to render on one finger: `render` false commands the device's minimum output there.
+struct FingerCommand {
+  Eigen::Vector3d force_N = Eigen::Vector3d::Zero();
+  bool render = false;
+};
+
 struct DeviceCounters {
   std::uint64_t saturations = 0;      // forces the device could render only approximately
   std::uint64_t rejected_frames = 0;  // readings its transport refused (checksum, range)
@@ -37,14 +48,23 @@ class HapticDevice {
   virtual ~HapticDevice() = default;
 
   virtual const DeviceLimits& limits() const = 0;
+  // The fingers it serves, 1 to kMaxFingers; constant for the device's lifetime.
+  virtual std::uint32_t finger_count() const { return 1; }
 
   // Lockstep: blocks until a device is attached; false if a stop was requested first (or it will never attach).
   virtual bool wait_attached() = 0;
-  // The finger at haptic tick `tick` (time now_s); nullptr when no device is attached or its reading is stale.
+  // The fingers at haptic tick `tick` (time now_s): finger_count() samples, finger k at index k; nullptr when no
+  // device is attached or its reading is stale.
   virtual const FingerSample* read(std::uint64_t tick, double now_s) = 0;
-  // Renders `force_N` on the finger read last; `render` false commands the device's minimum output (no finger, or a
-  // fault upstream). Returns true if the force was rendered exactly (false: saturated, the nearest feasible force).
+  // Renders `force_N` on the (first) finger read last; `render` false commands the device's minimum output (no
+  // finger, or a fault upstream). Returns true if the force was rendered exactly (false: saturated, the nearest
+  // feasible force). A device of several fingers commands its others' minimum output.
   virtual bool command(std::uint64_t tick, const Eigen::Vector3d& force_N, bool render) = 0;
+  // Renders commands[k] on finger k, for all finger_count() fingers at once. Returns a bit per finger (bit k) that
+  // was rendered only approximately (saturated); 0 if every force was exact. A one-finger device need not override.
+  virtual std::uint32_t command_fingers(std::uint64_t tick, const FingerCommand* commands) {
+    return command(tick, commands[0].force_N, commands[0].render) ? 0u : 1u;
+  }
   // Lockstep: ends the session (a waiting device is released).
   virtual void end_session() = 0;
 

@@ -380,7 +380,8 @@ class FloorWorld final : public WorldLinkClient {
     floor.com_m = {0.0, 0.0, -0.5};
   }
   const WorldLinkInfo& info() const override { return info_; }
-  bool receive_frame(PlaneFrame& out) override {
+  std::uint32_t endpoints() const override { return 1; }
+  bool receive_frame(EndpointId, PlaneFrame& out) override {
     if (!pending_) return false;
     pending_ = false;
     out = frame_;

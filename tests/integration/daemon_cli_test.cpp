@@ -398,10 +398,10 @@ TEST_CASE("lockstep: odd sequence words scribbled into the running link are repa
   auto& layout = link.layout();
   // The sequence word is each channel's first; an odd value at rest made every reader wait for a write that never
   // ends. A scribble that lands while the writer is mid-write is overwritten by that write, so it is done 20 times.
-  const std::uint64_t before = layout.report.sequence();
+  const std::uint64_t before = layout.slots[0].report.sequence();
   for (int i = 0; i < 20; ++i) {
-    reinterpret_cast<std::atomic<std::uint64_t>*>(&layout.planes)->store(1001);
-    reinterpret_cast<std::atomic<std::uint64_t>*>(&layout.report)->store(2001);
+    reinterpret_cast<std::atomic<std::uint64_t>*>(&layout.slots[0].planes)->store(1001);
+    reinterpret_cast<std::atomic<std::uint64_t>*>(&layout.slots[0].report)->store(2001);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
@@ -409,7 +409,7 @@ TEST_CASE("lockstep: odd sequence words scribbled into the running link are repa
   // may land inside a write (odd; a report is written every tick), so it is sampled for up to 100 ms.
   bool still_moving = false;
   for (int i = 0; i < 100 && !still_moving; ++i) {
-    const std::uint64_t now = layout.report.sequence();
+    const std::uint64_t now = layout.slots[0].report.sequence();
     still_moving = now % 2 == 0 && now != before;
     if (!still_moving) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }

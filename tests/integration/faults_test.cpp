@@ -198,8 +198,8 @@ TEST_CASE("random bytes written into a live world link are rejected and counted 
       for (std::size_t k = 0; k < length; ++k) bytes[offset + k] = static_cast<unsigned char>(random());
     };
     for (int round = 0; round < 200; ++round) {
-      scribble(&link->planes, sizeof(link->planes));
-      scribble(&link->report, sizeof(link->report));
+      scribble(&link->slots[0].planes, sizeof(link->slots[0].planes));
+      scribble(&link->slots[0].report, sizeof(link->slots[0].report));
       sleep_s(0.005);
     }
   }

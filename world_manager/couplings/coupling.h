@@ -80,8 +80,9 @@ class CouplingStrategy : public SubstepHook {
   // meaningful when `moment_finite`) and the window it was rendered in.
   virtual void take_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment,
                             bool moment_finite, const RenderWindow& window) = 0;
-  // After the report, before the engine steps.
-  virtual void before_step(const FingerState&, const FeatureExtractor&) {}
+  // After the reports, before the engine steps: the sampled finger of every endpoint slot (index = slot; an
+  // endpoint without a usable finger has valid == false).
+  virtual void before_step(std::span<const FingerState>, const FeatureExtractor&) {}
   void before_substep(int) override {}
   // After the engine's last substep.
   virtual void after_step() {}

@@ -10,6 +10,7 @@
 
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
 namespace impetus {
 namespace {
@@ -22,59 +23,128 @@ constexpr double kTurnTimeout_s = 60.0;
 
 ShmWorldLinkServer::ShmWorldLinkServer(const std::string& shm, const WorldLinkInfo& info)
     : segment_(Segment<WorldLinkLayout>::create(world_link_name(shm),
-                                                [&](WorldLinkLayout& layout) { layout.config = info; })) {}
+                                                [&](WorldLinkLayout& layout) { layout.config = info; })),
+      slots_(kMaxEndpoints) {}
 
-bool ShmWorldLinkServer::latest_report(HapticReport& out) { return reports_.read(segment_->report, out); }
+bool ShmWorldLinkServer::latest_report(std::uint32_t slot, HapticReport& out) {
+  return slot < kMaxEndpoints && slots_[slot].reports.read(segment_->slots[slot].report, out);
+}
 
-void ShmWorldLinkServer::publish_frame(const PlaneFrame& frame) {
+void ShmWorldLinkServer::publish_frame(std::uint32_t slot, const PlaneFrame& frame) {
+  if (slot >= kMaxEndpoints) return;
   encode(frame, frame_wire_);
-  if (!segment_->planes.write(frame_wire_, used_bytes(frame_wire_))) ++repairs_;
+  if (!segment_->slots[slot].planes.write(frame_wire_, used_bytes(frame_wire_))) ++repairs_;
 }
 
 void ShmWorldLinkServer::publish_stats(const LoopStats& stats) {
   if (!segment_->world_stats.write(stats)) ++repairs_;
 }
 
-bool ShmWorldLinkServer::latest_haptic_stats(LoopStats& out) {
-  segment_->haptic_stats.try_read(haptic_stats_, haptic_stats_sequence_);
-  out = haptic_stats_;
-  return haptic_stats_sequence_ != 0;
+bool ShmWorldLinkServer::latest_haptic_stats(std::uint32_t slot, LoopStats& out) {
+  if (slot >= kMaxEndpoints) return false;
+  SlotReader& reader = slots_[slot];
+  segment_->slots[slot].haptic_stats.try_read(reader.stats, reader.stats_sequence);
+  out = reader.stats;
+  return reader.stats_sequence != 0;
+}
+
+std::uint64_t ShmWorldLinkServer::rejected_reports() const {
+  std::uint64_t rejected = 0;
+  for (const SlotReader& reader : slots_) rejected += reader.reports.rejected();
+  return rejected;
 }
 
 TurnResult ShmWorldLinkServer::wait_turn() {
   WorldLinkLayout& link = *segment_;
-  // Before a haptic node attaches we wait as long as we are not stopped; once one attached, its death ends the run
+  // Before the master attaches we wait as long as we are not stopped; once one attached, its death ends the run
   // (nobody would ever give us another turn).
   return link.world_turn.wait_turn([&] {
     if (g_stop_requested.load()) return false;
-    const std::int32_t haptic = link.haptic_pid.load();
-    return haptic == 0 || process_alive(haptic);
+    const std::int32_t master = link.master_pid.load();
+    return master == 0 || process_alive(master);
   });
 }
 
 void ShmWorldLinkServer::finish_turn() { segment_->world_turn.finish(); }
 
-ShmWorldLinkClient::ShmWorldLinkClient(const std::string& shm, ClockMode clock, double wait_s)
-    : name_(world_link_name(shm)), clock_(clock) {
-  worlds_.push_back(
-      std::make_unique<Segment<WorldLinkLayout>>(open_when_ready<WorldLinkLayout>(name_, wait_s)));
-  current_.store(&**worlds_.back(), std::memory_order_release);
-  info_ = world().config;
+namespace {
+
+// Takes `word` for this process if it is free (0) or held by a process that is gone. A word this process holds is
+// not free: two clients in one process take different slots.
+bool take(std::atomic<std::int32_t>& word, std::int32_t self) {
+  std::int32_t holder = word.load();
+  while (holder == 0 || (holder != self && !process_alive(holder))) {
+    if (word.compare_exchange_weak(holder, self)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::unique_ptr<ShmWorldLinkClient::Attachment> ShmWorldLinkClient::attach(
+    std::unique_ptr<Segment<WorldLinkLayout>> segment) const {
+  WorldLinkLayout& link = **segment;
+  const auto self = static_cast<std::int32_t>(getpid());
+  auto attachment = std::make_unique<Attachment>();
+  std::uint32_t taken = 0;
+  for (std::uint32_t slot = 0; slot < kMaxEndpoints && taken < endpoints_; ++slot) {
+    if (take(link.slots[slot].owner_pid, self)) attachment->slots[taken++] = slot;
+  }
+  if (taken < endpoints_) {
+    for (std::uint32_t k = 0; k < taken; ++k) link.slots[attachment->slots[k]].owner_pid.store(0);
+    throw std::runtime_error("the world at '" + name_ + "' has " + std::to_string(taken) + " free endpoint slot(s) of " +
+                             std::to_string(kMaxEndpoints) + "; this controller needs " + std::to_string(endpoints_));
+  }
+  if (clock_ == ClockMode::lockstep && !take(link.master_pid, self)) {
+    for (std::uint32_t k = 0; k < taken; ++k) link.slots[attachment->slots[k]].owner_pid.store(0);
+    throw std::runtime_error("the lockstep world at '" + name_ + "' already has a haptic controller as its master "
+                             "(pid " + std::to_string(link.master_pid.load()) + "); over shared memory a lockstep "
+                             "world takes one controller (use --clock realtime for several)");
+  }
+  attachment->segment = std::move(segment);
+  return attachment;
+}
+
+ShmWorldLinkClient::ShmWorldLinkClient(const std::string& shm, ClockMode clock, double wait_s,
+                                       std::uint32_t endpoints)
+    : name_(world_link_name(shm)), clock_(clock), endpoints_(endpoints) {
+  if (endpoints == 0 || endpoints > kMaxEndpoints) {
+    throw std::invalid_argument("a haptic controller serves 1 to " + std::to_string(kMaxEndpoints) +
+                                " endpoints, not " + std::to_string(endpoints));
+  }
+  auto segment = std::make_unique<Segment<WorldLinkLayout>>(open_when_ready<WorldLinkLayout>(name_, wait_s));
+  info_ = (*segment)->config;
   if (info_.clock != clock) {
     throw std::runtime_error(std::string("the world manager runs --clock ") + to_string(info_.clock) +
                              " but the haptic controller was started with --clock " + to_string(clock));
   }
-  world().haptic_pid.store(static_cast<std::int32_t>(getpid()));
+  worlds_.push_back(attach(std::move(segment)));
+  current_.store(worlds_.back().get(), std::memory_order_release);
 }
 
-bool ShmWorldLinkClient::receive_frame(PlaneFrame& out) {
-  WorldLinkLayout* current = &world();
-  if (current != frames_from_) {  // re-attached to a restarted world: its sequence numbers start afresh
-    frames_from_ = current;
-    last_frame_sequence_ = 0;
+ShmWorldLinkClient::~ShmWorldLinkClient() {
+  const auto self = static_cast<std::int32_t>(getpid());
+  for (const auto& attachment : worlds_) {
+    WorldLinkLayout& link = **attachment->segment;
+    for (std::uint32_t k = 0; k < endpoints_; ++k) {
+      std::int32_t expected = self;
+      link.slots[attachment->slots[k]].owner_pid.compare_exchange_strong(expected, 0);
+    }
+    std::int32_t expected = self;
+    link.master_pid.compare_exchange_strong(expected, 0);
+  }
+}
+
+bool ShmWorldLinkClient::receive_frame(EndpointId endpoint, PlaneFrame& out) {
+  if (endpoint >= endpoints_) return false;
+  const Attachment& attachment = current();
+  if (&attachment != frames_from_) {  // re-attached to a restarted world: its sequence numbers start afresh
+    frames_from_ = &attachment;
+    last_frame_sequence_.fill(0);
   }
   std::size_t copied = 0;
-  if (!current->planes.try_read(frame_wire_, last_frame_sequence_, 4, &copied)) return false;
+  const EndpointSlotLayout& slot = (*attachment.segment)->slots[attachment.slots[endpoint]];
+  if (!slot.planes.try_read(frame_wire_, last_frame_sequence_[endpoint], 4, &copied)) return false;
   if (used_bytes(frame_wire_) > copied || decode(frame_wire_, out) != FrameError::ok) {
     ++rejected_;
     return false;
@@ -83,12 +153,16 @@ bool ShmWorldLinkClient::receive_frame(PlaneFrame& out) {
 }
 
 void ShmWorldLinkClient::publish_report(const HapticReport& report) {
+  if (report.endpoint >= endpoints_) return;
+  const Attachment& attachment = current();
   encode(report, report_wire_);
-  if (!world().report.write(report_wire_, used_bytes(report_wire_))) ++repairs_;
+  EndpointSlotLayout& slot = (*attachment.segment)->slots[attachment.slots[report.endpoint]];
+  if (!slot.report.write(report_wire_, used_bytes(report_wire_))) ++repairs_;
 }
 
 void ShmWorldLinkClient::publish_stats(const LoopStats& stats) {
-  if (!world().haptic_stats.write(stats)) ++repairs_;
+  const Attachment& attachment = current();
+  if (!(*attachment.segment)->slots[attachment.slots[0]].haptic_stats.write(stats)) ++repairs_;
 }
 
 bool ShmWorldLinkClient::step_world(std::uint64_t tick) {
@@ -96,7 +170,8 @@ bool ShmWorldLinkClient::step_world(std::uint64_t tick) {
   if (!world_alive_) return false;
   WorldLinkLayout& link = world();
   link.world_turn.give(tick);
-  const TurnResult result = link.world_turn.wait_done([&] { return worlds_.back()->creator_alive(); }, kTurnTimeout_s);
+  const TurnResult result =
+      link.world_turn.wait_done([&] { return worlds_.back()->segment->creator_alive(); }, kTurnTimeout_s);
   if (result != TurnResult::ok) {
     std::fprintf(stderr, "haptic_controller: the world manager is lost: %s; keeping its last planes\n",
                  to_string(result));
@@ -107,21 +182,24 @@ bool ShmWorldLinkClient::step_world(std::uint64_t tick) {
 
 void ShmWorldLinkClient::end_session() { world().world_turn.request_shutdown(); }
 
-bool ShmWorldLinkClient::world_alive() const { return worlds_.back()->creator_alive(); }
+bool ShmWorldLinkClient::world_alive() const { return worlds_.back()->segment->creator_alive(); }
 
 bool ShmWorldLinkClient::reattach() {
-  if (worlds_.back()->creator_alive()) return false;
+  if (worlds_.back()->segment->creator_alive()) return false;
   try {
     auto fresh = std::make_unique<Segment<WorldLinkLayout>>(Segment<WorldLinkLayout>::open(name_));
     if (!fresh->creator_alive() || (*fresh)->config.clock != clock_) return false;
-    (*fresh)->haptic_pid.store(static_cast<std::int32_t>(getpid()));
-    worlds_.push_back(std::move(fresh));
-    current_.store(&**worlds_.back(), std::memory_order_release);
+    worlds_.push_back(attach(std::move(fresh)));
+    current_.store(worlds_.back().get(), std::memory_order_release);
     attaches_.fetch_add(1);
     std::fprintf(stderr, "haptic_controller: re-attached to a restarted world manager\n");
     return true;
   } catch (const SegmentError&) {
     return false;  // not (yet) there: the last planes stay in force meanwhile
+  } catch (const std::runtime_error& error) {
+    // The restarted world's slots are all taken (other controllers came first): say so, and keep looking.
+    std::fprintf(stderr, "haptic_controller: cannot re-attach: %s\n", error.what());
+    return false;
   }
 }
 

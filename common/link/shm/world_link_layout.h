@@ -10,6 +10,7 @@
 #include "common/link/shm/segment.h"
 #include "common/link/shm/seqlock.h"
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <type_traits>
@@ -18,17 +19,27 @@ namespace impetus {
 
 static_assert(std::is_trivially_copyable_v<WorldLinkInfo>);
 
+// One endpoint's channels. A haptic controller takes a slot for each of its endpoints by swapping owner_pid from 0
+// (or from a pid that is no longer alive) to its own; only the holder writes its report and stats channels.
+struct EndpointSlotLayout {
+  SeqlockChannel<wire::PlaneFrame> planes;      // writer: world manager
+  SeqlockChannel<wire::HapticReport> report;    // writer: the slot's holder
+  SeqlockChannel<LoopStats> haptic_stats;       // writer: the slot's holder
+  std::atomic<std::int32_t> owner_pid{0};       // the holder, 0 if none
+  std::uint32_t reserved = 0;
+};
+
 struct WorldLinkLayout {
   static constexpr SegmentKind kKind = SegmentKind::world_link;
 
   SegmentHeader header;
   WorldLinkInfo config;  // written once by the world manager before the segment is published; read-only after
-  SeqlockChannel<wire::PlaneFrame> planes;       // writer: world manager
-  SeqlockChannel<wire::HapticReport> report;     // writer: haptic controller
   SeqlockChannel<LoopStats> world_stats;   // writer: world manager
-  SeqlockChannel<LoopStats> haptic_stats;  // writer: haptic controller
-  LockstepTurn world_turn;                 // master: haptic controller; follower: world manager
-  std::atomic<std::int32_t> haptic_pid{0}; // the attached haptic controller, 0 if none (for the world's liveness checks)
+  std::array<EndpointSlotLayout, kMaxEndpoints> slots;
+  LockstepTurn world_turn;                 // master: the lockstep haptic controller; follower: world manager
+  // The lockstep master, 0 if none (the world's liveness check while it waits for a turn; a second lockstep
+  // controller is refused).
+  std::atomic<std::int32_t> master_pid{0};
 };
 
 }  // namespace impetus

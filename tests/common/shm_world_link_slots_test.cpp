@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: Apache-2.0
+// The shared-memory world link's endpoint slots: haptic controllers take the next free slots as they attach, each
+// endpoint's reports and frames travel in its own slot, a controller that needs more slots than are free is refused
+// with the numbers, and slots given back are taken again.
+
+#include "common/link/shm/shm_world_link.h"
+#include "test_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <memory>
+#include <string>
+
+namespace impetus {
+
+TEST_CASE("shm world link: controllers take endpoint slots in turn, and each endpoint's frames and reports stay in "
+          "its own slot") {
+  const std::string shm = test::unique_segment_name("slots");
+  WorldLinkInfo info;
+  info.world_rate_hz = 20.0;
+  info.world_period_s = 0.05;
+  ShmWorldLinkServer server(shm, info);
+  auto one = std::make_unique<ShmWorldLinkClient>(shm, ClockMode::realtime, 1.0, 1);
+  ShmWorldLinkClient two(shm, ClockMode::realtime, 1.0, 2);
+  CHECK(one->slot_of(0) == 0);
+  CHECK(two.slot_of(0) == 1);
+  CHECK(two.slot_of(1) == 2);
+
+  // A report of the second controller's endpoint 1 arrives in slot 2, and only there.
+  HapticReport report;
+  report.haptic_session = 77;
+  report.endpoint = 1;
+  report.tick = 5;
+  two.publish_report(report);
+  HapticReport received;
+  REQUIRE(server.latest_report(2, received));
+  CHECK(received.haptic_session == 77);
+  CHECK(received.endpoint == 1);
+  CHECK_FALSE(server.latest_report(0, received));
+  CHECK_FALSE(server.latest_report(1, received));
+
+  // A frame for slot 1 reaches the second controller's endpoint 0, and nobody else.
+  PlaneFrame frame;
+  frame.world_session = 3;
+  frame.world_period_s = 0.05;
+  frame.frame_index = 9;
+  server.publish_frame(1, frame);
+  PlaneFrame out;
+  CHECK_FALSE(one->receive_frame(0, out));
+  CHECK_FALSE(two.receive_frame(1, out));
+  REQUIRE(two.receive_frame(0, out));
+  CHECK(out.frame_index == 9);
+
+  // Five slots are left: a controller of six fingers is refused, naming the numbers.
+  CHECK_THROWS_WITH(ShmWorldLinkClient(shm, ClockMode::realtime, 1.0, 6),
+                    Catch::Contains("5 free endpoint slot(s) of 8") && Catch::Contains("needs 6"));
+  // A controller that leaves gives its slot back; the next one takes it.
+  one.reset();
+  ShmWorldLinkClient three(shm, ClockMode::realtime, 1.0, 1);
+  CHECK(three.slot_of(0) == 0);
+}
+
+TEST_CASE("shm world link: a lockstep world takes one controller as its master and refuses a second") {
+  const std::string shm = test::unique_segment_name("master");
+  WorldLinkInfo info;
+  info.world_rate_hz = 20.0;
+  info.world_period_s = 0.05;
+  info.clock = ClockMode::lockstep;
+  ShmWorldLinkServer server(shm, info);
+  ShmWorldLinkClient master(shm, ClockMode::lockstep, 1.0, 1);
+  CHECK_THROWS_WITH(ShmWorldLinkClient(shm, ClockMode::lockstep, 1.0, 1), Catch::Contains("already has a haptic "
+                                                                                         "controller as its master"));
+  CHECK(master.slot_of(0) == 0);
+}
+
+}  // namespace impetus

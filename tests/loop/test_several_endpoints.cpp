@@ -1,0 +1,250 @@
+// SPDX-License-Identifier: Apache-2.0
+// Several endpoints on one world (DESIGN.md §1, §6), deterministically: a world and one servo per finger in this
+// thread, the fingers on scripted paths (kinematic: the device holds them exactly where the script says, so what is
+// tested is the world and the servos, not a hand model).
+//   - Grasp and lift: thumb and index squeeze the grasp scene's cube from opposite sides, lift it 5 cm, hold 5 s and
+//     put it down. Friction alone holds it.
+//   - Two users, one cube: two haptic sessions push the tap scene's cube from opposite sides, equally (it stays) and
+//     unequally (it moves as the net impulse says).
+// In all of them each endpoint's impulse, as the world applied it, equals what its servo rendered.
+
+#include "haptic_controller/servo.h"
+#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/scene.h"
+#include "world_manager/world.h"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace impetus {
+namespace {
+
+constexpr double kTick_s = 1e-3;
+constexpr int kTicksPerStep = 50;  // 1 kHz servos, the scenes' 20 Hz world
+
+Scene shipped_scene(const char* name) {
+  return load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/" + name + ".json");
+}
+
+double smooth(double t_s, double begin_s, double end_s) {
+  const double u = std::clamp((t_s - begin_s) / (end_s - begin_s), 0.0, 1.0);
+  return 0.5 - 0.5 * std::cos(M_PI * u);
+}
+
+// One finger: its servo, its haptic session and endpoint, and where the script puts it at time t.
+struct ScriptedFinger {
+  std::unique_ptr<HapticServo> servo;
+  std::function<Eigen::Vector3d(double)> path_m;
+};
+
+// What a run recorded, per world step.
+struct Run {
+  std::vector<double> time_s;
+  std::vector<Eigen::Vector3d> cube_m;
+  std::vector<Eigen::Vector3d> cube_velocity_mps;
+  std::vector<double> finger_z_m;  // the first finger's height
+  // Per finger: the report the world applied at its last step (rendered), and the world's per-endpoint total.
+  std::vector<Eigen::Vector3d> rendered_Ns;
+  std::vector<Eigen::Vector3d> applied_Ns;
+  double max_force_N = 0.0;
+};
+
+// The world steps at ticks phase, phase + 50, ... (the lockstep phase, DESIGN.md §3).
+Run run(const Scene& scene, Coupling coupling, std::vector<ScriptedFinger>& fingers, double duration_s,
+        int phase_ticks = 0) {
+  init_ode_once();
+  WorldOptions options;
+  options.coupling = coupling;
+  options.world_session = 7;
+  World world(scene, options);
+  Run out;
+  std::vector<const HapticReport*> reports(fingers.size());
+  std::vector<HapticReport> last_applied(fingers.size());
+  // The haptic node exchanges pushes among its own endpoints; here, among the fingers of each session.
+  std::vector<HapticServo*> servos;
+  for (ScriptedFinger& finger : fingers) servos.push_back(finger.servo.get());
+  const bool one_session = std::all_of(fingers.begin(), fingers.end(), [&](const ScriptedFinger& finger) {
+    return finger.servo->report().haptic_session == fingers[0].servo->report().haptic_session;
+  });
+  if (!one_session) servos.clear();
+  const int ticks = static_cast<int>(std::lround(duration_s / kTick_s));
+  for (int tick = 0; tick <= ticks; ++tick) {
+    const double now_s = tick * kTick_s;
+    for (ScriptedFinger& finger : fingers) {
+      FingerSample sample;
+      sample.position_m = finger.path_m(now_s);
+      sample.valid = true;
+      const TickResult& result = finger.servo->tick(&sample, now_s, kTick_s);
+      out.max_force_N = std::max(out.max_force_N, to_eigen(result.force_N).norm());
+    }
+    exchange_pushes(servos);  // the fingers of one controller (one session) feel each other's pushes
+    if (tick % kTicksPerStep != phase_ticks) continue;
+    for (std::size_t k = 0; k < fingers.size(); ++k) {
+      reports[k] = &fingers[k].servo->report();
+      last_applied[k] = fingers[k].servo->report();
+    }
+    const auto frames = world.step(reports);
+    for (std::size_t k = 0; k < fingers.size(); ++k) fingers[k].servo->on_plane_frame(frames[k], now_s);
+    out.time_s.push_back(world.time_s());
+    out.cube_m.push_back(world.states()[0].pose.position_m);
+    out.cube_velocity_mps.push_back(world.states()[0].velocity_mps);
+    out.finger_z_m.push_back(fingers[0].path_m(now_s).z());
+  }
+  for (std::size_t k = 0; k < fingers.size(); ++k) {
+    const HapticReport& report = last_applied[k];
+    Eigen::Vector3d rendered = Eigen::Vector3d::Zero();
+    for (std::uint32_t e = 0; e < report.entry_count; ++e) {
+      if (report.entries[e].object_id == 0) rendered = to_eigen(report.entries[e].impulse_Ns);
+    }
+    out.rendered_Ns.push_back(rendered);
+    out.applied_Ns.push_back(world.applied_by({report.haptic_session, report.endpoint}, 0));
+  }
+  return out;
+}
+
+void check_applied_equals_rendered(const Run& result) {
+  for (std::size_t k = 0; k < result.rendered_Ns.size(); ++k) {
+    INFO("endpoint " << k << ": rendered " << result.rendered_Ns[k].transpose() << " N·s, applied "
+                     << result.applied_Ns[k].transpose());
+    CHECK(result.rendered_Ns[k].norm() > 0.01);  // it really pushed
+    CHECK((result.rendered_Ns[k] - result.applied_Ns[k]).norm() <= 1e-12 * (1.0 + result.rendered_Ns[k].norm()));
+  }
+}
+
+// Index of the first step at or after t.
+std::size_t step_at(const Run& result, double t_s) {
+  return static_cast<std::size_t>(std::lower_bound(result.time_s.begin(), result.time_s.end(), t_s - 1e-9) -
+                                  result.time_s.begin());
+}
+
+// Grasp and lift. The cube's sides are at x = ±0.025 m; each finger aims 1.25 mm inside its side, so the servo's
+// spring (2 kN/m) squeezes with 2.5 N: friction (μ_s = 1.0) can hold up to 5 N against the cube's 1.96 N weight.
+// Timeline (s): close 0–0.5, settle to 1, lift 5 cm over 1–2, hold 2–7, lower 7–8, open 8–8.5, rest to 9.
+constexpr double kSqueeze_m = 0.00125;
+constexpr double kLift_m = 0.05;
+
+Eigen::Vector3d grasp_path(double side, double t_s) {
+  const double open_x = side * 0.045;
+  const double closed_x = side * (0.025 - kSqueeze_m);
+  const double x = open_x + (closed_x - open_x) * (smooth(t_s, 0.0, 0.5) - smooth(t_s, 8.0, 8.5));
+  const double z = 0.025 + kLift_m * (smooth(t_s, 1.0, 2.0) - smooth(t_s, 7.0, 8.0));
+  return {x, 0.0, z};
+}
+
+// Returns the lift height.
+double check_grasp(Coupling coupling, int phase_ticks = 0) {
+  const Scene scene = shipped_scene("grasp");
+  std::vector<ScriptedFinger> fingers;
+  const std::uint64_t session = 42;
+  fingers.push_back({std::make_unique<HapticServo>(ServoOptions{}, session, 0),
+                     [](double t) { return grasp_path(-1.0, t); }});  // thumb, from −x
+  fingers.push_back({std::make_unique<HapticServo>(ServoOptions{}, session, 1),
+                     [](double t) { return grasp_path(+1.0, t); }});  // index, from +x
+  const Run result = run(scene, coupling, fingers, 9.0, phase_ticks);
+
+  // Lifted: at the start of the hold the cube is up with the fingers.
+  const std::size_t hold_begin = step_at(result, 2.5);  // half a second after the lift, to let it settle
+  const std::size_t hold_end = step_at(result, 7.0);
+  const double lifted_m = result.cube_m[hold_begin].z() - 0.025;
+  // Motion is measured from the poses, step to step (what the user sees and feels); the velocity the engine reports
+  // at a step's end also holds the within-step sawtooth of impulses placed at their render times.
+  double slip_m = 0.0, fastest_hold_mps = 0.0;
+  for (std::size_t i = hold_begin; i <= hold_end; ++i) {
+    slip_m = std::max(slip_m, (result.cube_m[i] - result.cube_m[hold_begin]).norm());
+    if (i > hold_begin) {
+      fastest_hold_mps = std::max(fastest_hold_mps, (result.cube_m[i] - result.cube_m[i - 1]).norm() /
+                                                        (result.time_s[i] - result.time_s[i - 1]));
+    }
+  }
+  const Eigen::Vector3d& final_m = result.cube_m.back();
+  INFO(to_string(coupling) << " coupling: lifted " << lifted_m * 1e3 << " mm, slip during the hold " << slip_m * 1e3
+                           << " mm, fastest during the hold " << fastest_hold_mps * 1e3 << " mm/s, ends at "
+                           << final_m.transpose() << " m, largest force " << result.max_force_N << " N");
+  // The cube follows the fingers up within the sag its weight needs: the proxies stick on its sides and their
+  // springs stretch by weight / (2 k) ≈ 0.5 mm each, plus what the squeeze lets it settle.
+  CHECK(lifted_m > kLift_m - 0.005);
+  CHECK(lifted_m < kLift_m + 0.001);  // never thrown above the fingers
+  CHECK(slip_m < 0.001);              // held by friction: < 1 mm of slip over 4.5 s
+  CHECK(fastest_hold_mps < 0.01);
+  // Put down where it was picked up, at rest.
+  CHECK(std::abs(final_m.z() - 0.025) < 0.001);
+  CHECK(std::abs(final_m.x()) < 0.005);
+  CHECK((result.cube_m.back() - result.cube_m[result.cube_m.size() - 2]).norm() < 1e-5);  // at rest
+  check_applied_equals_rendered(result);
+  return lifted_m;
+}
+
+}  // namespace
+
+// Impulse coupling cannot hold a body up: every period the fingers' support, m·g·T, reaches the world as one
+// velocity change g·T at the step's start (paper §3.5), so the held cube hops (12 mm at 20 Hz) and the fingers lose
+// it. Not hidden: measured and printed here, and the ledger's invariant still holds.
+TEST_CASE("several endpoints under impulse coupling: a grasped cube is thrown by the period's support impulse, and "
+          "each endpoint's impulse is still applied as rendered") {
+  const Scene scene = shipped_scene("grasp");
+  std::vector<ScriptedFinger> fingers;
+  fingers.push_back({std::make_unique<HapticServo>(ServoOptions{}, 42, 0), [](double t) { return grasp_path(-1, t); }});
+  fingers.push_back({std::make_unique<HapticServo>(ServoOptions{}, 42, 1), [](double t) { return grasp_path(+1, t); }});
+  const Run result = run(scene, Coupling::impulse, fingers, 9.0);
+  double highest_m = 0.0;
+  for (const Eigen::Vector3d& cube_m : result.cube_m) highest_m = std::max(highest_m, cube_m.z());
+  WARN("impulse coupling, grasp and lift: the cube rose to " << (highest_m - 0.025) * 1e3 << " mm and ends "
+       << (result.cube_m.back() - Eigen::Vector3d(0, 0, 0.025)).norm() * 1e3 << " mm from where it started");
+  CHECK(result.cube_m.back().allFinite());
+  check_applied_equals_rendered(result);
+}
+
+TEST_CASE("several endpoints: thumb and index grasp a cube, lift it 5 cm, hold it by friction and put it down "
+          "(local coupling, 5 world phases)") {
+  double lowest_m = 1.0, highest_m = 0.0;
+  for (int phase = 0; phase < kTicksPerStep; phase += kTicksPerStep / 5) {
+    const double lifted_m = check_grasp(Coupling::local, phase);
+    lowest_m = std::min(lowest_m, lifted_m);
+    highest_m = std::max(highest_m, lifted_m);
+  }
+  WARN("local coupling, grasp and lift over 5 world phases: lifted " << lowest_m * 1e3 << " to " << highest_m * 1e3
+       << " mm (the fingers rose " << kLift_m * 1e3 << " mm)");
+}
+
+TEST_CASE("several endpoints: two users push one cube, equally (it stays) and unequally (the net impulse moves it)") {
+  const Scene scene = shipped_scene("tap");  // the 1 kg cube, sides at x = 0.005 and 0.055 m
+  // User A pushes from −x, user B from +x, each its own haptic session; each presses `depth` into its side.
+  auto push = [&](double depth_a_m, double depth_b_m) {
+    std::vector<ScriptedFinger> fingers;
+    fingers.push_back({std::make_unique<HapticServo>(ServoOptions{}, 101, 0), [=](double t) {
+                         return Eigen::Vector3d(-0.01 + (0.015 + depth_a_m) * smooth(t, 0.0, 0.5), 0.0, 0.025);
+                       }});
+    fingers.push_back({std::make_unique<HapticServo>(ServoOptions{}, 202, 0), [=](double t) {
+                         return Eigen::Vector3d(0.07 - (0.015 + depth_b_m) * smooth(t, 0.0, 0.5), 0.0, 0.025);
+                       }});
+    return run(scene, Coupling::impulse, fingers, 3.0);
+  };
+  SECTION("equal and opposite: the cube stays") {
+    const Run result = push(0.001, 0.001);
+    const double moved_m = std::abs(result.cube_m.back().x() - 0.03);
+    INFO("moved " << moved_m * 1e3 << " mm");
+    CHECK(moved_m < 0.001);
+    check_applied_equals_rendered(result);
+    // Each pushed about K·depth = 2 N for 2.5 s: the totals are opposite and near equal.
+    CHECK(result.applied_Ns[0].x() > 3.0);
+    CHECK(std::abs(result.applied_Ns[0].x() + result.applied_Ns[1].x()) < 0.05 * result.applied_Ns[0].x());
+  }
+  SECTION("unequal: the stronger push moves it, by the net impulse") {
+    const Run result = push(0.004, 0.001);
+    check_applied_equals_rendered(result);
+    const double net_Ns = result.applied_Ns[0].x() + result.applied_Ns[1].x();
+    const double moved_m = result.cube_m.back().x() - 0.03;
+    INFO("net impulse " << net_Ns << " N·s, moved " << moved_m * 1e3 << " mm");
+    CHECK(net_Ns > 0.5);
+    CHECK(moved_m > 0.002);  // toward +x, the weaker user's side
+  }
+}
+
+}  // namespace impetus
