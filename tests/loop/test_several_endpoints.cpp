@@ -183,9 +183,11 @@ double check_grasp(Coupling coupling, int phase_ticks = 0) {
 
 }  // namespace
 
-// Impulse coupling cannot hold a body up: every period the fingers' support, m·g·T, reaches the world as one
-// velocity change g·T at the step's start (paper §3.5), so the held cube hops (12 mm at 20 Hz) and the fingers lose
-// it. Not hidden: measured and printed here, and the ledger's invariant still holds.
+// Impulse coupling cannot lift the grasped cube. The proxies stick to planes that move only with the world's frames,
+// a period late; as the fingers rise, the sticking springs stretch until the next frame, and the period's impulse
+// then exceeds what the cube needed (0.15 N·s against m·g·T = 0.10 N·s in the lift's first step): the cube is thrown
+// up 12 mm, the fingers lose it, and slower lifts (2 and 3 s) fail alike. The loop through a period's delay has gain
+// about 2·k·T²/m = 50 here. Not hidden: measured and printed, and the ledger's invariant still holds.
 TEST_CASE("several endpoints under impulse coupling: a grasped cube is thrown by the period's support impulse, and "
           "each endpoint's impulse is still applied as rendered") {
   const Scene scene = shipped_scene("grasp");
