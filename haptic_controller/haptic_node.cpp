@@ -44,15 +44,6 @@ ServoOptions servo_options(const HapticNodeOptions& options, const DeviceLimits&
 
 }  // namespace
 
-std::string endpoint_log_path(const std::string& log_path, EndpointId endpoint) {
-  if (endpoint == 0 || log_path.empty()) return log_path;
-  const std::string suffix = ".endpoint" + std::to_string(endpoint);
-  const std::size_t slash = log_path.find_last_of('/');
-  const std::size_t dot = log_path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return log_path + suffix;
-  return log_path.substr(0, dot) + suffix + log_path.substr(dot);
-}
-
 HapticNode::HapticNode(const HapticNodeOptions& options, WorldLinkClient& world, HapticDevice& device)
     : options_(options), period_s_(1.0 / options.rate_hz), world_(world), device_(device) {
   const std::uint32_t fingers = device.finger_count();
@@ -98,7 +89,8 @@ void HapticNode::tick(std::uint64_t tick, double now_s, double dt_s, std::int64_
   const bool sampled = (tick & 63u) == 0;
   const std::int64_t cpu_before_ns = sampled ? thread_cpu_now_ns() : 0;
   for (std::size_t k = 0; k < endpoints_.size(); ++k) {
-    const TickResult& result = endpoints_[k]->servo.tick(fingers != nullptr ? &fingers[k] : nullptr, now_s, dt_s);
+    const FingerSample* finger = fingers != nullptr && fingers[k].present ? &fingers[k] : nullptr;
+    const TickResult& result = endpoints_[k]->servo.tick(finger, now_s, dt_s);
     commands_[k].force_N = to_eigen(result.force_N);
     commands_[k].render = result.render;
   }

@@ -10,6 +10,7 @@
 
 #include "common/link/world_link.h"
 #include "common/runtime/lockstep_schedule.h"
+#include "common/runtime/log_paths.h"
 #include "common/runtime/loop_stats.h"
 #include "common/runtime/rt_log.h"
 #include "haptic_controller/device/haptic_device.h"
@@ -50,10 +51,6 @@ struct HapticLogRow {
   std::int32_t active_planes;
   std::uint32_t flags;  // bit 0 finger valid, 1 saturated, 2 fault, 3 world stale, 4 sticking
 };
-
-// The log of endpoint `endpoint` given the node's --log path: the path itself for endpoint 0, and for the others the
-// same name with ".endpointK" before the extension (haptic.csv → haptic.endpoint1.csv).
-std::string endpoint_log_path(const std::string& log_path, EndpointId endpoint);
 
 // A haptic node serves one endpoint per finger of its device (HapticDevice::finger_count()): a servo each, ticked in
 // finger order every tick, their forces commanded to the device together.

@@ -5,8 +5,14 @@
 #include "common/link/shm/shm_device_port.h"
 #include "common/link/shm/shm_world_link.h"
 #include "common/runtime/cli.h"
+#include "haptic_controller/device/finger_set.h"
 #include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/haptic_node.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
 int main(int argc, char** argv) {
   using namespace impetus;
@@ -15,6 +21,8 @@ int main(int argc, char** argv) {
   std::string shm = "impetus";
   double world_wait_s = 10.0;
   std::string device_spec = "spidar";
+  std::string world_shm;  // "": the same as --shm
+  unsigned fingers = 1;
   CLI::App app{"haptic_controller: the 1 kHz haptic servo of Impetus. Interpolates the world's planes, renders the "
                "god-object force on the SPIDAR and integrates it into impulses for the world."};
   app.add_option("--rate", options.rate_hz, "servo rate in Hz (1000)")
@@ -33,6 +41,13 @@ int main(int argc, char** argv) {
   app.add_option("--world-wait", world_wait_s, "seconds to wait for the world manager's link (10)")
       ->check(positive_number(kMaxFlagSeconds));
   app.add_option("--device", device_spec, "spidar (the built-in geometry) or spidar:FILE.json (a device file)");
+  app.add_option("--fingers", fingers,
+                 "fingers of the device, one endpoint of the world each, 1 to 8 (1); finger k has the device port "
+                 "NAME.device (k = 0) or NAME.device<k>, and a string set of the device's geometry")
+      ->check(CLI::Range(1u, kMaxFingers));
+  app.add_option("--world-shm", world_shm,
+                 "the world link's NAME when it differs from --shm: several users' controllers, each with its own "
+                 "--shm for its device, on one world");
   app.add_flag("!--no-realtime-priority", options.realtime_priority,
                "do not ask for SCHED_FIFO and mlockall in real time");
   CLI11_PARSE(app, argc, argv);
@@ -40,13 +55,27 @@ int main(int argc, char** argv) {
   return run_node("haptic_controller", [&] {
     options.haptic_session = new_session_id();
     const SpidarDevice spidar = parse_device_spec(device_spec);
-    ShmDevicePortHost port(shm, options.clock, 1.0 / options.rate_hz,
-                           {geometry_hash(spidar.geometry), spidar.source});
-    SpidarDriver device(spidar.geometry, port, options.clock, options.haptic_session);
-    ShmWorldLinkClient world(shm, options.clock, world_wait_s);
+    // A SPIDAR string set per finger, each on its own port; one finger is the SPIDAR itself.
+    std::vector<std::unique_ptr<ShmDevicePortHost>> ports;
+    std::vector<std::unique_ptr<SpidarDriver>> drivers;
+    std::vector<HapticDevice*> devices;
+    for (unsigned k = 0; k < fingers; ++k) {
+      ports.push_back(std::make_unique<ShmDevicePortHost>(shm, options.clock, 1.0 / options.rate_hz,
+                                                          DeviceDescription{geometry_hash(spidar.geometry),
+                                                                            spidar.source},
+                                                          k));
+      drivers.push_back(
+          std::make_unique<SpidarDriver>(spidar.geometry, *ports.back(), options.clock, options.haptic_session));
+      devices.push_back(drivers.back().get());
+    }
+    std::optional<FingerSet> finger_set;
+    if (fingers > 1) finger_set.emplace(devices);
+    HapticDevice& device = finger_set ? static_cast<HapticDevice&>(*finger_set) : *drivers[0];
+    ShmWorldLinkClient world(world_shm.empty() ? shm : world_shm, options.clock, world_wait_s, fingers);
     HapticNode node(options, world, device);
-    std::fprintf(stderr, "haptic_controller: %.0f Hz, %s clock, world at %.1f Hz, device port '%s'\n",
-                 options.rate_hz, to_string(options.clock), world.info().world_rate_hz, port.name().c_str());
+    std::fprintf(stderr, "haptic_controller: %.0f Hz, %s clock, world at %.1f Hz, device port '%s'%s\n",
+                 options.rate_hz, to_string(options.clock), world.info().world_rate_hz, ports[0]->name().c_str(),
+                 fingers > 1 ? (" and " + std::to_string(fingers - 1) + " more, one per finger").c_str() : "");
     const int status = node.run();
     write_summary(summary_path, node.summary());
     const ServoCounters& counters = node.servo().counters();

@@ -4,6 +4,8 @@
 #include "common/link/inproc/inproc_device_port.h"
 #include "common/link/inproc/inproc_world_link.h"
 #include "common/runtime/cli.h"
+#include "common/runtime/log_paths.h"
+#include "haptic_controller/device/finger_set.h"
 #include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/haptic_node.h"
 #include "spidar_sim/device_node.h"
@@ -11,7 +13,11 @@
 #include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world_node.h"
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
+#include <optional>
+#include <vector>
 #include <cstdio>
 #include <mutex>
 #include <stdexcept>
@@ -82,18 +88,51 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   haptic_options.stiffness_Npm = options.stiffness_Npm;
   haptic_options.damping_Nspm = options.damping_Nspm;
   haptic_options.duration_s = options.duration_s;
-  InProcessDevicePort port(1.0 / haptic_options.rate_hz);
-  SpidarDriver driver(SpidarGeometry{}, port, ClockMode::lockstep, haptic_options.haptic_session);
-  HapticNode haptic(haptic_options, world_link.attach(1), driver);
-
-  DeviceSim sim(SpidarGeometry{}, HardwareParams{}, FingerParams{}, load_trajectory(options.trajectory));
-  DeviceNode device(sim, port, log_path(options.out_dir, "device.csv"), 1);
-  port.connect(device);
+  // The device: one SPIDAR string set, port and simulated finger per finger (one for a --trajectory trial).
+  if (!options.fingers.empty() && !options.trajectory.empty()) {
+    throw std::invalid_argument("give trajectory or fingers, not both");
+  }
+  const std::vector<NamedFinger> fingers = options.fingers.empty()
+                                               ? std::vector<NamedFinger>{{"finger", load_trajectory(options.trajectory)}}
+                                               : parse_fingers(options.fingers, kMaxFingers);
+  double longest_s = 0.0;
+  for (const NamedFinger& named : fingers) longest_s = std::max(longest_s, named.trajectory.duration_s());
+  std::vector<std::unique_ptr<InProcessDevicePort>> ports;
+  std::vector<std::unique_ptr<SpidarDriver>> drivers;
+  std::vector<std::unique_ptr<DeviceSim>> sims;
+  std::vector<std::unique_ptr<DeviceNode>> devices;
+  std::vector<HapticDevice*> finger_devices;
+  for (std::size_t k = 0; k < fingers.size(); ++k) {
+    ports.push_back(std::make_unique<InProcessDevicePort>(1.0 / haptic_options.rate_hz));
+    drivers.push_back(std::make_unique<SpidarDriver>(SpidarGeometry{}, *ports.back(), ClockMode::lockstep,
+                                                     haptic_options.haptic_session));
+    finger_devices.push_back(drivers.back().get());
+    sims.push_back(std::make_unique<DeviceSim>(SpidarGeometry{}, HardwareParams{}, FingerParams{},
+                                               fingers[k].trajectory.held_until(longest_s)));
+    devices.push_back(std::make_unique<DeviceNode>(
+        *sims.back(), *ports.back(),
+        endpoint_log_path(log_path(options.out_dir, "device.csv"), static_cast<std::uint32_t>(k)), 1 + k));
+    ports.back()->connect(*devices.back());
+  }
+  std::optional<FingerSet> finger_set;
+  if (fingers.size() > 1) finger_set.emplace(finger_devices);
+  HapticDevice& device = finger_set ? static_cast<HapticDevice&>(*finger_set) : *drivers[0];
+  HapticNode haptic(haptic_options, world_link.attach(static_cast<std::uint32_t>(fingers.size())), device);
 
   haptic.run();
   nlohmann::json summary = world.summary();
   summary.update(haptic.summary());
-  summary.update(device.summary());
+  summary.update(devices[0]->summary());
+  if (fingers.size() > 1) {
+    nlohmann::json per_finger = nlohmann::json::array();
+    for (std::size_t k = 0; k < fingers.size(); ++k) {
+      nlohmann::json one = devices[k]->summary()["device"];
+      one["name"] = fingers[k].name;
+      one["trajectory"] = fingers[k].trajectory.description();
+      per_finger.push_back(one);
+    }
+    summary["device"]["fingers"] = per_finger;
+  }
   return summary;
 }
 

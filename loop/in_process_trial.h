@@ -16,12 +16,16 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace impetus {
 
 struct InProcessTrialOptions {
   std::string scene_path;  // a scene file (world_manager/scene.h)
   std::string trajectory;  // a trajectory CSV file or a built-in spec, as spidar_sim --trajectory takes
+  // Or a several-finger device: "NAME=TRAJECTORY" per finger, as spidar_sim --finger takes (then `trajectory` must be
+  // empty). Finger k is endpoint k of the world; its logs are haptic.endpointK.csv and device.endpointK.csv.
+  std::vector<std::string> fingers;
   Coupling coupling = Coupling::impulse;
   std::uint64_t phase_ticks = 0;  // lockstep phase of the world clock, in haptic ticks (< one world period)
   // Each has the range of the daemon flag it mirrors (common/contract/limits.h) and the same default.

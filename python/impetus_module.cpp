@@ -30,13 +30,15 @@ impetus::Coupling parse_coupling(const std::string& name) {
 }
 
 // The trial's summary.json document as text (the Python half parses it into a dict).
-std::string run_trial(const std::string& scene, const std::string& trajectory, const std::string& coupling,
+std::string run_trial(const std::string& scene, const std::string& trajectory, const std::vector<std::string>& fingers,
+                      const std::string& coupling,
                       std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
                       std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm, double duration_s,
                       const std::string& out_dir) {
   impetus::InProcessTrialOptions options;
   options.scene_path = scene;
   options.trajectory = trajectory;
+  options.fingers = fingers;
   options.coupling = parse_coupling(coupling);
   options.phase_ticks = phase_ticks;
   options.world_rate_hz = world_rate_hz;
@@ -96,7 +98,7 @@ py::tuple read_log(const std::string& path) {
 
 PYBIND11_MODULE(_impetus, module) {
   module.doc() = "Impetus' compiled core; use the impetus package, not this module.";
-  module.def("run_trial", &run_trial, py::arg("scene"), py::arg("trajectory"), py::arg("coupling"),
+  module.def("run_trial", &run_trial, py::arg("scene"), py::arg("trajectory"), py::arg("fingers"), py::arg("coupling"),
              py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("stiffness_Npm"),
              py::arg("damping_Nspm"), py::arg("duration_s"), py::arg("out_dir"));
   module.def("read_log", &read_log, py::arg("path"));

@@ -3,11 +3,13 @@
 # Runs one trial: world_manager + haptic_controller + spidar_sim (DESIGN.md §4), collects their logs under DIR,
 # prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
 #
-#   scripts/run.sh --scene FILE --trajectory SPEC [--coupling impulse|position|local] [--rate HZ] [--phase TICKS]
-#                  [--substeps N]
+#   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ...) [--coupling impulse|position|local]
+#                  [--rate HZ] [--phase TICKS] [--substeps N]
 #                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet]
 #                  [--view [--view-listen HOST:PORT] [--view-wait S]]
 #                  [-- extra haptic_controller flags, e.g. --stiffness 5000]
+# --finger (once per finger, up to 8) runs a several-finger device: one endpoint of the world per finger; logs of
+# finger k > 0 are haptic.endpointK.csv and device.endpointK.csv.
 # --view starts a viewer beside the trial (default address 127.0.0.1:8080) and prints where to watch it; with
 # --view-wait S the finger starts S seconds after the world, time to open the page. Afterwards
 # `build/viewer/viewer --replay DIR` plays the trial back.
@@ -17,16 +19,18 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${IMPETUS_BUILD_DIR:-$root/build}"
 
-usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "run.sh: $*" >&2; exit 2; }
 
 view=0 view_listen="127.0.0.1:8080" view_wait=0
 substeps="" scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
 haptic_extra=()
+fingers=()
 while (($#)); do
   case "$1" in
     --scene) scene="${2:?}"; shift 2 ;;
     --trajectory) trajectory="${2:?}"; shift 2 ;;
+    --finger) fingers+=("${2:?}"); shift 2 ;;
     --coupling) coupling="${2:?}"; shift 2 ;;
     --rate) rate="${2:?}"; shift 2 ;;
     --substeps) substeps="${2:?}"; shift 2 ;;
@@ -45,7 +49,12 @@ while (($#)); do
 done
 [ -n "$scene" ] || die "--scene is required"
 [ -f "$scene" ] || die "--scene: no such file '$scene'"
-[ -n "$trajectory" ] || die "--trajectory is required"
+if ((${#fingers[@]})); then
+  [ -z "$trajectory" ] || die "give --trajectory or --finger, not both"
+  ((${#fingers[@]} <= 8)) || die "--finger: at most 8 fingers, not ${#fingers[@]}"
+else
+  [ -n "$trajectory" ] || die "--trajectory (or --finger NAME=SPEC for each finger) is required"
+fi
 case "$clock" in realtime|lockstep) ;; *) die "--clock must be realtime or lockstep, not '$clock'" ;; esac
 [[ "$view_wait" =~ ^[0-9]+([.][0-9]+)?$ ]] || die "--view-wait must be a number of seconds, not '$view_wait'"
 bins=(world_manager haptic_controller spidar_sim)
@@ -64,8 +73,17 @@ world_args=(--scene "$scene" --coupling "$coupling" --clock "$clock" --phase "$p
 [ -n "$substeps" ] && world_args+=(--substeps "$substeps")
 haptic_args=(--clock "$clock" --duration "$duration" --shm "$shm" --log "$out/haptic.csv"
              --summary "$out/haptic.json" "${haptic_extra[@]}")
-device_args=(--clock "$clock" --trajectory "$trajectory" --shm "$shm" --log "$out/device.csv"
-             --summary "$out/device.json")
+device_args=(--clock "$clock" --shm "$shm" --log "$out/device.csv" --summary "$out/device.json")
+if ((${#fingers[@]})); then
+  haptic_args+=(--fingers "${#fingers[@]}")
+  for finger in "${fingers[@]}"; do device_args+=(--finger "$finger"); done
+  trajectory="$(IFS=' '; echo "${fingers[*]}")"
+else
+  device_args+=(--trajectory "$trajectory")
+fi
+# Every segment the trial may create: the world's, the viewer's and one device port per finger.
+segments=("/dev/shm/$shm.world" "/dev/shm/$shm.view" "/dev/shm/$shm.device")
+for ((k = 1; k < ${#fingers[@]}; ++k)); do segments+=("/dev/shm/$shm.device$k"); done
 
 pids=()
 viewer_pid=""
@@ -76,7 +94,7 @@ on_interrupt() {
   echo "run.sh: interrupted, stopping the trial" >&2
   stop_all
   wait || true
-  rm -f "/dev/shm/$shm.world" "/dev/shm/$shm.device" "/dev/shm/$shm.view"
+  rm -f "${segments[@]}"
   exit 130
 }
 trap on_interrupt INT TERM
@@ -130,7 +148,7 @@ for name in world haptic device; do
 done
 end=$(date +%s.%N)
 trap - INT TERM
-for segment in "/dev/shm/$shm.world" "/dev/shm/$shm.device" "/dev/shm/$shm.view"; do
+for segment in "${segments[@]}"; do
   [ -e "$segment" ] && { echo "run.sh: $segment was left behind; removing it" >&2; rm -f "$segment"; status=1; }
 done
 ((status == 0)) || exit "$status"

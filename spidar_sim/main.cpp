@@ -7,6 +7,13 @@
 #include "common/runtime/cli.h"
 #include "spidar_sim/device_node.h"
 #include "spidar_sim/trajectory.h"
+#include "common/runtime/log_paths.h"
+
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
 
 namespace {
 // A finger with hand and forearm behind it is ~2 kg: 10 kg is beyond any body part a device is strapped to.
@@ -28,9 +35,16 @@ int main(int argc, char** argv) {
   FingerParams finger;
   CLI::App app{"spidar_sim: a simulated SPIDAR device and finger playing a scripted trajectory against a running "
                "haptic_controller."};
-  app.add_option("--trajectory", trajectory_spec,
-                 "CSV file with header t,x,y,z, or a built-in: tap|press|slide|circle[:key=value,...]")
-      ->required();
+  std::vector<std::string> finger_specs;
+  auto* trajectory_flag =
+      app.add_option("--trajectory", trajectory_spec,
+                     "CSV file with header t,x,y,z, or a built-in: tap|press|slide|circle[:key=value,...]");
+  auto* finger_flag = app.add_option(
+      "--finger", finger_specs,
+      "NAME=TRAJECTORY, once per finger of a several-finger device (the haptic controller's --fingers): finger k "
+      "attaches to its port k and plays its trajectory; all fingers run until the longest trajectory ends");
+  trajectory_flag->excludes(finger_flag);
+  finger_flag->excludes(trajectory_flag);
   add_clock_flag(app, clock);
   add_output_flag(app, "--log", log_path, "CSV log: time, target, finger, velocity, force, tensions, counts");
   add_output_flag(app, "--summary", summary_path, "JSON summary written at exit (ticks, finger and device)");
@@ -49,18 +63,53 @@ int main(int argc, char** argv) {
       ->check(number_in(0.0, kMaxMotorLag_s));
   CLI11_PARSE(app, argc, argv);
 
+  if (trajectory_spec.empty() && finger_specs.empty()) {
+    std::fprintf(stderr, "spidar_sim: error: give --trajectory, or --finger NAME=TRAJECTORY for each finger\n");
+    return 2;
+  }
+
   return run_node("spidar_sim", [&] {
-    const Trajectory trajectory = load_trajectory(trajectory_spec);
+    const std::vector<NamedFinger> fingers =
+        finger_specs.empty() ? std::vector<NamedFinger>{{"finger", load_trajectory(trajectory_spec)}}
+                             : parse_fingers(finger_specs, kMaxFingers);
+    double longest_s = 0.0;
+    for (const NamedFinger& named : fingers) longest_s = std::max(longest_s, named.trajectory.duration_s());
     const SpidarDevice spidar = parse_device_spec(device_spec);
-    DeviceSim sim(spidar.geometry, hardware, finger, trajectory);
-    ShmDevicePortClient port(shm, clock, attach_timeout_s, {geometry_hash(spidar.geometry), spidar.source});
-    DeviceNode node(sim, port, log_path, new_session_id());
-    std::fprintf(stderr, "spidar_sim: attached to '%s' (%s), trajectory %.3f s\n", port.name().c_str(),
-                 to_string(clock), trajectory.duration_s());
-    const int status = node.run();
-    write_summary(summary_path, node.summary());
+    // One SPIDAR string set, simulation and port per finger, each on its own thread (in lockstep each waits for its
+    // own turn, which the haptic controller gives in finger order).
+    std::vector<std::unique_ptr<DeviceSim>> sims;
+    std::vector<std::unique_ptr<ShmDevicePortClient>> ports;
+    std::vector<std::unique_ptr<DeviceNode>> nodes;
+    for (std::size_t k = 0; k < fingers.size(); ++k) {
+      sims.push_back(std::make_unique<DeviceSim>(spidar.geometry, hardware, finger,
+                                                 fingers[k].trajectory.held_until(longest_s)));
+      ports.push_back(std::make_unique<ShmDevicePortClient>(
+          shm, clock, attach_timeout_s, DeviceDescription{geometry_hash(spidar.geometry), spidar.source},
+          static_cast<unsigned>(k)));
+      nodes.push_back(std::make_unique<DeviceNode>(*sims.back(), *ports.back(),
+                                                   endpoint_log_path(log_path, static_cast<std::uint32_t>(k)),
+                                                   new_session_id()));
+      std::fprintf(stderr, "spidar_sim: '%s' attached to '%s' (%s), trajectory %.3f s\n", fingers[k].name.c_str(),
+                   ports.back()->name().c_str(), to_string(clock), fingers[k].trajectory.duration_s());
+    }
+    std::vector<int> statuses(nodes.size(), 0);
+    std::vector<std::thread> threads;
+    for (std::size_t k = 1; k < nodes.size(); ++k) threads.emplace_back([&, k] { statuses[k] = nodes[k]->run(); });
+    statuses[0] = nodes[0]->run();
+    for (std::thread& thread : threads) thread.join();
+
+    nlohmann::json summary = nodes[0]->summary();
+    nlohmann::json per_finger = nlohmann::json::array();
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      nlohmann::json one = nodes[k]->summary()["device"];
+      one["name"] = fingers[k].name;
+      one["trajectory"] = fingers[k].trajectory.description();
+      per_finger.push_back(one);
+    }
+    if (nodes.size() > 1) summary["device"]["fingers"] = per_finger;  // a one-finger summary stays as it was
+    write_summary(summary_path, summary);
     std::fprintf(stderr, "spidar_sim: detached after %llu ticks (%.3f s simulated)\n",
-                 static_cast<unsigned long long>(node.ticks()), sim.time_s());
-    return status;
+                 static_cast<unsigned long long>(nodes[0]->ticks()), sims[0]->time_s());
+    return *std::max_element(statuses.begin(), statuses.end());
   });
 }

@@ -230,6 +230,18 @@ const TrajectorySegment& Trajectory::segment_at(double t_s) const {
   return it == segments_.end() ? segments_.back() : *it;
 }
 
+Trajectory Trajectory::held_until(double end_s) const {
+  if (!(end_s > duration_s())) return *this;
+  std::vector<TrajectorySegment> segments = segments_;
+  TrajectorySegment hold;
+  hold.begin_s = duration_s();
+  hold.end_s = end_s;
+  hold.from_m = position_at(duration_s());
+  hold.to_m = hold.from_m;
+  segments.push_back(hold);
+  return Trajectory(std::move(segments), description_);
+}
+
 Vec3 Trajectory::position_at(double t_s) const {
   if (!(t_s > segments_.front().begin_s)) return to_vec3(point_on_path(segments_.front(), 0.0));
   if (t_s >= segments_.back().end_s) return to_vec3(point_on_path(segments_.back(), 1.0));
@@ -600,6 +612,30 @@ Trajectory load_trajectory(const std::string& spec_or_path) {
     return make_builtin_trajectory(spec_or_path);
   }
   return load_trajectory_csv(spec_or_path);
+}
+
+std::vector<NamedFinger> parse_fingers(const std::vector<std::string>& specs, std::size_t max_fingers) {
+  if (specs.empty() || specs.size() > max_fingers) {
+    throw TrajectoryError("a device has 1 to " + std::to_string(max_fingers) + " fingers, but " +
+                          std::to_string(specs.size()) + " were given");
+  }
+  std::vector<NamedFinger> fingers;
+  for (const std::string& spec : specs) {
+    const std::size_t equals = spec.find('=');
+    if (equals == std::string::npos || equals == 0 || equals + 1 == spec.size()) {
+      throw TrajectoryError("finger '" + spec + "': expected NAME=TRAJECTORY (e.g. thumb=grasp_thumb.csv)");
+    }
+    const std::string name = spec.substr(0, equals);
+    for (const NamedFinger& other : fingers) {
+      if (other.name == name) throw TrajectoryError("finger '" + name + "' is given twice");
+    }
+    try {
+      fingers.push_back({name, load_trajectory(spec.substr(equals + 1))});
+    } catch (const TrajectoryError& error) {
+      throw TrajectoryError("finger '" + name + "': " + error.what());
+    }
+  }
+  return fingers;
 }
 
 }  // namespace impetus

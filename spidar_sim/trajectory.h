@@ -129,6 +129,9 @@ class Trajectory {
   Vec3 velocity_at(double t_s) const;
   // Time (s) of the last point; after it the target holds still.
   double duration_s() const { return segments_.back().end_s; }
+  // The same path, then holding its last point until end_s (if later than its own end): the fingers of one device
+  // run for as long as the longest of their trajectories.
+  Trajectory held_until(double end_s) const;
   // The spec or path this trajectory was made from, for logs and run summaries.
   const std::string& description() const { return description_; }
 
@@ -142,6 +145,15 @@ class Trajectory {
 // A built-in spec (see above) if the text before ':' names a built-in and no file of that name exists, otherwise the
 // path of a CSV file. Throws TrajectoryError.
 Trajectory load_trajectory(const std::string& spec_or_path);
+
+// One finger of a several-finger device and the trajectory it plays (spidar_sim --finger NAME=TRAJECTORY).
+struct NamedFinger {
+  std::string name;
+  Trajectory trajectory;
+};
+// Parses "NAME=TRAJECTORY" specs (TRAJECTORY as load_trajectory takes it): 1 to `max_fingers` of them, names
+// non-empty and distinct. Throws TrajectoryError naming the spec.
+std::vector<NamedFinger> parse_fingers(const std::vector<std::string>& specs, std::size_t max_fingers);
 
 // The parts of load_trajectory, for callers that know which they have.
 Trajectory load_trajectory_csv(const std::string& path);

@@ -236,9 +236,9 @@ nlohmann::json WorldNode::summary() const {
                          {"impulse_by_object_Ns", impulses}});
   }
   return {{"objects", objects},
-          {"endpoints", endpoints},
           {"world",
            {{"steps", world_.steps_taken()},
+            {"endpoints", endpoints},
             {"time_s", world_.time_s()},
             {"period_s", world_.world_period_s()},
             {"skipped_periods", stats_.skipped_periods},

@@ -22,6 +22,8 @@ inline constexpr std::uint32_t kMaxPlanes = 64;          // planes in one world 
 // Endpoints one world serves at once, over all its haptic controllers (DESIGN.md §1): two hands of four fingers, or
 // several users with a finger or two each.
 inline constexpr std::uint32_t kMaxEndpoints = 8;
+// Fingers one device may serve (a SPIDAR with a string set per finger): each is an endpoint of the world.
+inline constexpr std::uint32_t kMaxFingers = kMaxEndpoints;
 inline constexpr std::uint32_t kMaxImpulseEntries = 64;  // objects with a running impulse total in one report
 
 enum class Coupling : std::uint32_t {

@@ -20,15 +20,15 @@ namespace impetus {
 struct FingerSample {
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // world frame
   bool valid = false;
+  // False when this finger's part of a several-finger device is absent or stale while others answer: the servo then
+  // gets no finger (minimum output, no fault), as when the whole device is absent.
+  bool present = true;
 };
 
 // What the device can render; the servo clamps to it.
 struct DeviceLimits {
   double max_force_N = 0.0;
 };
-
-// Fingers one device may serve (a SPIDAR with a string set per finger, two hands): each is an endpoint of the world.
-inline constexpr std::uint32_t kMaxFingers = kMaxEndpoints;
 
 // What to render on one finger: `render` false commands the device's minimum output there.
 struct FingerCommand {

@@ -96,7 +96,9 @@ def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_tick
 
     scene          a scene file (str or path; shipped_scene("tap") for a shipped one)
     trajectory     the finger's path: a built-in ("tap", "tap:speed=0.2", "hold", ...) or a trajectory CSV file, as
-                   spidar_sim --trajectory takes
+                   spidar_sim --trajectory takes; or, for a device of several fingers, a dict {name: path} in finger
+                   order (spidar_sim --finger NAME=PATH), each finger an endpoint of the world (Trial.logs holds
+                   the first finger's logs)
     coupling       one of COUPLINGS
     rate_hz        the world rate (world_manager --rate); None: the scene's
     phase_ticks    the world clock's lockstep phase in haptic ticks, within one world period (world_manager --phase)
@@ -123,11 +125,14 @@ def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_tick
         directory = pathlib.Path(out_dir) if out_dir is not None else pathlib.Path(scratch)
         directory.mkdir(parents=True, exist_ok=True)
         start = time.monotonic()
-        summary = json.loads(_impetus.run_trial(str(scene), str(trajectory), coupling, phase_ticks, rate_hz, substeps,
+        fingers = [f"{name}={path}" for name, path in trajectory.items()] if isinstance(trajectory, dict) else []
+        summary = json.loads(_impetus.run_trial(str(scene), "" if fingers else str(trajectory), fingers, coupling,
+                                                phase_ticks, rate_hz, substeps,
                                                 stiffness_Npm, damping_Nspm, float(duration_s),
                                                 str(directory) if (out_dir is not None or logs) else ""))
         # What run.sh adds to the daemons' config (impetus_py/summary.py): the trial's own arguments.
-        summary["config"].update({"scene": str(scene), "trajectory": str(trajectory), "duration_s": float(duration_s),
+        trajectory_text = " ".join(fingers) if fingers else str(trajectory)
+        summary["config"].update({"scene": str(scene), "trajectory": trajectory_text, "duration_s": float(duration_s),
                                   "wall_time_s": time.monotonic() - start})
         if out_dir is not None:
             (directory / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

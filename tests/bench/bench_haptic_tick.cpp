@@ -1,14 +1,19 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tick cost of the haptic servo with its SPIDAR driver (kinematics + interpolation + proxy + force + accumulation +
-// tensions) against the number of planes in the world frame: p50 / p99 in ns. Prints only; no assertions.
+// tensions) against the number of planes in the world frame: p50 / p99 in ns. Then the cost of one controller tick
+// with 1, 2, 4 and 8 endpoints (a SPIDAR string set, port and servo per finger, 4 planes each, the pushes exchanged
+// among them). Prints only; no assertions.
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <array>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "common/link/inproc/inproc_device_port.h"
+#include "haptic_controller/device/finger_set.h"
 #include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/servo.h"
 
@@ -93,9 +98,61 @@ void run(int planes) {
               ns[kTicks / 2], ns[kTicks * 99 / 100], ns.back(), 100.0 * contact_ticks / kTicks);
 }
 
+// One controller tick with `endpoints` fingers: the finger set's read (each finger's port turn and kinematics), a
+// servo tick per finger, the push exchange, and the forces to every finger's strings.
+void run_endpoints(int endpoints) {
+  constexpr int kPlanes = 4;
+  const SpidarGeometry geometry;
+  const SpidarKinematics kinematics(geometry);
+  std::vector<std::unique_ptr<InProcessDevicePort>> ports;
+  std::vector<std::unique_ptr<ScriptedDevice>> devices;
+  std::vector<std::unique_ptr<SpidarDriver>> drivers;
+  std::vector<std::unique_ptr<HapticServo>> servos;
+  std::vector<HapticDevice*> fingers;
+  std::vector<HapticServo*> servo_list;
+  for (int k = 0; k < endpoints; ++k) {
+    ports.push_back(std::make_unique<InProcessDevicePort>(1e-3));
+    devices.push_back(std::make_unique<ScriptedDevice>(*ports.back()));
+    ports.back()->connect(*devices.back());
+    drivers.push_back(std::make_unique<SpidarDriver>(geometry, *ports.back(), ClockMode::lockstep, 1));
+    fingers.push_back(drivers.back().get());
+    servos.push_back(std::make_unique<HapticServo>(ServoOptions{}, 1, static_cast<EndpointId>(k)));
+    servo_list.push_back(servos.back().get());
+  }
+  FingerSet set(fingers);
+  std::array<FingerCommand, kMaxFingers> commands{};
+  std::vector<double> ns(kTicks);
+  for (int tick = 0; tick < kTicks; ++tick) {
+    const double now_s = tick * 1e-3;
+    if (tick % kTicksPerWorldStep == 0) {
+      for (auto& servo : servos) servo->on_plane_frame(make_frame(kPlanes, tick / kTicksPerWorldStep, now_s), now_s);
+    }
+    for (int k = 0; k < endpoints; ++k) {
+      const Eigen::Vector3d finger =
+          to_eigen(geometry.centre_m) + 0.05 * Eigen::Vector3d(std::sin(tick * 0.0031 + k), std::sin(tick * 0.0023),
+                                                               std::sin(tick * 0.0017 - k));
+      devices[k]->state.encoder_counts = kinematics.encoder_counts(finger);
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const FingerSample* samples = set.read(static_cast<std::uint64_t>(tick), now_s);
+    for (int k = 0; k < endpoints; ++k) {
+      const TickResult& result = servos[k]->tick(&samples[k], now_s, 1e-3);
+      commands[k] = {to_eigen(result.force_N), result.render};
+    }
+    exchange_pushes(servo_list);
+    set.command_fingers(static_cast<std::uint64_t>(tick), commands.data());
+    const auto stop = std::chrono::steady_clock::now();
+    ns[tick] = std::chrono::duration<double, std::nano>(stop - start).count();
+  }
+  std::sort(ns.begin(), ns.end());
+  std::printf("endpoints %d  controller tick p50 %8.0f ns  p99 %8.0f ns  max %8.0f ns  (p50 per endpoint %.0f ns)\n",
+              endpoints, ns[kTicks / 2], ns[kTicks * 99 / 100], ns.back(), ns[kTicks / 2] / endpoints);
+}
+
 }  // namespace
 
 int main() {
   for (const int planes : {1, 4, 16, 64}) run(planes);
+  for (const int endpoints : {1, 2, 4, 8}) run_endpoints(endpoints);
   return 0;
 }

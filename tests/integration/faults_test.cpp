@@ -214,3 +214,101 @@ TEST_CASE("random bytes written into a live world link are rejected and counted 
 }
 
 }  // namespace impetus
+
+namespace impetus {
+namespace {
+
+// One user of a shared world: a haptic controller with its own device port (--shm) on the world's link
+// (--world-shm), and a simulated finger on a CSV path.
+struct User {
+  const Daemons& world;
+  std::string name;
+  std::string shm() const { return world.shm + "_" + name; }
+  pid_t haptic(const std::string& tag) const {
+    return test::spawn({test::binary("haptic_controller"), "--shm", shm(), "--world-shm", world.shm, "--log",
+                        (world.dir / ("haptic_" + name + tag + ".csv")).string(), "--summary",
+                        (world.dir / ("haptic_" + name + tag + ".json")).string()},
+                       world.dir / ("haptic_" + name + tag + ".out"));
+  }
+  pid_t device(const std::string& tag, const std::filesystem::path& path) const {
+    return test::spawn({test::binary("spidar_sim"), "--shm", shm(), "--trajectory", path.string()},
+                       world.dir / ("device_" + name + tag + ".out"));
+  }
+};
+
+// A finger that comes in along x from `from_x` to `to_x` over 0.5 s and holds there until `until_s`.
+std::filesystem::path side_press(const std::filesystem::path& dir, const std::string& name, double from_x, double to_x,
+                                 double until_s) {
+  const std::filesystem::path path = dir / (name + ".csv");
+  std::ofstream out(path);
+  out << "t,x,y,z\n0," << from_x << ",0,0.025\n0.5," << to_x << ",0,0.025\n" << until_s << "," << to_x << ",0,0.025\n";
+  return path;
+}
+
+}  // namespace
+
+TEST_CASE("two users on one world: one controller killed with kill -9 mid-squeeze leaves the other undisturbed, and "
+          "its restart causes no burst") {
+  Daemons daemons = make_daemons("twousers");
+  daemons.scene = std::string(IMPETUS_SOURCE_DIR) + "/scenes/grasp.json";
+  daemons.coupling = "local";
+  const User a{daemons, "a"}, b{daemons, "b"};
+  // The grasp scene's cube (sides at x = ±0.025 m) squeezed from both sides, 10 mm past each side (about 2.6 N).
+  const auto path_a = side_press(daemons.dir, "a", -0.045, -0.015, 8.0);
+  const auto path_b = side_press(daemons.dir, "b", 0.045, 0.015, 8.0);
+  const pid_t world = daemons.world("");
+  const pid_t haptic_a = a.haptic("");
+  const pid_t device_a = a.device("", path_a);
+  pid_t haptic_b = b.haptic("1");
+  const pid_t device_b = b.device("1", path_b);
+  sleep_s(2.5);  // both squeeze from about 0.5 s on
+  kill(haptic_b, SIGKILL);
+  CHECK(test::wait_for(haptic_b, 5.0) == -1);
+  CHECK(test::wait_for(device_b, 10.0) >= 0);  // its device saw the host die and left by itself
+  sleep_s(1.0);
+  haptic_b = b.haptic("2");
+  const pid_t device_b2 = b.device("2", path_b);
+  CHECK(test::wait_for(device_a, 30.0) == 0);
+  CHECK(test::wait_for(device_b2, 30.0) == 0);
+  kill(haptic_b, SIGTERM);
+  CHECK(test::wait_for(haptic_b, 10.0) == 0);
+  stop_like_a_user(haptic_a, world);
+  INFO(test::read_text(daemons.dir / "haptic_a.out") << test::read_text(daemons.dir / "haptic_b2.out"));
+
+  // User A ran through: every tick, no fault, and its force never rose above what it was squeezing with before the
+  // other user vanished (with B gone, A only pushes the cube away).
+  const auto summary_a = test::read_json(daemons.dir / "haptic_a.json")["haptic"];
+  CHECK(summary_a["faults"] == 0);
+  CHECK(summary_a["world_attaches"] == 1);
+  const auto log_a = test::read_csv_columns(daemons.dir / "haptic_a.csv");
+  const auto& time_a = log_a.at("time_s");
+  const auto& force_x = log_a.at("force_x");
+  REQUIRE(time_a.size() > 5000);
+  double before_N = 0.0, after_N = 0.0;
+  for (std::size_t i = 0; i < time_a.size(); ++i) {
+    (time_a[i] < 2.5 ? before_N : after_N) = std::max(time_a[i] < 2.5 ? before_N : after_N, std::abs(force_x[i]));
+  }
+  INFO("user A's largest force before the kill " << before_N << " N, after " << after_N << " N");
+  CHECK(before_N > 1.0);  // it really squeezed
+  CHECK(after_N <= 1.1 * before_N);
+
+  // The world served both: B's restarted controller took a slot again, and its impulse is applied from zero (no
+  // burst): the cube never moves faster than a finger does.
+  const auto summary_b2 = test::read_json(daemons.dir / "haptic_b2.json")["haptic"];
+  CHECK(summary_b2["faults"] == 0);
+  const auto world_log = test::read_csv_columns(daemons.dir / "world.csv");
+  double fastest_mps = 0.0;
+  for (std::size_t i = 0; i < world_log.at("cube.vx_mps").size(); ++i) {
+    fastest_mps = std::max(fastest_mps, std::hypot(world_log.at("cube.vx_mps")[i], world_log.at("cube.vy_mps")[i],
+                                                   world_log.at("cube.vz_mps")[i]));
+  }
+  INFO("fastest cube " << fastest_mps << " m/s");
+  CHECK(fastest_mps < 1.0);
+  const auto world_summary = test::read_json(daemons.dir / "world.json")["world"];
+  CHECK(world_summary["endpoints"].size() == 3);  // A, the killed B and the restarted B: three ledgers
+  CHECK_FALSE(daemons.segments_left());
+  CHECK_FALSE(std::filesystem::exists("/dev/shm/" + device_port_name(a.shm())));
+  CHECK_FALSE(std::filesystem::exists("/dev/shm/" + device_port_name(b.shm())));
+}
+
+}  // namespace impetus

@@ -7,7 +7,10 @@
 namespace impetus {
 
 inline std::string world_link_name(const std::string& shm) { return shm + ".world"; }
-inline std::string device_port_name(const std::string& shm) { return shm + ".device"; }
+// Finger k of a several-finger device has its own port: "<shm>.device" for finger 0, "<shm>.device<k>" after it.
+inline std::string device_port_name(const std::string& shm, unsigned finger = 0) {
+  return finger == 0 ? shm + ".device" : shm + ".device" + std::to_string(finger);
+}
 inline std::string world_view_name(const std::string& shm) { return shm + ".view"; }
 
 }  // namespace impetus

@@ -21,8 +21,8 @@ constexpr double kTurnTimeout_s = 60.0;
 }  // namespace
 
 ShmDevicePortHost::ShmDevicePortHost(const std::string& shm, ClockMode clock, double haptic_period_s,
-                                     const DeviceDescription& device)
-    : segment_(Segment<DevicePortLayout>::create(device_port_name(shm), [&](DevicePortLayout& port) {
+                                     const DeviceDescription& device, unsigned finger)
+    : segment_(Segment<DevicePortLayout>::create(device_port_name(shm, finger), [&](DevicePortLayout& port) {
         port.clock = clock;
         port.haptic_period_s = haptic_period_s;
         port.device_hash = device.hash;
@@ -110,8 +110,8 @@ bool ShmDevicePortHost::wait_for_device() {
 void ShmDevicePortHost::end_session() { segment_->device_turn.request_shutdown(); }
 
 ShmDevicePortClient::ShmDevicePortClient(const std::string& shm, ClockMode clock, double timeout_s,
-                                         const DeviceDescription& device)
-    : segment_(open_when_ready<DevicePortLayout>(device_port_name(shm), timeout_s)) {
+                                         const DeviceDescription& device, unsigned finger)
+    : segment_(open_when_ready<DevicePortLayout>(device_port_name(shm, finger), timeout_s)) {
   if (segment_->clock != clock) {
     throw std::runtime_error(std::string("the haptic controller runs --clock ") + to_string(segment_->clock) +
                              " but the device was started with --clock " + to_string(clock));

@@ -15,9 +15,10 @@ namespace impetus {
 
 class ShmDevicePortHost final : public DevicePortHost {
  public:
-  // Creates "<shm>.device" for a host ticking every `haptic_period_s` with `device` (throws SegmentError if a live
-  // process owns it).
-  ShmDevicePortHost(const std::string& shm, ClockMode clock, double haptic_period_s, const DeviceDescription& device);
+  // Creates the port of finger `finger` (names.h: "<shm>.device" for finger 0) for a host ticking every
+  // `haptic_period_s` with `device` (throws SegmentError if a live process owns it).
+  ShmDevicePortHost(const std::string& shm, ClockMode clock, double haptic_period_s, const DeviceDescription& device,
+                    unsigned finger = 0);
 
   const DeviceState* lockstep_turn(std::uint64_t tick) override;
   const DeviceState* latest_state(double now_s) override;
@@ -52,7 +53,9 @@ class ShmDevicePortClient final : public DevicePortClient {
   // Opens "<shm>.device" (waiting up to `timeout_s` for the haptic node to create it) and claims its slot (waiting
   // up to `timeout_s` for a dead device's slot to be freed). Throws if the host runs another clock than `clock`,
   // was configured for another device than `device` (naming both descriptions), or a live device holds the slot.
-  ShmDevicePortClient(const std::string& shm, ClockMode clock, double timeout_s, const DeviceDescription& device);
+  // `finger`: which finger's port (names.h) of a several-finger host.
+  ShmDevicePortClient(const std::string& shm, ClockMode clock, double timeout_s, const DeviceDescription& device,
+                      unsigned finger = 0);
   ~ShmDevicePortClient() override;
 
   ClockMode clock() const override { return segment_->clock; }
