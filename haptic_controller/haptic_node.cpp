@@ -139,6 +139,7 @@ bool HapticNode::lockstep_tick(std::uint64_t t) {
   // Exactly t·T: interpolation weights are then tick counts over n, the same in every run.
   const double now_s = static_cast<double>(t) * period_s_;
   tick(t, now_s, period_s_, 0);
+  world_.lead_followers(t);  // other controllers on this world take tick t too, before the world steps
   if (schedule_->world_step_due(t)) {
     if (world_.step_world(t)) {
       receive_frames(now_s);
@@ -167,10 +168,53 @@ void HapticNode::finish_lockstep() {
 // Lockstep time advances only while a device is attached: a lockstep run is in step with its device, so a session
 // starts from the same state whenever the device attaches, and nothing is simulated while nobody is there.
 void HapticNode::run_lockstep() {
+  if (world_.follower()) {
+    run_follower();
+    return;
+  }
+  if (options_.followers > 0) {
+    if (!world_.wait_for_followers(options_.followers)) {
+      finish_lockstep();
+      return;
+    }
+  }
   // A stop request is checked every tick: the followers' turns keep coming, so the stop must come from the master.
   for (std::uint64_t t = 0; lockstep_tick(t); ++t) {
   }
   finish_lockstep();
+}
+
+bool HapticNode::follow_tick(std::uint64_t t) {
+  if (t > 0) receive_frames(static_cast<double>(t - 1) * period_s_);
+  if (g_stop_requested.load() || !device_.wait_attached()) return false;
+  tick(t, static_cast<double>(t) * period_s_, period_s_, 0);
+  if (t % kStatsEveryTicks == 0) publish_stats(nullptr);
+  return true;
+}
+
+// Another controller is the lockstep master: take its ticks as they come (follow_tick).
+void HapticNode::run_follower() {
+  const std::uint64_t ticks = max_ticks();
+  bool master_lost = false;
+  for (std::uint64_t done = 0; done < ticks;) {
+    std::uint64_t t = 0;
+    const TurnResult result = world_.wait_follower_turn(t);
+    if (result != TurnResult::ok) {
+      master_lost = result != TurnResult::shutdown && !g_stop_requested.load();
+      if (master_lost) {
+        std::fprintf(stderr, "haptic_controller: error: the lockstep master went away mid-trial: %s\n",
+                     to_string(result));
+      }
+      break;
+    }
+    const bool attached = follow_tick(t);
+    if (attached) ++done;
+    world_.finish_follower_turn();
+    if (!attached) break;
+  }
+  world_.end_session();  // leaves the master's turns
+  device_.end_session();
+  if (master_lost || device_.counters().devices_lost > 0) cut_short_ = true;
 }
 
 void HapticNode::run_realtime() {

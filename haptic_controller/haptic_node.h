@@ -8,6 +8,7 @@
 //
 // Owns the servo, its log and statistics; its summary is the haptic half of summary.json (DESIGN.md §4).
 
+#include "common/link/inproc/inproc_world_link.h"
 #include "common/link/world_link.h"
 #include "common/runtime/lockstep_schedule.h"
 #include "common/runtime/log_paths.h"
@@ -37,6 +38,8 @@ struct HapticNodeOptions {
   std::string log_path;     // "": no log
   bool realtime_priority = true;
   std::uint64_t haptic_session = 1;  // nonzero; the nodes' mains pass new_session_id() (common/runtime/process.h)
+  // Lockstep master: other controllers (users) to wait for before the first tick; they then follow its ticks.
+  std::uint32_t followers = 0;
 };
 
 // One row of the haptic log (the ring holds these; formatted by the drain thread).
@@ -54,7 +57,7 @@ struct HapticLogRow {
 
 // A haptic node serves one endpoint per finger of its device (HapticDevice::finger_count()): a servo each, ticked in
 // finger order every tick, their forces commanded to the device together.
-class HapticNode {
+class HapticNode final : public FollowerStepper {
  public:
   // The link and the device must outlive the node. Throws std::invalid_argument for a lockstep world period that is
   // not a whole number of ticks or a link whose endpoints do not match the device's fingers, std::runtime_error if a
@@ -69,6 +72,10 @@ class HapticNode {
   // requested: the run is over; then finish_lockstep() ends it.
   bool lockstep_tick(std::uint64_t t);
   void finish_lockstep();
+  // A follower's tick `t` (another controller is the lockstep master): the frames the world published after the
+  // master's tick t−1, taken at time (t−1)·T as the master took them, then tick t. False once its device has left or
+  // a stop was requested (nothing was ticked).
+  bool follow_tick(std::uint64_t t) override;
 
   // The haptic half of summary.json; per endpoint under "endpoints".
   nlohmann::json summary() const;
@@ -91,6 +98,7 @@ class HapticNode {
                 std::int64_t lateness_ns);
   void receive_frames(double now_s);
   void run_lockstep();
+  void run_follower();
   void run_realtime();
   void publish_stats(const class RealtimeClock* clock);
   std::uint64_t max_ticks() const;

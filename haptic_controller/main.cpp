@@ -45,6 +45,10 @@ int main(int argc, char** argv) {
                  "fingers of the device, one endpoint of the world each, 1 to 8 (1); finger k has the device port "
                  "NAME.device (k = 0) or NAME.device<k>, and a string set of the device's geometry")
       ->check(CLI::Range(1u, kMaxFingers));
+  app.add_option("--followers", options.followers,
+                 "lockstep, the first of several users' controllers on one world: wait for this many more to attach "
+                 "(with --world-shm) before the first tick; they follow this one's ticks (0)")
+      ->check(CLI::Range(0u, kMaxEndpoints - 1));
   app.add_option("--world-shm", world_shm,
                  "the world link's NAME when it differs from --shm: several users' controllers, each with its own "
                  "--shm for its device, on one world");

@@ -60,6 +60,58 @@ void check_options(const InProcessTrialOptions& options) {
   if (options.duration_s != 0.0) check_option("duration_s", options.duration_s, positive_number(kMaxFlagSeconds));
 }
 
+// One user: a haptic node and its device, a SPIDAR string set, port and simulated finger per finger.
+struct Controller {
+  Controller(const HapticNodeOptions& haptic_options, const std::vector<NamedFinger>& fingers,
+             InProcessWorldLink& world, const std::string& device_log)
+      : names(fingers), link(world.attach(static_cast<std::uint32_t>(fingers.size()))) {
+    double longest_s = 0.0;
+    for (const NamedFinger& named : fingers) longest_s = std::max(longest_s, named.trajectory.duration_s());
+    std::vector<HapticDevice*> finger_devices;
+    for (std::size_t k = 0; k < fingers.size(); ++k) {
+      ports.push_back(std::make_unique<InProcessDevicePort>(1.0 / haptic_options.rate_hz));
+      drivers.push_back(std::make_unique<SpidarDriver>(SpidarGeometry{}, *ports.back(), ClockMode::lockstep,
+                                                       haptic_options.haptic_session));
+      finger_devices.push_back(drivers.back().get());
+      sims.push_back(std::make_unique<DeviceSim>(SpidarGeometry{}, HardwareParams{}, FingerParams{},
+                                                 fingers[k].trajectory.held_until(longest_s)));
+      devices.push_back(std::make_unique<DeviceNode>(*sims.back(), *ports.back(),
+                                                     endpoint_log_path(device_log, static_cast<std::uint32_t>(k)),
+                                                     1 + k));
+      ports.back()->connect(*devices.back());
+    }
+    if (fingers.size() > 1) finger_set.emplace(finger_devices);
+    HapticDevice& device = finger_set ? static_cast<HapticDevice&>(*finger_set) : *drivers[0];
+    haptic = std::make_unique<HapticNode>(haptic_options, link, device);
+  }
+
+  // The haptic and device halves of its summary (a device of several fingers lists each under "device"."fingers").
+  nlohmann::json summary() const {
+    nlohmann::json out = haptic->summary();
+    out.update(devices[0]->summary());
+    if (devices.size() > 1) {
+      nlohmann::json per_finger = nlohmann::json::array();
+      for (std::size_t k = 0; k < devices.size(); ++k) {
+        nlohmann::json one = devices[k]->summary()["device"];
+        one["name"] = names[k].name;
+        one["trajectory"] = names[k].trajectory.description();
+        per_finger.push_back(one);
+      }
+      out["device"]["fingers"] = per_finger;
+    }
+    return out;
+  }
+
+  std::vector<NamedFinger> names;
+  WorldLinkClient& link;
+  std::vector<std::unique_ptr<InProcessDevicePort>> ports;
+  std::vector<std::unique_ptr<SpidarDriver>> drivers;
+  std::vector<std::unique_ptr<DeviceSim>> sims;
+  std::vector<std::unique_ptr<DeviceNode>> devices;
+  std::optional<FingerSet> finger_set;
+  std::unique_ptr<HapticNode> haptic;
+};
+
 }  // namespace
 
 nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
@@ -82,56 +134,39 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   world.connect(world_link);
   world_link.connect(world);
 
-  HapticNodeOptions haptic_options;
-  haptic_options.clock = ClockMode::lockstep;
-  haptic_options.log_path = log_path(options.out_dir, "haptic.csv");
-  haptic_options.stiffness_Npm = options.stiffness_Npm;
-  haptic_options.damping_Nspm = options.damping_Nspm;
-  haptic_options.duration_s = options.duration_s;
-  // The device: one SPIDAR string set, port and simulated finger per finger (one for a --trajectory trial).
   if (!options.fingers.empty() && !options.trajectory.empty()) {
     throw std::invalid_argument("give trajectory or fingers, not both");
   }
-  const std::vector<NamedFinger> fingers = options.fingers.empty()
-                                               ? std::vector<NamedFinger>{{"finger", load_trajectory(options.trajectory)}}
-                                               : parse_fingers(options.fingers, kMaxFingers);
-  double longest_s = 0.0;
-  for (const NamedFinger& named : fingers) longest_s = std::max(longest_s, named.trajectory.duration_s());
-  std::vector<std::unique_ptr<InProcessDevicePort>> ports;
-  std::vector<std::unique_ptr<SpidarDriver>> drivers;
-  std::vector<std::unique_ptr<DeviceSim>> sims;
-  std::vector<std::unique_ptr<DeviceNode>> devices;
-  std::vector<HapticDevice*> finger_devices;
-  for (std::size_t k = 0; k < fingers.size(); ++k) {
-    ports.push_back(std::make_unique<InProcessDevicePort>(1.0 / haptic_options.rate_hz));
-    drivers.push_back(std::make_unique<SpidarDriver>(SpidarGeometry{}, *ports.back(), ClockMode::lockstep,
-                                                     haptic_options.haptic_session));
-    finger_devices.push_back(drivers.back().get());
-    sims.push_back(std::make_unique<DeviceSim>(SpidarGeometry{}, HardwareParams{}, FingerParams{},
-                                               fingers[k].trajectory.held_until(longest_s)));
-    devices.push_back(std::make_unique<DeviceNode>(
-        *sims.back(), *ports.back(),
-        endpoint_log_path(log_path(options.out_dir, "device.csv"), static_cast<std::uint32_t>(k)), 1 + k));
-    ports.back()->connect(*devices.back());
+  // One controller per user: the first is the lockstep master, the others follow its ticks (DESIGN.md §3).
+  std::vector<std::unique_ptr<Controller>> users;
+  const std::size_t user_count = 1 + options.followers.size();
+  for (std::size_t u = 0; u < user_count; ++u) {
+    const std::string prefix = u == 0 ? "" : "user" + std::to_string(u) + ".";
+    HapticNodeOptions haptic_options;
+    haptic_options.clock = ClockMode::lockstep;
+    haptic_options.log_path = log_path(options.out_dir, (prefix + "haptic.csv").c_str());
+    haptic_options.stiffness_Npm = options.stiffness_Npm;
+    haptic_options.damping_Nspm = options.damping_Nspm;
+    haptic_options.duration_s = options.duration_s;
+    haptic_options.haptic_session = 1 + u;
+    haptic_options.followers = u == 0 ? static_cast<std::uint32_t>(options.followers.size()) : 0;
+    const std::vector<NamedFinger> fingers =
+        u > 0 ? parse_fingers(options.followers[u - 1], kMaxFingers)
+        : options.fingers.empty() ? std::vector<NamedFinger>{{"finger", load_trajectory(options.trajectory)}}
+                                  : parse_fingers(options.fingers, kMaxFingers);
+    users.push_back(std::make_unique<Controller>(haptic_options, fingers, world_link,
+                                                 log_path(options.out_dir, (prefix + "device.csv").c_str())));
+    if (u > 0) world_link.connect_follower(users.back()->link, *users.back()->haptic);
   }
-  std::optional<FingerSet> finger_set;
-  if (fingers.size() > 1) finger_set.emplace(finger_devices);
-  HapticDevice& device = finger_set ? static_cast<HapticDevice&>(*finger_set) : *drivers[0];
-  HapticNode haptic(haptic_options, world_link.attach(static_cast<std::uint32_t>(fingers.size())), device);
 
-  haptic.run();
+  users[0]->haptic->run();
+  for (std::size_t u = 1; u < users.size(); ++u) users[u]->haptic->run();  // their session is over: they finish
   nlohmann::json summary = world.summary();
-  summary.update(haptic.summary());
-  summary.update(devices[0]->summary());
-  if (fingers.size() > 1) {
-    nlohmann::json per_finger = nlohmann::json::array();
-    for (std::size_t k = 0; k < fingers.size(); ++k) {
-      nlohmann::json one = devices[k]->summary()["device"];
-      one["name"] = fingers[k].name;
-      one["trajectory"] = fingers[k].trajectory.description();
-      per_finger.push_back(one);
-    }
-    summary["device"]["fingers"] = per_finger;
+  summary.update(users[0]->summary());
+  if (users.size() > 1) {
+    nlohmann::json followers = nlohmann::json::array();
+    for (std::size_t u = 1; u < users.size(); ++u) followers.push_back(users[u]->summary());
+    summary["followers"] = followers;
   }
   return summary;
 }

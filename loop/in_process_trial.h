@@ -26,6 +26,10 @@ struct InProcessTrialOptions {
   // Or a several-finger device: "NAME=TRAJECTORY" per finger, as spidar_sim --finger takes (then `trajectory` must be
   // empty). Finger k is endpoint k of the world; its logs are haptic.endpointK.csv and device.endpointK.csv.
   std::vector<std::string> fingers;
+  // Other users on the same world, each a haptic controller of its own with its fingers ("NAME=TRAJECTORY" each):
+  // they follow the first controller's lockstep ticks (DESIGN.md §3). User u's logs are userU.haptic.csv and
+  // userU.device.csv (u = 1, 2, ...), its summary under "followers".
+  std::vector<std::vector<std::string>> followers;
   Coupling coupling = Coupling::impulse;
   std::uint64_t phase_ticks = 0;  // lockstep phase of the world clock, in haptic ticks (< one world period)
   // Each has the range of the daemon flag it mirrors (common/contract/limits.h) and the same default.

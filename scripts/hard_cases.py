@@ -67,9 +67,13 @@ class Trial:
         self.scene = Scene(self.summary.scene_path)
         self.objects = self.scene.objects
         self.device = logs.read_log(out_dir / logs.DEVICE)
+        # A device of several fingers: finger k > 0 logs to device.endpointK.csv (run.sh --finger).
+        self.devices = [self.device]
+        while (out_dir / f"device.endpoint{len(self.devices)}.csv").exists():
+            self.devices.append(logs.read_log(out_dir / f"device.endpoint{len(self.devices)}.csv"))
         haptic = logs.read_log(out_dir / logs.HAPTIC)
         self.world = logs.read_log(out_dir / logs.WORLD)
-        self.finite = self.device.finite and haptic.finite and self.world.finite
+        self.finite = all(d.finite for d in self.devices) and haptic.finite and self.world.finite
         self.haptic_period_s = self.summary.haptic_period_s
         self.world_period_s = self.summary.world_period_s
         # The device's session ends with its trajectory; the haptic controller runs a few more ticks without a device
@@ -97,7 +101,7 @@ def check_generic(trial):
         problems.append(f"{h['faults']} servo faults (non-finite finger or force)")
     if not h["max_force_N"] <= h["force_limit_N"] + 1e-9:
         problems.append(f"max force {h['max_force_N']:.3f} N > {h['force_limit_N']} N")
-    energy = energy_balance(trial.scene, trial.device, trial.world, trial.summary.device, trial.world_period_s,
+    energy = energy_balance(trial.scene, trial.devices, trial.world, trial.summary.device, trial.world_period_s,
                             trial.haptic_period_s)
     if not energy["ok"]:
         problems.append(f"energy grew {energy['excess_J']:.4f} J beyond the hand's work at t={energy['at_s']:.3f} s "
@@ -340,6 +344,30 @@ def check_press_hold(trial):
 
 
 REST_TOLERANCE_M = 1e-4
+
+
+def check_grasp_lift(trial):
+    """Grasp and lift: thumb and index (a SPIDAR string set each) squeeze a 0.2 kg cube from opposite sides, lift it
+    5 cm over 1-2 s, hold it until 7 s and put it down. Friction alone holds it, so the cube must rise with the
+    fingers (at least 4 cm: each simulated finger sags ~3 mm under half the weight on its 300 N/m hand), slip less
+    than 1 mm during the hold (2.5-7 s) and end at rest on the floor; and each finger's impulse on the cube, as the
+    world applied it, equals what its servo rendered (1e-9 relative: sums of the ledger's differences)."""
+    z0 = trial.objects["cube"]["position_m"][2]
+    w = trial.world
+    t, z = w["time_s"].tolist(), w["cube.z_m"].tolist()
+    hold = [zz for tt, zz in zip(t, z) if 2.5 <= tt <= 7.0]
+    lifted = hold[0] - z0 if hold else 0.0
+    slip = max(hold) - min(hold) if hold else math.inf
+    end_speed = float(np.linalg.norm(w.vectors("cube.v", "_mps")[-1]))
+    rendered = [e["impulse_by_object_Ns"].get("0", [0.0] * 3) for e in trial.summary.haptic.get("endpoints", [])]
+    applied = [e["impulse_by_object_Ns"].get("0", [0.0] * 3) for e in trial.summary.world.get("endpoints", [])]
+    ledger_ok = len(rendered) == 2 and len(applied) == 2 and all(
+        abs(r - a) <= 1e-9 * (1.0 + abs(r)) for rr, aa in zip(rendered, applied) for r, a in zip(rr, aa))
+    ok = lifted >= 0.04 and slip < 1e-3 and abs(z[-1] - z0) < 1e-3 and end_speed < 1e-3 and ledger_ok
+    worst = max((abs(r - a) for rr, aa in zip(rendered, applied) for r, a in zip(rr, aa)), default=math.inf)
+    return ok, (f"lifted {1e3 * lifted:.1f} mm, slip during the hold {1e3 * slip:.3f} mm, put down "
+                f"{1e3 * abs(z[-1] - z0):.2f} mm from its rest height; per finger applied - rendered at most "
+                f"{worst:.1e} N·s"), []
 
 
 def check_static_push(trial):
@@ -614,11 +642,16 @@ CASES = [
      "c12c_ball_rolls_into_finger.csv", None, check_arrival_no_pass),
     ("12d", "object comes to the finger: pushed by another", "c12d_pushed_into_finger.json",
      "c12d_pushed_into_finger.csv", None, check_arrival_no_pass),
+    ("14", "grasp and lift: two fingers, 0.2 kg cube", "c14_grasp_lift.json",
+     {"thumb": "c14_grasp_thumb.csv", "index": "c14_grasp_index.csv"}, None, check_grasp_lift),
 ]
 
 
 def resolve_trajectory(spec):
-    """A case's trajectory: a file under tests/hard_cases/ if there is one of that name, else a spidar_sim spec."""
+    """A case's trajectory: a file under tests/hard_cases/ if there is one of that name, else a spidar_sim spec; a
+    dict {finger name: trajectory} for a device of several fingers."""
+    if isinstance(spec, dict):
+        return {name: resolve_trajectory(each) for name, each in spec.items()}
     path = CASES_DIR / spec
     return str(path) if path.exists() else spec
 

@@ -17,6 +17,10 @@ bash scripts/run.sh --scene scenes/tap.json --trajectory tap --out out/figures/t
 /usr/bin/python3 scripts/tap_task.py --methods position,impulse,local --out out/figures/tap_task
 cp out/figures/tap_task/tap_task.png docs/tap_task.png
 cp out/figures/tap_task/tap_task.md docs/tap_task.md
+# Grasp and lift with two fingers under each coupling (hard case 14): height and forces, lift over 5 world phases.
+/usr/bin/python3 scripts/grasp_figure.py --out out/figures/grasp
+cp out/figures/grasp/grasp.png docs/grasp.png
+cp out/figures/grasp/grasp.md docs/grasp.md
 # The viewer replaying a lockstep tap trial at its hardest push, in headless Chromium (the browser test's replay case
 # takes the picture).
 bash scripts/deps.sh --browser

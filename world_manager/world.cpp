@@ -146,7 +146,8 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
     }
     const auto id = static_cast<std::size_t>(entry.object_id);
     const ImpulseDelta delta = ledger_.take(owner, entry);
-    applied[id] += delta.impulse_Ns;
+    // Position coupling moves nothing by the reports (its penalty comes from the sampled finger): nothing applied.
+    if (options_.coupling != Coupling::position) applied[id] += delta.impulse_Ns;
     ObjectImpulse moments = entry;  // the moments through the same ledger rules (owner, epoch, baseline)
     moments.impulse_Ns = entry.impulse_moment_Nss;
     moments.angular_impulse_Nms = entry.angular_impulse_moment_Nmss;

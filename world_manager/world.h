@@ -81,7 +81,8 @@ class World {
   const Eigen::Vector3d& total_impulse_Ns(std::size_t id) const { return applied_.total_Ns(id); }
   const Eigen::Vector3d& total_angular_impulse_Nms(std::size_t id) const { return applied_.total_angular_Nms(id); }
   // Impulse on object `id` taken from the reports of one endpoint of one haptic session, since it first reported
-  // (N·s; the ledger's differences, summed): per endpoint, what the world applied of what it rendered.
+  // (N·s; the ledger's differences, summed): per endpoint, what the world applied of what it rendered. Zero under
+  // position coupling, which applies a penalty from the sampled finger instead.
   Eigen::Vector3d applied_by(const CounterOwner& owner, std::size_t id) const;
   // Every (haptic session, endpoint) that has had impulse applied, in order.
   std::vector<CounterOwner> impulse_owners() const;

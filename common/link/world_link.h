@@ -72,8 +72,22 @@ class WorldLinkClient {
   // stay in force until reattach() finds a new one). A follower (another controller in a lockstep run whose master
   // steps the world) returns true at once.
   virtual bool step_world(std::uint64_t tick) = 0;
-  // Lockstep master: ends the session; a waiting world returns from wait_turn() with `shutdown`.
+  // Lockstep master: ends the session; a waiting world returns from wait_turn() with `shutdown`, and so does every
+  // follower waiting in wait_follower_turn().
   virtual void end_session() = 0;
+
+  // Several controllers on one lockstep world (DESIGN.md §3): the first is the master, the others follow its ticks.
+  // Whether this end is a follower.
+  virtual bool follower() const { return false; }
+  // Master, before its first tick: waits until `count` followers have attached (a lockstep run of several users
+  // starts when they are all there); false if a stop was requested first.
+  virtual bool wait_for_followers(std::uint32_t count) { return count == 0; }
+  // Master, every tick after its own: each follower does tick `tick`, in slot order, before the world may step.
+  virtual void lead_followers(std::uint64_t /*tick*/) {}
+  // Follower: waits for the master's next tick. ok: do tick `tick`, then finish_follower_turn(); shutdown: the
+  // session ended; peer_gone: the master died (or a stop was requested).
+  virtual TurnResult wait_follower_turn(std::uint64_t& /*tick*/) { return TurnResult::shutdown; }
+  virtual void finish_follower_turn() {}
   // Whether the world is still there (its process alive); a transport that cannot tell says true. A lockstep world
   // that died after its last step, before the session ended, is noticed here.
   virtual bool world_alive() const { return true; }

@@ -64,8 +64,9 @@ def _initial_energy_J(obj, gravity_mps2):
 
 
 def energy_balance(scene, device, world, finger, world_period_s, haptic_period_s):
-    """Energy of finger + dynamic objects against the hand's work, from a trial's scene (scene.Scene), device and
-    world logs (logs.Log) and the finger and hand it ran with (the summary's "device" section: finger_mass_kg,
+    """Energy of finger + dynamic objects against the hand's work, from a trial's scene (scene.Scene), device log (or
+    the list of a several-finger device's logs, one per finger) and world log (logs.Log) and the finger and hand it
+    ran with (the summary's "device" section: finger_mass_kg,
     hand_stiffness_Npm, hand_damping_Nspm).
 
     The system is the finger (point mass m_f) and the dynamic objects. External forces on it: the hand
@@ -102,25 +103,34 @@ def energy_balance(scene, device, world, finger, world_period_s, haptic_period_s
     gravity = scene.gravity_mps2
     g = math.sqrt(sum(x * x for x in gravity))
     dynamic = scene.dynamic_objects
-    # Tick 0 (t = 0) is the finger at rest on its target, before the first device tick the log records.
-    times = np.concatenate(([0.0], device["time_s"]))
-    target = device.vectors("target_", "_m")
-    target = np.concatenate((target[:1], target))
-    position = np.concatenate((target[:1], device.vectors("finger_", "_m")))
-    velocity = np.concatenate((np.zeros((1, 3)), device.vectors("finger_v", "_mps")))
-    # Target velocity by central finite differences (one-sided at the ends).
+    # A device of several fingers: each finger is a point mass on its own hand spring, the system holds them all, and
+    # the hand's work is the sum over the fingers. Their logs share the device's ticks.
+    devices = device if isinstance(device, (list, tuple)) else [device]
+    times = np.concatenate(([0.0], devices[0]["time_s"]))
     ticks = np.arange(len(times))
-    before, after = np.maximum(ticks - 1, 0), np.minimum(ticks + 1, len(times) - 1)
-    target_velocity = (target[after] - target[before]) / (times[after] - times[before])[:, None]
-    hand_force = hand_stiffness_Npm * (target - position) + hand_damping_Nspm * (target_velocity - velocity)
-    power = _dot3(hand_force, velocity)
-    # W_hand by the trapezoid rule at the log's step h, and at 2h for the quadrature tolerance.
-    work = np.concatenate(([0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(times))))
     even = ticks[2::2]
-    work_coarse = np.cumsum((power[even] + power[even - 2]) * 0.5 * (times[even] - times[even - 2]))
-    quadrature = float(np.abs(work[even] - work_coarse).max(initial=0.0))
+    work = np.zeros(len(times))
+    quadrature = 0.0
+    finger_kinetic = np.zeros(len(times))
+    for one in devices:
+        # Tick 0 (t = 0) is the finger at rest on its target, before the first device tick the log records.
+        target = one.vectors("target_", "_m")
+        target = np.concatenate((target[:1], target))
+        position = np.concatenate((target[:1], one.vectors("finger_", "_m")))
+        velocity = np.concatenate((np.zeros((1, 3)), one.vectors("finger_v", "_mps")))
+        # Target velocity by central finite differences (one-sided at the ends).
+        before, after = np.maximum(ticks - 1, 0), np.minimum(ticks + 1, len(times) - 1)
+        target_velocity = (target[after] - target[before]) / (times[after] - times[before])[:, None]
+        hand_force = hand_stiffness_Npm * (target - position) + hand_damping_Nspm * (target_velocity - velocity)
+        power = _dot3(hand_force, velocity)
+        # W_hand by the trapezoid rule at the log's step h, and at 2h for the quadrature tolerance (each finger's
+        # bound added, so errors of opposite sign in two fingers cannot hide each other).
+        finger_work = np.concatenate(([0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(times))))
+        finger_coarse = np.cumsum((power[even] + power[even - 2]) * 0.5 * (times[even] - times[even - 2]))
+        quadrature += float(np.abs(finger_work[even] - finger_coarse).max(initial=0.0))
+        work = work + finger_work
+        finger_kinetic = finger_kinetic + 0.5 * finger_mass_kg * _dot3(velocity, velocity)
 
-    finger_kinetic = 0.5 * finger_mass_kg * _dot3(velocity, velocity)
     e0 = float(finger_kinetic[0])
     for obj in dynamic:
         e0 += _initial_energy_J(obj, gravity)

@@ -54,7 +54,8 @@ def backend():
 
 def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=None, substeps=None,
               stiffness_Npm=None, damping_Nspm=None):
-    """Runs one lockstep trial of `scene` (a path) driven by `trajectory` (a spidar_sim --trajectory spec or file)
+    """Runs one lockstep trial of `scene` (a path) driven by `trajectory` (a spidar_sim --trajectory spec or file, or
+    a dict {finger name: spec or file} for a device of several fingers)
     into out_dir and returns its Summary. rate_hz, phase_ticks and substeps are world_manager's --rate, --phase and
     --substeps, stiffness_Npm and damping_Nspm haptic_controller's --stiffness and --damping (None: the scene's
     values, phase 0). Raises RuntimeError naming the trial if it failed."""
@@ -69,7 +70,10 @@ def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=No
             raise RuntimeError(f"trial failed ({scene}, {trajectory}, {coupling} coupling, rate {rate_hz}, "
                                f"phase {phase_ticks}): {error}") from None
         return Summary(trial.summary)
-    command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), "--trajectory", str(trajectory),
+    # A dict {finger name: trajectory} is a device of several fingers (run.sh --finger NAME=SPEC each).
+    fingers = [["--finger", f"{name}={each}"] for name, each in trajectory.items()] if isinstance(trajectory, dict) \
+        else [["--trajectory", str(trajectory)]]
+    command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), *[arg for pair in fingers for arg in pair],
                "--coupling", coupling, "--clock", "lockstep", "--out", str(out_dir), "--quiet"]
     for flag, value in (("--rate", rate_hz), ("--phase", phase_ticks), ("--substeps", substeps)):
         if value is not None:

@@ -10,6 +10,8 @@
 
 #include <memory>
 #include <string>
+#include <thread>
+#include <vector>
 
 namespace impetus {
 
@@ -60,7 +62,8 @@ TEST_CASE("shm world link: controllers take endpoint slots in turn, and each end
   CHECK(three.slot_of(0) == 0);
 }
 
-TEST_CASE("shm world link: a lockstep world takes one controller as its master and refuses a second") {
+TEST_CASE("shm world link: on a lockstep world the first controller is the master and the next ones follow its "
+          "ticks") {
   const std::string shm = test::unique_segment_name("master");
   WorldLinkInfo info;
   info.world_rate_hz = 20.0;
@@ -68,9 +71,25 @@ TEST_CASE("shm world link: a lockstep world takes one controller as its master a
   info.clock = ClockMode::lockstep;
   ShmWorldLinkServer server(shm, info);
   ShmWorldLinkClient master(shm, ClockMode::lockstep, 1.0, 1);
-  CHECK_THROWS_WITH(ShmWorldLinkClient(shm, ClockMode::lockstep, 1.0, 1), Catch::Contains("already has a haptic "
-                                                                                         "controller as its master"));
-  CHECK(master.slot_of(0) == 0);
+  ShmWorldLinkClient follower(shm, ClockMode::lockstep, 1.0, 2);
+  CHECK_FALSE(master.follower());
+  CHECK(follower.follower());
+  CHECK(follower.slot_of(0) == 1);
+
+  // The master hands ticks 0..9 to the follower; each returns only once the follower has finished that tick.
+  std::vector<std::uint64_t> followed;
+  std::thread follower_loop([&] {
+    for (;;) {
+      std::uint64_t tick = 0;
+      if (follower.wait_follower_turn(tick) != TurnResult::ok) break;
+      followed.push_back(tick);
+      follower.finish_follower_turn();
+    }
+  });
+  for (std::uint64_t tick = 0; tick < 10; ++tick) master.lead_followers(tick);
+  master.end_session();  // the follower's next wait ends with `shutdown`
+  follower_loop.join();
+  CHECK(followed == std::vector<std::uint64_t>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9});
 }
 
 }  // namespace impetus

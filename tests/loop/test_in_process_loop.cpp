@@ -3,6 +3,7 @@
 // run through shared memory bit for bit (DESIGN.md §6: the same trial in one process or three gives the same outcome).
 
 #include "tests/integration/trial_support.h"
+#include "tests/integration/users_support.h"
 #include "loop/in_process_trial.h"
 
 #include <catch2/catch.hpp>
@@ -90,6 +91,26 @@ void check_same_grasp(const std::string& name, std::uint64_t phase_ticks) {
 TEST_CASE("a two-finger grasp in one process equals the grasp in three, bit for bit, and each finger's impulse is "
           "applied as rendered") {
   check_same_grasp("loop-grasp", 20);
+}
+
+TEST_CASE("two users on one world in one process equal the same users as five processes, bit for bit") {
+  // Users A (the master) and B (following its ticks) press the tap scene's cube from both sides, 4 and 1 mm deep.
+  const std::filesystem::path processes = test::two_users("loop-users-processes", 0.004, 0.001);
+
+  InProcessTrialOptions options;
+  options.scene_path = std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json";
+  options.fingers = {"finger=" + (processes / "a.csv").string()};
+  options.followers = {{"finger=" + (processes / "b.csv").string()}};
+  options.out_dir = test::out_dir("loop-users-in-process");
+  const nlohmann::json summary = run_in_process_trial(options);
+
+  const std::string world = test::read_text(options.out_dir / "world.csv");
+  CHECK(world.size() > 1000);
+  CHECK(world == test::read_text(processes / "world.csv"));
+  CHECK(test::read_text(options.out_dir / "haptic.csv") == test::read_text(processes / "haptic_a.csv"));
+  CHECK(test::read_text(options.out_dir / "user1.haptic.csv") == test::read_text(processes / "haptic_b.csv"));
+  REQUIRE(summary["followers"].size() == 1);
+  CHECK(summary["followers"][0]["haptic"]["ticks"].get<int>() > 3000);
 }
 
 TEST_CASE("the tap trial in one process equals the tap trial in three, bit for bit (impulse coupling)") {

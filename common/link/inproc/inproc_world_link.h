@@ -22,12 +22,27 @@ class WorldStepper {
   virtual void step_world() = 0;
 };
 
+// What the in-process link calls for a follower's tick (a following haptic node implements it): false once it has
+// stopped (its device left), and it is not called again.
+class FollowerStepper {
+ public:
+  virtual ~FollowerStepper() = default;
+  virtual bool follow_tick(std::uint64_t tick) = 0;
+};
+
 class InProcessWorldLink final : public WorldLinkServer {
  public:
   explicit InProcessWorldLink(const WorldLinkInfo& info) : info_(info), slots_(kMaxEndpoints) {}
 
   // The world node whose step_world() the master's step_world(tick) runs; set before the first step.
   void connect(WorldStepper& world) { world_ = &world; }
+
+  // A follower's node, whose follow_tick(t) the master's lead_followers(t) runs; `client` is the end attach() gave it.
+  void connect_follower(WorldLinkClient& client, FollowerStepper& node) {
+    for (auto& each : clients_) {
+      if (each.get() == &client) each->stepper_ = &node;
+    }
+  }
 
   // The end for a haptic node with `endpoints` endpoints, on the next free slots; valid as long as the link. Throws
   // std::invalid_argument if the slots would run out.
@@ -96,10 +111,24 @@ class InProcessWorldLink final : public WorldLinkServer {
       link_.world_->step_world();
       return true;
     }
+    bool follower() const override { return !master_; }
+    bool wait_for_followers(std::uint32_t count) override {
+      std::uint32_t present = 0;
+      for (const auto& client : link_.clients_) present += client->stepper_ != nullptr ? 1 : 0;
+      return present >= count;
+    }
+    void lead_followers(std::uint64_t tick) override {
+      if (!master_) return;
+      for (auto& client : link_.clients_) {
+        if (client->stepper_ != nullptr && !client->stepper_->follow_tick(tick)) client->stepper_ = nullptr;
+      }
+    }
     void end_session() override {}
     bool reattach() override { return false; }
     std::uint64_t rejected_frames() const override { return 0; }
     std::uint64_t attaches() const override { return 1; }
+
+    FollowerStepper* stepper_ = nullptr;  // a follower's node, while it follows
 
    private:
     InProcessWorldLink& link_;

@@ -96,10 +96,12 @@ std::unique_ptr<ShmWorldLinkClient::Attachment> ShmWorldLinkClient::attach(
                              std::to_string(kMaxEndpoints) + "; this controller needs " + std::to_string(endpoints_));
   }
   if (clock_ == ClockMode::lockstep && !take(link.master_pid, self)) {
-    for (std::uint32_t k = 0; k < taken; ++k) link.slots[attachment->slots[k]].owner_pid.store(0);
-    throw std::runtime_error("the lockstep world at '" + name_ + "' already has a haptic controller as its master "
-                             "(pid " + std::to_string(link.master_pid.load()) + "); over shared memory a lockstep "
-                             "world takes one controller (use --clock realtime for several)");
+    // Another controller leads: follow its ticks. Its turn is reset before the mark is set, so the master never
+    // gives a turn on words a previous holder left behind.
+    EndpointSlotLayout& first = link.slots[attachment->slots[0]];
+    first.follower_turn.reset();
+    first.follower.store(1, std::memory_order_release);
+    attachment->follower = true;
   }
   attachment->segment = std::move(segment);
   return attachment;
@@ -126,6 +128,7 @@ ShmWorldLinkClient::~ShmWorldLinkClient() {
   const auto self = static_cast<std::int32_t>(getpid());
   for (const auto& attachment : worlds_) {
     WorldLinkLayout& link = **attachment->segment;
+    if (attachment->follower) link.slots[attachment->slots[0]].follower.store(0, std::memory_order_release);
     for (std::uint32_t k = 0; k < endpoints_; ++k) {
       std::int32_t expected = self;
       link.slots[attachment->slots[k]].owner_pid.compare_exchange_strong(expected, 0);
@@ -180,7 +183,72 @@ bool ShmWorldLinkClient::step_world(std::uint64_t tick) {
   return world_alive_;
 }
 
-void ShmWorldLinkClient::end_session() { world().world_turn.request_shutdown(); }
+void ShmWorldLinkClient::end_session() {
+  WorldLinkLayout& link = world();
+  if (current().follower) {
+    // A follower leaves: the master stops giving it turns.
+    link.slots[current().slots[0]].follower.store(0, std::memory_order_release);
+    return;
+  }
+  link.world_turn.request_shutdown();
+  for (EndpointSlotLayout& slot : link.slots) {
+    if (slot.follower.load(std::memory_order_acquire) == 1) slot.follower_turn.request_shutdown();
+  }
+}
+
+bool ShmWorldLinkClient::wait_for_followers(std::uint32_t count) {
+  for (bool said = false;; said = true) {
+    std::uint32_t present = 0;
+    for (const EndpointSlotLayout& slot : world().slots) {
+      if (slot.follower.load(std::memory_order_acquire) == 1 && process_alive(slot.owner_pid.load())) ++present;
+    }
+    if (present >= count) return true;
+    if (g_stop_requested.load()) return false;
+    if (!said) {
+      std::fprintf(stderr, "haptic_controller: waiting for %u more controller(s) to follow this lockstep run\n",
+                   count - present);
+    }
+    usleep(1'000);
+  }
+}
+
+void ShmWorldLinkClient::lead_followers(std::uint64_t tick) {
+  if (current().follower) return;
+  WorldLinkLayout& link = world();
+  for (EndpointSlotLayout& slot : link.slots) {
+    if (slot.follower.load(std::memory_order_acquire) != 1) continue;
+    const std::int32_t holder = slot.owner_pid.load();
+    slot.follower_turn.give(tick);
+    const TurnResult result = slot.follower_turn.wait_done(
+        [&] { return holder != 0 && process_alive(holder) && slot.follower.load() == 1; }, kTurnTimeout_s);
+    if (result != TurnResult::ok) {
+      // Gone, stuck or left mid-turn: no more turns for it (its endpoints' last reports stay; the world drops them
+      // as it drops any endpoint that stopped reporting).
+      slot.follower.store(0, std::memory_order_release);
+      std::fprintf(stderr, "haptic_controller: a following haptic controller (pid %d) left the lockstep run: %s\n",
+                   holder, to_string(result));
+    }
+  }
+}
+
+TurnResult ShmWorldLinkClient::wait_follower_turn(std::uint64_t& tick) {
+  const Attachment& attachment = current();
+  if (!attachment.follower) return TurnResult::shutdown;
+  WorldLinkLayout& link = **attachment.segment;
+  EndpointSlotLayout& slot = link.slots[attachment.slots[0]];
+  const TurnResult result = slot.follower_turn.wait_turn([&] {
+    if (g_stop_requested.load()) return false;
+    const std::int32_t master = link.master_pid.load();
+    return master != 0 && process_alive(master) && attachment.segment->creator_alive();
+  });
+  if (result == TurnResult::ok) tick = slot.follower_turn.tick();
+  return result;
+}
+
+void ShmWorldLinkClient::finish_follower_turn() {
+  const Attachment& attachment = current();
+  if (attachment.follower) (*attachment.segment)->slots[attachment.slots[0]].follower_turn.finish();
+}
 
 bool ShmWorldLinkClient::world_alive() const { return worlds_.back()->segment->creator_alive(); }
 

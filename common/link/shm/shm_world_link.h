@@ -49,8 +49,9 @@ class ShmWorldLinkServer final : public WorldLinkServer {
 class ShmWorldLinkClient final : public WorldLinkClient {
  public:
   // Opens "<shm>.world", waiting up to `wait_s` for the world node to create it, and takes an endpoint slot for each
-  // of `endpoints` endpoints. Throws SegmentError if the world does not appear in time, std::runtime_error if the
-  // world runs another clock than `clock`, has too few free slots, or (lockstep) already has a master.
+  // of `endpoints` endpoints. In lockstep the first controller becomes the master and later ones its followers.
+  // Throws SegmentError if the world does not appear in time, std::runtime_error if the world runs another clock
+  // than `clock` or has too few free slots.
   ShmWorldLinkClient(const std::string& shm, ClockMode clock, double wait_s, std::uint32_t endpoints = 1);
   // Gives the slots back.
   ~ShmWorldLinkClient() override;
@@ -67,6 +68,11 @@ class ShmWorldLinkClient final : public WorldLinkClient {
   std::uint64_t rejected_frames() const override { return rejected_; }
   std::uint64_t attaches() const override { return attaches_.load(); }
   std::uint64_t channel_repairs() const override { return repairs_; }
+  bool follower() const override { return current().follower; }
+  bool wait_for_followers(std::uint32_t count) override;
+  void lead_followers(std::uint64_t tick) override;
+  TurnResult wait_follower_turn(std::uint64_t& tick) override;
+  void finish_follower_turn() override;
 
   const std::string& name() const { return name_; }
   // The slot endpoint `endpoint` holds in the current world's segment (tests).
@@ -77,6 +83,7 @@ class ShmWorldLinkClient final : public WorldLinkClient {
   struct Attachment {
     std::unique_ptr<Segment<WorldLinkLayout>> segment;
     std::array<std::uint32_t, kMaxEndpoints> slots{};
+    bool follower = false;  // lockstep: another controller is the master; the turns come in slots[0]
   };
   // Takes the slots (and, lockstep, the master's place) in `segment`; throws std::runtime_error if it cannot.
   std::unique_ptr<Attachment> attach(std::unique_ptr<Segment<WorldLinkLayout>> segment) const;

@@ -26,7 +26,10 @@ struct EndpointSlotLayout {
   SeqlockChannel<wire::HapticReport> report;    // writer: the slot's holder
   SeqlockChannel<LoopStats> haptic_stats;       // writer: the slot's holder
   std::atomic<std::int32_t> owner_pid{0};       // the holder, 0 if none
-  std::uint32_t reserved = 0;
+  // Lockstep, a second (third, ...) controller: its first slot is marked and carries its turn. The master gives it
+  // a turn every tick, after its own and before the world's.
+  std::atomic<std::uint32_t> follower{0};       // 1: the holder follows the master's ticks through follower_turn
+  LockstepTurn follower_turn;                   // master: the lockstep master; follower: the holder
 };
 
 struct WorldLinkLayout {
@@ -38,7 +41,7 @@ struct WorldLinkLayout {
   std::array<EndpointSlotLayout, kMaxEndpoints> slots;
   LockstepTurn world_turn;                 // master: the lockstep haptic controller; follower: world manager
   // The lockstep master, 0 if none (the world's liveness check while it waits for a turn; a second lockstep
-  // controller is refused).
+  // controller follows it).
   std::atomic<std::int32_t> master_pid{0};
 };
 
