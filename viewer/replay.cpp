@@ -157,31 +157,35 @@ Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<View
     }
   }
 
-  // The finger at each step's time: the last haptic row at or before it.
-  const fs::path haptic_path = folder / "haptic.csv";
-  std::error_code missing;
-  if (!fs::is_regular_file(haptic_path, missing)) return;
-  const CsvTable haptic = read_csv(haptic_path);
-  static const char* const kHapticColumns[] = {"time_s",  "finger_x", "finger_y", "finger_z", "proxy_x",
-                                               "proxy_y", "proxy_z",  "force_x",  "force_y",  "force_z"};
-  std::array<int, 10> hc{};
-  for (int v = 0; v < 10; ++v) {
-    hc[v] = haptic.column(kHapticColumns[v]);
-    if (hc[v] < 0) throw ReplayError(haptic_path.string() + ": no column '" + kHapticColumns[v] + "'");
-  }
-  if (haptic.rows.empty()) return;
-  have_endpoint_ = true;
-  endpoints_.resize(times_s_.size());
-  std::size_t next = 0;
-  for (std::size_t f = 0; f < times_s_.size(); ++f) {
-    while (next + 1 < haptic.rows.size() && haptic.rows[next + 1][hc[0]] <= times_s_[f]) ++next;
-    const std::vector<double>& row = haptic.rows[next];
-    ViewEndpoint& endpoint = endpoints_[f];
-    endpoint.finger_m = {row[hc[1]], row[hc[2]], row[hc[3]]};
-    endpoint.proxy_m = {row[hc[4]], row[hc[5]], row[hc[6]]};
-    endpoint.force_N = {row[hc[7]], row[hc[8]], row[hc[9]]};
-    endpoint.finger_valid = all_finite(endpoint.finger_m) && all_finite(endpoint.proxy_m) && all_finite(endpoint.force_N);
-    if (!endpoint.finger_valid) endpoint = ViewEndpoint{};
+  // Each endpoint's finger at each step's time: the last row at or before it of its haptic log (haptic.csv, then
+  // haptic.endpoint1.csv, ... for a device of several fingers).
+  for (std::uint32_t e = 0; e < kMaxViewEndpoints; ++e) {
+    const fs::path haptic_path = folder / (e == 0 ? std::string("haptic.csv") : "haptic.endpoint" + std::to_string(e) + ".csv");
+    std::error_code missing;
+    if (!fs::is_regular_file(haptic_path, missing)) break;
+    const CsvTable haptic = read_csv(haptic_path);
+    static const char* const kHapticColumns[] = {"time_s",  "finger_x", "finger_y", "finger_z", "proxy_x",
+                                                 "proxy_y", "proxy_z",  "force_x",  "force_y",  "force_z"};
+    std::array<int, 10> hc{};
+    for (int v = 0; v < 10; ++v) {
+      hc[v] = haptic.column(kHapticColumns[v]);
+      if (hc[v] < 0) throw ReplayError(haptic_path.string() + ": no column '" + kHapticColumns[v] + "'");
+    }
+    if (haptic.rows.empty()) break;
+    std::vector<ViewEndpoint>& track = endpoints_.emplace_back(times_s_.size());
+    std::size_t next = 0;
+    for (std::size_t f = 0; f < times_s_.size(); ++f) {
+      while (next + 1 < haptic.rows.size() && haptic.rows[next + 1][hc[0]] <= times_s_[f]) ++next;
+      const std::vector<double>& row = haptic.rows[next];
+      ViewEndpoint& endpoint = track[f];
+      endpoint.endpoint = e;
+      endpoint.finger_m = {row[hc[1]], row[hc[2]], row[hc[3]]};
+      endpoint.proxy_m = {row[hc[4]], row[hc[5]], row[hc[6]]};
+      endpoint.force_N = {row[hc[7]], row[hc[8]], row[hc[9]]};
+      endpoint.finger_valid =
+          all_finite(endpoint.finger_m) && all_finite(endpoint.proxy_m) && all_finite(endpoint.force_N);
+      if (!endpoint.finger_valid) endpoint = ViewEndpoint{};
+    }
   }
 }
 
@@ -199,8 +203,8 @@ void Replay::snapshot(std::size_t frame, WorldSnapshot& out) const {
   out.haptic_stats = LoopStats{};
   out.body_count = scene_->body_count;
   std::copy_n(poses_.begin() + static_cast<std::ptrdiff_t>(frame * out.body_count), out.body_count, out.bodies.begin());
-  out.endpoint_count = have_endpoint_ ? 1 : 0;
-  if (have_endpoint_) out.endpoints[0] = endpoints_[frame];
+  out.endpoint_count = static_cast<std::uint32_t>(endpoints_.size());
+  for (std::size_t e = 0; e < endpoints_.size(); ++e) out.endpoints[e] = endpoints_[e][frame];
 }
 
 }  // namespace impetus::view

@@ -43,8 +43,8 @@ class Replay {
   double world_period_s_ = 0.0;
   std::vector<double> times_s_;
   std::vector<ViewBodyPose> poses_;  // frame_count × body_count, frame-major
-  std::vector<ViewEndpoint> endpoints_;  // one per frame; endpoint_ids_ tells whether there is one
-  bool have_endpoint_ = false;
+  // Per endpoint (at most kMaxViewEndpoints), its finger at every frame.
+  std::vector<std::vector<ViewEndpoint>> endpoints_;
 };
 
 }  // namespace impetus::view

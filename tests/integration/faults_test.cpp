@@ -275,8 +275,9 @@ TEST_CASE("two users on one world: one controller killed with kill -9 mid-squeez
   stop_like_a_user(haptic_a, world);
   INFO(test::read_text(daemons.dir / "haptic_a.out") << test::read_text(daemons.dir / "haptic_b2.out"));
 
-  // User A ran through: every tick, no fault, and its force never rose above what it was squeezing with before the
-  // other user vanished (with B gone, A only pushes the cube away).
+  // User A ran through: every tick, no fault, and while B was gone (its kill at 2.5 s to its restart a second later,
+  // on A's clock within its start-up) A's force never rose above what it was squeezing with before: with B gone, A
+  // only pushes the cube away. (Once B is back it may press the cube into A harder than before: that is B's push.)
   const auto summary_a = test::read_json(daemons.dir / "haptic_a.json")["haptic"];
   CHECK(summary_a["faults"] == 0);
   CHECK(summary_a["world_attaches"] == 1);
@@ -286,9 +287,10 @@ TEST_CASE("two users on one world: one controller killed with kill -9 mid-squeez
   REQUIRE(time_a.size() > 5000);
   double before_N = 0.0, after_N = 0.0;
   for (std::size_t i = 0; i < time_a.size(); ++i) {
-    (time_a[i] < 2.5 ? before_N : after_N) = std::max(time_a[i] < 2.5 ? before_N : after_N, std::abs(force_x[i]));
+    if (time_a[i] < 2.4) before_N = std::max(before_N, std::abs(force_x[i]));
+    if (time_a[i] > 2.6 && time_a[i] < 3.4) after_N = std::max(after_N, std::abs(force_x[i]));
   }
-  INFO("user A's largest force before the kill " << before_N << " N, after " << after_N << " N");
+  INFO("user A's largest force before the kill " << before_N << " N, while B was gone " << after_N << " N");
   CHECK(before_N > 1.0);  // it really squeezed
   CHECK(after_N <= 1.1 * before_N);
 

@@ -174,7 +174,7 @@ TEST_CASE("the listen address is HOST:PORT on loopback, another address only wit
   CHECK_THROWS_WITH(view::parse_listen("8080", false), Catch::Contains("HOST:PORT"));
 }
 
-TEST_CASE("a replay reads a trial's scene and logs, a malformed log is named with its line and column") {
+TEST_CASE("a replay reads a trial's scene and logs (every finger's), a malformed log is named with its line and column") {
   const fs::path dir = scratch("replay");
   std::ofstream(dir / "summary.json")
       << R"({"config": {"scene": ")" << IMPETUS_SOURCE_DIR << R"(/scenes/tap.json", "coupling": "local", "world_rate_hz": 20}})";
@@ -197,6 +197,18 @@ TEST_CASE("a replay reads a trial's scene and logs, a malformed log is named wit
   REQUIRE(snapshot->endpoint_count == 1);
   CHECK(snapshot->endpoints[0].force_N[0] == 10.0);  // the haptic row at or before 0.1 s
   CHECK(std::string(snapshot_problem(*snapshot)).empty());
+
+  // A device of several fingers: the second finger's log joins as a second endpoint.
+  std::ofstream(dir / "haptic.endpoint1.csv")
+      << "time_s,finger_x,finger_y,finger_z,proxy_x,proxy_y,proxy_z,force_x,force_y,force_z\n"
+      << "0.0,0.09,0,0.025,0.09,0,0.025,0,0,0\n0.09,0.07,0,0.025,0.055,0,0.025,-3,0,0\n";
+  const view::Replay two_fingers(dir.string());
+  two_fingers.snapshot(1, *snapshot);
+  REQUIRE(snapshot->endpoint_count == 2);
+  CHECK(snapshot->endpoints[0].force_N[0] == 10.0);
+  CHECK(snapshot->endpoints[1].endpoint == 1);
+  CHECK(snapshot->endpoints[1].force_N[0] == -3.0);
+  fs::remove(dir / "haptic.endpoint1.csv");
 
   std::ofstream(dir / "world.csv") << header << "0.05,0.03,0,0.025,1,0,0,0\n0.1,0.04,oops,0.025,1,0,0,0\n";
   CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("world.csv:3") && Catch::Contains("column 3") &&
