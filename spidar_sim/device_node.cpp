@@ -15,6 +15,8 @@ namespace {
 constexpr double kDevicePeriod_s = 1e-3;
 // Statistics and (real time) the host's liveness, which reads /proc: every 100 ticks, ten times a second.
 constexpr std::uint64_t kCheckEveryTicks = 100;
+// Rows of the log ring: 2 s at 1 kHz, far more than the log thread's 2 ms sleep needs.
+constexpr std::size_t kLogRows = 2048;
 
 }  // namespace
 
@@ -22,10 +24,8 @@ DeviceNode::DeviceNode(DeviceSim& sim, DevicePortClient& port, const std::string
                        std::uint64_t device_session)
     : sim_(sim), port_(port), session_(device_session) {
   if (!log_path.empty()) {
-    log_.emplace(log_path);
-    if (!*log_) throw std::runtime_error("cannot open log file '" + log_path + "' for writing");
-    log_watch_.emplace("spidar_sim", log_path);
-    DeviceSim::write_log_header(*log_);
+    log_.emplace(log_path, DeviceSim::log_header(), DeviceSim::format_log_row, kLogRows,
+                 port.clock() == ClockMode::lockstep ? LogOverflow::wait : LogOverflow::drop, "spidar_sim");
   }
 }
 
@@ -38,10 +38,7 @@ void DeviceNode::tick(double dt_s) {
   DeviceState state = sim_.tick(tensions, dt_s);
   state.device_session = session_;
   port_.publish_state(state);
-  if (log_) {
-    sim_.write_log_row(*log_);
-    if (!log_->good()) log_watch_->check(*log_);  // at once, while errno is this write's (once: WriteWatch)
-  }
+  if (log_) log_->push(sim_.log_row());
   ++ticks_;
 }
 
@@ -54,7 +51,6 @@ bool DeviceNode::step_device() {
   tick(port_.haptic_period_s());
   if (ticks_ % kCheckEveryTicks == 0) {
     publish_stats(nullptr);
-    check_log();
   }
   return true;
 }
@@ -108,25 +104,14 @@ int DeviceNode::run() {
       if (timing.index % kCheckEveryTicks == 0) host_alive = port_.host_alive();
       // After a host stall the finger is advanced by the real elapsed time, capped so one tick stays a tick.
       tick(std::min(timing.elapsed_s, DeviceSim::kMaxTick_s));
-      if (timing.index % kCheckEveryTicks == 0) {
-        publish_stats(&clock);
-        check_log();
-      }
+      if (timing.index % kCheckEveryTicks == 0) publish_stats(&clock);
     }
     publish_stats(&clock);
     port_.detach();
   }
-  if (log_) log_->flush();
-  check_log();
-  return cut_short_ || (log_watch_ && log_watch_->failed()) ? 1 : 0;
-}
-
-void DeviceNode::check_log() {
-  // The row of each tick goes into the stream's buffer; flushed and looked at every kCheckEveryTicks (0.1 s), a full
-  // disk is found within a fraction of a second.
-  if (!log_ || !log_watch_ || log_watch_->failed()) return;
-  log_->flush();  // so the stream's state, and errno, are this write's
-  log_watch_->check(*log_);
+  if (log_) log_->close();
+  // A failed log write was reported when the log's thread met it (rt_log.h).
+  return cut_short_ || (log_ && log_->failed()) ? 1 : 0;
 }
 
 nlohmann::json DeviceNode::summary() const {

@@ -7,7 +7,7 @@
 //
 // Owns the simulation's log and statistics.
 
-#include "common/runtime/write_watch.h"
+#include "common/runtime/rt_log.h"
 #include "common/link/device_port.h"
 #include "common/link/inproc/inproc_device_port.h"
 #include "spidar_sim/device_sim.h"
@@ -15,7 +15,6 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
-#include <fstream>
 #include <optional>
 #include <string>
 
@@ -41,13 +40,13 @@ class DeviceNode final : public DeviceStepper {
  private:
   void tick(double dt_s);
   void publish_stats(const class RealtimeClock* clock);
-  void check_log();  // a failed log write, reported when noticed (WriteWatch)
 
   DeviceSim& sim_;
   DevicePortClient& port_;
   std::uint64_t session_;
-  std::optional<std::ofstream> log_;
-  std::optional<WriteWatch> log_watch_;  // reports a failed log write when it is noticed
+  // Rows leave the tick as copies and are formatted and written by the log's own thread (rt_log.h): lockstep waits
+  // for room (a complete log), real time drops and counts.
+  std::optional<RtLog<DeviceLogRow>> log_;
   bool cut_short_ = false;               // lockstep: the haptic controller died before the trajectory ended
   std::uint64_t ticks_ = 0;
 };

@@ -39,17 +39,22 @@ const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& comma
   return state_;
 }
 
-void DeviceSim::write_log_header(std::ostream& out) {
-  out << "time_s,target_x_m,target_y_m,target_z_m,finger_x_m,finger_y_m,finger_z_m,"
+const char* DeviceSim::log_header() {
+  return "time_s,target_x_m,target_y_m,target_z_m,finger_x_m,finger_y_m,finger_z_m,"
          "finger_vx_mps,finger_vy_mps,finger_vz_mps,force_x_N,force_y_N,force_z_N,"
-         "tension_0_N,tension_1_N,tension_2_N,tension_3_N,count_0,count_1,count_2,count_3\n";
+         "tension_0_N,tension_1_N,tension_2_N,tension_3_N,count_0,count_1,count_2,count_3";
 }
 
-void DeviceSim::write_log_row(std::ostream& out) const {
+DeviceLogRow DeviceSim::log_row() const {
+  return {time_s_, target_m(), finger_m(), finger_velocity_mps(), device_force_N(), tensions_N(), encoder_counts()};
+}
+
+void DeviceSim::format_log_row(std::ostream& out, const DeviceLogRow& row) {
   CsvLine line(out);
-  line.number(time_s_).numbers(target_m()).numbers(finger_m()).numbers(finger_velocity_mps()).numbers(device_force_N());
-  for (const double t : tensions_N()) line.number(t);
-  for (const std::int64_t c : encoder_counts()) line.integer(c);
+  line.number(row.time_s).numbers(row.target_m).numbers(row.finger_m).numbers(row.finger_velocity_mps);
+  line.numbers(row.force_N);
+  for (const double t : row.tension_N) line.number(t);
+  for (const std::int64_t c : row.encoder_counts) line.integer(c);
 }
 
 }  // namespace impetus

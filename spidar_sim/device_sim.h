@@ -20,6 +20,14 @@
 
 namespace impetus {
 
+// One row of the device log (DESIGN.md §4 "Logs"): copied out of a tick, formatted by another thread (rt_log.h).
+struct DeviceLogRow {
+  double time_s;
+  Vec3 target_m, finger_m, finger_velocity_mps, force_N;
+  std::array<double, kStringCount> tension_N;
+  std::array<std::int64_t, kStringCount> encoder_counts;
+};
+
 class DeviceSim {
  public:
   // Throws std::invalid_argument (from the parts) if the geometry or parameters are unusable.
@@ -51,8 +59,11 @@ class DeviceSim {
 
   // Log (DESIGN.md §4 "Logs"): one header, then one row per tick with time, target, finger position and velocity,
   // device force, applied tensions and encoder counts.
-  static void write_log_header(std::ostream& out);
-  void write_log_row(std::ostream& out) const;
+  static const char* log_header();  // the column names, without the line's end
+  DeviceLogRow log_row() const;      // this tick's row; no allocation
+  static void format_log_row(std::ostream& out, const DeviceLogRow& row);
+  static void write_log_header(std::ostream& out) { out << log_header() << '\n'; }
+  void write_log_row(std::ostream& out) const { format_log_row(out, log_row()); }
 
  private:
   SpidarHardware hardware_;
