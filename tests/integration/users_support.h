@@ -45,7 +45,6 @@ inline std::filesystem::path two_users(const std::string& name, double depth_a_m
   User users[] = {{"a", -0.01, user_a_target_x(depth_a_m)}, {"b", 0.07, user_b_target_x(depth_b_m)}};
   for (User& user : users) {
     const std::string shm = world_shm + "_" + user.name;
-    // The master (A) attaches first, so B follows it.
     std::vector<std::string> argv = {binary("haptic_controller"), "--clock", "lockstep", "--shm", shm,
                                      "--world-shm", world_shm, "--log",
                                      (dir / ("haptic_" + user.name + ".csv")).string(), "--summary",
@@ -55,7 +54,14 @@ inline std::filesystem::path two_users(const std::string& name, double depth_a_m
     user.device = spawn({binary("spidar_sim"), "--clock", "lockstep", "--shm", shm, "--trajectory",
                                side_press(dir, user.name, user.from_x, user.to_x).string()},
                               dir / ("device_" + user.name + ".out"));
-    if (user.name == "a") std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    if (user.name == "a") {
+      // B starts once A holds the world's lockstep and waits for it (A says so), so A is the master in every run.
+      const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+      while (read_text(dir / "haptic_a.out").find("waiting for 1 more controller") == std::string::npos &&
+             std::chrono::steady_clock::now() < give_up) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    }
   }
   for (User& user : users) CHECK(wait_for(user.device, 60.0) == 0);
   // As a user ends a lockstep run: the follower first, then the master, then the world.
