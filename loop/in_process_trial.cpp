@@ -150,10 +150,17 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
     haptic_options.duration_s = options.duration_s;
     haptic_options.haptic_session = 1 + u;
     haptic_options.followers = u == 0 ? static_cast<std::uint32_t>(options.followers.size()) : 0;
-    const std::vector<NamedFinger> fingers =
-        u > 0 ? parse_fingers(options.followers[u - 1], kMaxFingers)
-        : options.fingers.empty() ? std::vector<NamedFinger>{{"finger", load_trajectory(options.trajectory)}}
-                                  : parse_fingers(options.fingers, kMaxFingers);
+    // Built step by step: a throwing call inside a braced list of elements is cleaned up wrongly by GCC 12
+    // (AddressSanitizer: stack-use-after-scope when the trajectory is bad).
+    std::vector<NamedFinger> fingers;
+    if (u > 0) {
+      fingers = parse_fingers(options.followers[u - 1], kMaxFingers);
+    } else if (options.fingers.empty()) {
+      Trajectory trajectory = load_trajectory(options.trajectory);
+      fingers.push_back({"finger", std::move(trajectory)});
+    } else {
+      fingers = parse_fingers(options.fingers, kMaxFingers);
+    }
     users.push_back(std::make_unique<Controller>(haptic_options, fingers, world_link,
                                                  log_path(options.out_dir, (prefix + "device.csv").c_str())));
     if (u > 0) world_link.connect_follower(users.back()->link, *users.back()->haptic);

@@ -69,9 +69,15 @@ int main(int argc, char** argv) {
   }
 
   return run_node("spidar_sim", [&] {
-    const std::vector<NamedFinger> fingers =
-        finger_specs.empty() ? std::vector<NamedFinger>{{"finger", load_trajectory(trajectory_spec)}}
-                             : parse_fingers(finger_specs, kMaxFingers);
+    // Built step by step: a throwing call inside a braced list of elements is cleaned up wrongly by GCC 12
+    // (AddressSanitizer: stack-use-after-scope when the trajectory is bad).
+    std::vector<NamedFinger> fingers;
+    if (finger_specs.empty()) {
+      Trajectory trajectory = load_trajectory(trajectory_spec);
+      fingers.push_back({"finger", std::move(trajectory)});
+    } else {
+      fingers = parse_fingers(finger_specs, kMaxFingers);
+    }
     double longest_s = 0.0;
     for (const NamedFinger& named : fingers) longest_s = std::max(longest_s, named.trajectory.duration_s());
     const SpidarDevice spidar = parse_device_spec(device_spec);

@@ -630,7 +630,8 @@ std::vector<NamedFinger> parse_fingers(const std::vector<std::string>& specs, st
       if (other.name == name) throw TrajectoryError("finger '" + name + "' is given twice");
     }
     try {
-      fingers.push_back({name, load_trajectory(spec.substr(equals + 1))});
+      Trajectory trajectory = load_trajectory(spec.substr(equals + 1));  // apart from the braced element: see spidar_sim/main.cpp
+      fingers.push_back({name, std::move(trajectory)});
     } catch (const TrajectoryError& error) {
       throw TrajectoryError("finger '" + name + "': " + error.what());
     }
