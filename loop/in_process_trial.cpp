@@ -88,17 +88,7 @@ struct Controller {
   // The haptic and device halves of its summary (a device of several fingers lists each under "device"."fingers").
   nlohmann::json summary() const {
     nlohmann::json out = haptic->summary();
-    out.update(devices[0]->summary());
-    if (devices.size() > 1) {
-      nlohmann::json per_finger = nlohmann::json::array();
-      for (std::size_t k = 0; k < devices.size(); ++k) {
-        nlohmann::json one = devices[k]->summary()["device"];
-        one["name"] = names[k].name;
-        one["trajectory"] = names[k].trajectory.description();
-        per_finger.push_back(one);
-      }
-      out["device"]["fingers"] = per_finger;
-    }
+    out.update(fingers_summary(devices, names));
     return out;
   }
 

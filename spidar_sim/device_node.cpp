@@ -133,4 +133,19 @@ nlohmann::json DeviceNode::summary() const {
             {"max_force_N", geometry.max_force_N}}}};
 }
 
+nlohmann::json fingers_summary(std::span<const std::unique_ptr<DeviceNode>> nodes,
+                               std::span<const NamedFinger> fingers) {
+  nlohmann::json summary = nodes[0]->summary();
+  if (nodes.size() < 2) return summary;  // a one-finger summary stays as it always was
+  nlohmann::json per_finger = nlohmann::json::array();
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    nlohmann::json one = nodes[k]->summary()["device"];
+    one["name"] = fingers[k].name;
+    one["trajectory"] = fingers[k].trajectory.description();
+    per_finger.push_back(one);
+  }
+  summary["device"]["fingers"] = per_finger;
+  return summary;
+}
+
 }  // namespace impetus

@@ -15,6 +15,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <optional>
 #include <string>
 
@@ -50,5 +52,10 @@ class DeviceNode final : public DeviceStepper {
   bool cut_short_ = false;               // lockstep: the haptic controller died before the trajectory ended
   std::uint64_t ticks_ = 0;
 };
+
+// The device half of summary.json for a device of one or several fingers (node k plays fingers[k]): finger 0's
+// summary and, when there are several, each finger's under "device"."fingers" with its name and trajectory.
+nlohmann::json fingers_summary(std::span<const std::unique_ptr<DeviceNode>> nodes,
+                               std::span<const NamedFinger> fingers);
 
 }  // namespace impetus

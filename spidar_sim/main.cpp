@@ -104,16 +104,7 @@ int main(int argc, char** argv) {
     statuses[0] = nodes[0]->run();
     for (std::thread& thread : threads) thread.join();
 
-    nlohmann::json summary = nodes[0]->summary();
-    nlohmann::json per_finger = nlohmann::json::array();
-    for (std::size_t k = 0; k < nodes.size(); ++k) {
-      nlohmann::json one = nodes[k]->summary()["device"];
-      one["name"] = fingers[k].name;
-      one["trajectory"] = fingers[k].trajectory.description();
-      per_finger.push_back(one);
-    }
-    if (nodes.size() > 1) summary["device"]["fingers"] = per_finger;  // a one-finger summary stays as it was
-    write_summary(summary_path, summary);
+    write_summary(summary_path, fingers_summary(nodes, fingers));
     std::fprintf(stderr, "spidar_sim: detached after %llu ticks (%.3f s simulated)\n",
                  static_cast<unsigned long long>(nodes[0]->ticks()), sims[0]->time_s());
     return *std::max_element(statuses.begin(), statuses.end());

@@ -14,14 +14,23 @@
 #include <vector>
 
 namespace impetus {
+namespace {
+
+// A 20 Hz world's link on `clock`.
+WorldLinkInfo world_info(ClockMode clock) {
+  WorldLinkInfo info;
+  info.world_rate_hz = 20.0;
+  info.world_period_s = 0.05;
+  info.clock = clock;
+  return info;
+}
+
+}  // namespace
 
 TEST_CASE("shm world link: controllers take endpoint slots in turn, and each endpoint's frames and reports stay in "
           "its own slot") {
   const std::string shm = test::unique_segment_name("slots");
-  WorldLinkInfo info;
-  info.world_rate_hz = 20.0;
-  info.world_period_s = 0.05;
-  ShmWorldLinkServer server(shm, info);
+  ShmWorldLinkServer server(shm, world_info(ClockMode::realtime));
   auto one = std::make_unique<ShmWorldLinkClient>(shm, ClockMode::realtime, 1.0, 1);
   ShmWorldLinkClient two(shm, ClockMode::realtime, 1.0, 2);
   CHECK(one->slot_of(0) == 0);
@@ -65,11 +74,7 @@ TEST_CASE("shm world link: controllers take endpoint slots in turn, and each end
 TEST_CASE("shm world link: on a lockstep world the first controller is the master and the next ones follow its "
           "ticks") {
   const std::string shm = test::unique_segment_name("master");
-  WorldLinkInfo info;
-  info.world_rate_hz = 20.0;
-  info.world_period_s = 0.05;
-  info.clock = ClockMode::lockstep;
-  ShmWorldLinkServer server(shm, info);
+  ShmWorldLinkServer server(shm, world_info(ClockMode::lockstep));
   ShmWorldLinkClient master(shm, ClockMode::lockstep, 1.0, 1);
   ShmWorldLinkClient follower(shm, ClockMode::lockstep, 1.0, 2);
   CHECK_FALSE(master.follower());
