@@ -206,9 +206,12 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
   frame.world_time_s = time_s_;
   frame.stiffness_Npm = scene_.haptic.stiffness_Npm;
   frame.damping_Nspm = scene_.haptic.damping_Nspm;
-  // Without a finger there is nothing to be near: no planes until a device reports one.
-  endpoint.plane_faces.begin_step(states_.size());
+  // Without a finger there is nothing to be near: no planes until a device reports one. The faces the proxy met are
+  // remembered across such steps (the step count advances only when planes are taken): a device that stalls while
+  // the finger goes on moving comes back with its proxy deep in the object, and must meet the face it went in by,
+  // not the far face of a memory that lapsed.
   const bool valid = endpoint.finger.valid;
+  if (valid) endpoint.plane_faces.begin_step(states_.size());
   frame.plane_count =
       valid ? features_.extract(endpoint.plane_query, states_, period_s_, frame.planes, &endpoint.plane_faces) : 0;
   if (!valid) frame.planes.fill(Plane{});

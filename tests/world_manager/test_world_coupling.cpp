@@ -275,3 +275,32 @@ TEST_CASE("impulse coupling: a push beyond what friction holds moves the cube at
   const double friction_dv = 0.5 * 9.81 * world->world_period_s();
   CHECK(speed == Approx(0.5 - friction_dv).margin(0.02));
 }
+
+TEST_CASE("a finger that comes back after its device stalled meets the face it went in by, not the far face") {
+  // The tap scene's cube (1 kg, 5 cm, centre x = 0.03 m): the proxy at its −x face, then the device stalls (reports
+  // without a finger) for 5 world steps while the finger goes on moving, and comes back with its proxy 1 cm past the
+  // cube's centre. The world must still give the −x face (the one the proxy went in by): the far face would put the
+  // proxy outside through the +x side and pull the finger on through.
+  impetus::init_ode_once();
+  const impetus::Scene scene = impetus::load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json");
+  impetus::World world(scene, impetus::WorldOptions{});
+  HapticReport report = make_report(7, 1, {0.006, 0.0, 0.025}, true);
+  report.proxy_m = {0.005, 0.0, 0.025};
+  auto cube_plane_normal_x = [&](const impetus::PlaneFrame& frame) {
+    for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
+      if (frame.planes[k].object_id == 0) return frame.planes[k].normal[0];
+    }
+    return 0.0;
+  };
+  CHECK(cube_plane_normal_x(world.step(&report)) < -0.99);  // the −x face
+  report.finger_valid = 0;
+  for (int step = 0; step < 5; ++step) {
+    ++report.tick;
+    CHECK(world.step(&report).plane_count == 0);
+  }
+  ++report.tick;
+  report.finger_valid = 1;
+  report.finger_m = {0.045, 0.0, 0.025};
+  report.proxy_m = {0.04, 0.0, 0.025};  // past the centre: the +x face is now the nearer one
+  CHECK(cube_plane_normal_x(world.step(&report)) < -0.99);
+}

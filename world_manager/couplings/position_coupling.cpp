@@ -14,8 +14,8 @@ void PositionCoupling::before_step(std::span<const FingerState> fingers, const F
   for (std::size_t slot = 0; slot < fingers.size() && slot < finger_faces_.size(); ++slot) {
     const FingerState& finger = fingers[slot];
     FeatureMemory& faces = finger_faces_[slot];
+    if (!finger.valid) continue;  // the faces are remembered across steps without a finger (World::publish)
     faces.begin_step(context_.scene.objects.size());
-    if (!finger.valid) continue;
     // Only the objects near the finger can be penetrated, so the feature index narrows the search.
     touching_.clear();
     features.within_reach(finger.finger, context_.states, 0.0, touching_, &faces);
