@@ -23,8 +23,9 @@ install(TARGETS ${exported_targets} impetus_warnings EXPORT ImpetusTargets
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/impetus)
 install(TARGETS world_manager haptic_controller spidar_sim RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 foreach(dir common world_manager haptic_controller spidar_sim loop)
+  # dds_codec.h needs the idlc-generated types, which are the transport's own and not installed.
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/impetus/${dir}
-          FILES_MATCHING PATTERN "*.h")
+          FILES_MATCHING PATTERN "*.h" PATTERN "dds_codec.h" EXCLUDE)
 endforeach()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${IMPETUS_INSTALL_DATADIR}/scenes
         FILES_MATCHING PATTERN "*.json")
@@ -52,7 +53,7 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Multi-rate haptic rendering with force in
 set(CPACK_RESOURCE_FILE_LICENSE ${PROJECT_SOURCE_DIR}/LICENSE)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
-set(CPACK_DEBIAN_PACKAGE_DEPENDS "libode8, libode-dev, libeigen3-dev, libboost-dev, nlohmann-json3-dev, libcli11-dev")
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "libode8, libddsc0debian, libode-dev, libeigen3-dev, libboost-dev, nlohmann-json3-dev, libcli11-dev")
 if(IMPETUS_PYTHON_DEB_DEPENDS)
   string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", ${IMPETUS_PYTHON_DEB_DEPENDS}")
 endif()

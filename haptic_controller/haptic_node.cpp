@@ -283,6 +283,7 @@ nlohmann::json HapticNode::endpoint_summary(const Endpoint& endpoint) const {
   }
   const Eigen::Vector3d& abandoned = endpoint.servo.accumulator().abandoned_impulse_Ns();
   return {{"endpoint", report.endpoint},
+          {"haptic_session", options_.haptic_session},
           {"faults", counters.faults},
           {"force_clamps", counters.force_clamps},
           {"infeasible_contacts", counters.infeasible_contacts},

@@ -2,6 +2,7 @@
 // haptic_controller: the 1 kHz haptic servo (DESIGN.md §1.2). Parses the flags, creates the device port, opens the
 // world link and runs a HapticNode on them; writes the haptic half of summary.json at exit.
 
+#include "common/link/dds/dds_world_link.h"
 #include "common/link/shm/shm_device_port.h"
 #include "common/link/shm/shm_world_link.h"
 #include "common/runtime/cli.h"
@@ -23,6 +24,7 @@ int main(int argc, char** argv) {
   std::string device_spec = "spidar";
   std::string world_shm;  // "": the same as --shm
   unsigned fingers = 1;
+  LinkOptions link_options;
   CLI::App app{"haptic_controller: the 1 kHz haptic servo of Impetus. Interpolates the world's planes, renders the "
                "god-object force on the SPIDAR and integrates it into impulses for the world."};
   app.add_option("--rate", options.rate_hz, "servo rate in Hz (1000)")
@@ -38,6 +40,7 @@ int main(int argc, char** argv) {
                   "CSV log: finger, proxy, force, accumulated impulse, lateness per tick");
   add_output_flag(app, "--summary", summary_path, "JSON summary written at exit (loop statistics, faults)");
   add_shm_flag(app, shm);
+  add_link_flags(app, link_options);
   app.add_option("--world-wait", world_wait_s, "seconds to wait for the world manager's link (10)")
       ->check(positive_number(kMaxFlagSeconds));
   app.add_option("--device", device_spec, "spidar (the built-in geometry) or spidar:FILE.json (a device file)");
@@ -59,6 +62,19 @@ int main(int argc, char** argv) {
   return run_node("haptic_controller", [&] {
     options.haptic_session = new_session_id();
     const SpidarDevice spidar = parse_device_spec(device_spec);
+    // The world link by --link, before the device ports: a device starts its motion when its port appears, and the
+    // servo can render only once the world serves it (over DDS that takes a discovery). The device ports stay in
+    // shared memory on this host either way.
+    std::unique_ptr<WorldLinkClient> world;
+    DdsWorldLinkClient* dds = nullptr;
+    if (link_options.kind == LinkKind::dds) {
+      auto client = std::make_unique<DdsWorldLinkClient>(link_options.dds, options.clock, world_wait_s, fingers);
+      dds = client.get();
+      world = std::move(client);
+    } else {
+      world = std::make_unique<ShmWorldLinkClient>(world_shm.empty() ? shm : world_shm, options.clock, world_wait_s,
+                                                   fingers);
+    }
     // A SPIDAR string set per finger, each on its own port; one finger is the SPIDAR itself.
     std::vector<std::unique_ptr<ShmDevicePortHost>> ports;
     std::vector<std::unique_ptr<SpidarDriver>> drivers;
@@ -75,13 +91,18 @@ int main(int argc, char** argv) {
     std::optional<FingerSet> finger_set;
     if (fingers > 1) finger_set.emplace(devices);
     HapticDevice& device = finger_set ? static_cast<HapticDevice&>(*finger_set) : *drivers[0];
-    ShmWorldLinkClient world(world_shm.empty() ? shm : world_shm, options.clock, world_wait_s, fingers);
-    HapticNode node(options, world, device);
+    HapticNode node(options, *world, device);
     std::fprintf(stderr, "haptic_controller: %.0f Hz, %s clock, world at %.1f Hz, device port '%s'%s\n",
-                 options.rate_hz, to_string(options.clock), world.info().world_rate_hz, ports[0]->name().c_str(),
+                 options.rate_hz, to_string(options.clock), world->info().world_rate_hz, ports[0]->name().c_str(),
                  fingers > 1 ? (" and " + std::to_string(fingers - 1) + " more, one per finger").c_str() : "");
     const int status = node.run();
-    write_summary(summary_path, node.summary());
+    nlohmann::json summary = node.summary();
+    if (dds != nullptr) {
+      summary["haptic"]["dds"] = {{"domain", link_options.dds.domain_id},
+                                  {"partition", link_options.dds.partition},
+                                  {"reports_sent", dds->reports_sent()}};
+    }
+    write_summary(summary_path, summary);
     const ServoCounters& counters = node.servo().counters();
     std::fprintf(stderr, "haptic_controller: %llu ticks, %llu faults, %llu force clamps, %llu saturations\n",
                  static_cast<unsigned long long>(counters.ticks), static_cast<unsigned long long>(counters.faults),

@@ -11,6 +11,7 @@
 #   5. lockstep throughput of the tap trial (simulated s per wall s, target >= 50x) via scripts/run.sh
 #   6. peak RSS of each process during a tap trial
 #   7. the world view: snapshot size and cost per world step, a viewer's read and encode   build/tests/bench_world_view
+#   8. world link one-way latency, shared memory and DDS, and DDS across a veth   build/tests/bench_dds_link
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -19,7 +20,7 @@ rt_seconds=30
 while (($#)); do
   case "$1" in
     --short) rt_seconds=5; shift ;;
-    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -123,3 +124,22 @@ done
 
 section "7. World view: snapshot size and cost per world step, and a viewer's per frame, vs number of bodies"
 bench bench_world_view
+
+section "8. World link one-way latency: shared memory and DDS on this host, DDS between two network hosts"
+# Both ends poll every 20 µs (the timer's slack makes it ~60 µs here): the shared-memory figures are the method's
+# floor, and the DDS figures minus them are what DDS adds.
+bench bench_dds_link --link shm --seconds 5
+bench bench_dds_link --link dds --seconds 5
+source scripts/netns_hosts.sh
+if make_hosts "impb$$"; then
+  ip netns exec "$world_ns" "$build/tests/bench_dds_link" --role world --seconds 5 --partition "impb$$" &
+  world_end=$!
+  sleep 0.5
+  ip netns exec "$hands_ns" "$build/tests/bench_dds_link" --role controller --seconds 5 --partition "impb$$" |
+    sed 's/^dds link/dds link across a veth/'
+  wait "$world_end" || true
+  remove_hosts
+else
+  remove_hosts
+  echo "(DDS across a veth skipped: network namespaces need root and iproute2)"
+fi

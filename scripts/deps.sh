@@ -12,6 +12,8 @@ browser=0
 IMPETUS_PACKAGES=(cmake g++ make pkg-config libeigen3-dev libode-dev libboost-dev catch2 nlohmann-json3-dev
                   libcli11-dev python3-matplotlib python3-numpy python3-tqdm
                   pybind11-dev python3-dev  # the impetus Python module (python/)
+                  cyclonedds-dev cyclonedds-tools  # the world link over DDS (common/link/dds; idlc)
+                  iproute2  # network namespaces: the DDS tests' and benchmark's two hosts
                   curl  # the install test fetches the installed viewer's page
                   time)  # /usr/bin/time: each process's peak RSS in scripts/bench.sh
 # The viewer's page comes from the npm registry; a machine without Node.js gets Debian's.

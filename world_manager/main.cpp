@@ -2,11 +2,14 @@
 // world_manager: the rigid-body world at the world rate (DESIGN.md §1.1). Parses the flags, creates the world link
 // and runs a WorldNode on it; writes the world half of summary.json at exit.
 
+#include "common/link/dds/dds_world_link.h"
 #include "common/link/shm/shm_world_link.h"
 #include "common/link/shm/shm_world_view.h"
 #include "common/runtime/cli.h"
 #include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world_node.h"
+
+#include <memory>
 
 namespace {
 // A phase is less than one world period in haptic ticks, and the longest period is the fastest haptic rate over the
@@ -20,6 +23,7 @@ int main(int argc, char** argv) {
   WorldNodeOptions options;
   std::string summary_path;
   std::string shm = "impetus";
+  LinkOptions link_options;
   CLI::App app{"world_manager: the ODE world of Impetus. Steps a scene at the world rate, applies the haptic "
                "controller's impulses and publishes the planes near the finger."};
   app.add_option("--scene", options.scene_path, "scene file (JSON, see scenes/)")->required()->check(CLI::ExistingFile);
@@ -37,6 +41,7 @@ int main(int argc, char** argv) {
   add_output_flag(app, "--log", options.log_path, "CSV log of every dynamic object per step");
   add_output_flag(app, "--summary", summary_path, "JSON summary written at exit (objects, loop statistics)");
   add_shm_flag(app, shm);
+  add_link_flags(app, link_options);
   app.add_option("--haptic-rate", options.haptic_rate_hz, "haptic rate the lockstep phase is counted in (1000)")
       ->check(number_in(limits::kMinHapticRate_Hz, limits::kMaxHapticRate_Hz));
   CLI11_PARSE(app, argc, argv);
@@ -44,18 +49,38 @@ int main(int argc, char** argv) {
   return run_node("world_manager", [&] {
     init_ode_once();
     WorldNode node(options);
-    ShmWorldLinkServer link(shm, node.link_info());
-    node.connect(link);
+    // The world link by --link; the world-state view stays in shared memory on this host either way.
+    std::unique_ptr<WorldLinkServer> link;
+    std::string link_name;
+    DdsWorldLinkServer* dds = nullptr;
+    if (link_options.kind == LinkKind::dds) {
+      auto server = std::make_unique<DdsWorldLinkServer>(link_options.dds, node.link_info());
+      dds = server.get();
+      link_name = server->name();
+      link = std::move(server);
+    } else {
+      auto server = std::make_unique<ShmWorldLinkServer>(shm, node.link_info());
+      link_name = "'" + server->name() + "'";
+      link = std::move(server);
+    }
+    node.connect(*link);
     ShmWorldViewPublisher view(shm);  // "<shm>.view": viewers attach to it read-only
     node.connect_view(view);
     const WorldLinkInfo info = node.link_info();
-    std::fprintf(stderr, "world_manager: '%s', %zu objects, %.1f Hz, %s coupling, %s clock, link '%s'\n",
+    std::fprintf(stderr, "world_manager: '%s', %zu objects, %.1f Hz, %s coupling, %s clock, link %s\n",
                  options.scene_path.c_str(), node.world().scene().objects.size(), info.world_rate_hz,
-                 to_string(info.coupling), to_string(info.clock), link.name().c_str());
+                 to_string(info.coupling), to_string(info.clock), link_name.c_str());
     const std::string warnings = node.warnings();
     if (!warnings.empty()) std::fprintf(stderr, "world_manager: warning: %s\n", warnings.c_str());
     const int status = node.run();
-    write_summary(summary_path, node.summary());
+    nlohmann::json summary = node.summary();
+    if (dds != nullptr) {
+      summary["world"]["dds"] = {{"domain", link_options.dds.domain_id},
+                                 {"partition", link_options.dds.partition},
+                                 {"refused_endpoints", dds->refused_endpoints()},
+                                 {"released_slots", dds->released_slots()}};
+    }
+    write_summary(summary_path, summary);
     std::fprintf(stderr, "world_manager: %llu steps, %.3f s simulated\n",
                  static_cast<unsigned long long>(node.world().steps_taken()), node.world().time_s());
     return status;

@@ -120,6 +120,7 @@ void WorldNode::step_world() {
     // applies nothing more from them; a restarted controller starts a new session from zero.
     if (options_.clock == ClockMode::realtime && slot_report.have &&
         static_cast<double>(now_ns - slot_report.fresh_ns) * 1e-9 > endpoint_stale_s(world_.world_period_s())) {
+      if (slot_report.report.finger_valid != 0) ++stale_finger_steps_;
       slot_report.report.finger_valid = 0;
     }
     report_of_slot_[slot] = slot_report.have ? &slot_report.report : nullptr;
@@ -245,6 +246,7 @@ nlohmann::json WorldNode::summary() const {
             {"rejected_reports", stats_.rejected_frames},
             {"channel_repairs", link_ != nullptr ? link_->channel_repairs() : 0},
             {"foreign_reports", world_.foreign_reports()},
+            {"stale_finger_steps", stale_finger_steps_},
             {"escaped_objects", escaped_names()},
             {"lateness_p50_ns", stats_.lateness_p50_ns},
             {"lateness_p99_ns", stats_.lateness_p99_ns},

@@ -88,6 +88,8 @@ class WorldNode final : public WorldStepper {
   std::vector<SlotReport> reports_;  // kMaxEndpoints (~7 KB each: on the heap)
   HapticReport incoming_{};
   std::array<const HapticReport*, kMaxEndpoints> report_of_slot_{};
+  // Steps × endpoints whose finger the world dropped because their reports stopped arriving (real time).
+  std::uint64_t stale_finger_steps_ = 0;
   std::size_t escapes_reported_ = 0;  // world_.escaped() entries already announced on stderr
   LoopStats stats_;
   LatencyHistogram step_cpu_ns_;  // CPU time of World::step (coupling + engine + features), per step

@@ -98,6 +98,18 @@ void add_shm_flag(CLI::App& app, std::string& shm) {
   app.add_option("--shm", shm, "shared-memory name of the link (default impetus)");
 }
 
+void add_link_flags(CLI::App& app, LinkOptions& link) {
+  app.add_option("--link", link.kind,
+                 "transport of the world link: shm (shared memory on this host, the default) or dds (DDS, world and "
+                 "controller on the same or different hosts; real time only)")
+      ->transform(CLI::CheckedTransformer(kLinkNames, CLI::ignore_case));
+  app.add_option("--dds-domain", link.dds.domain_id, "--link dds: the DDS domain id, 0 to 232 (0)")
+      ->check(whole_number_in(0, kMaxDdsDomainId));
+  app.add_option("--dds-partition", link.dds.partition,
+                 "--link dds: the DDS partition; worlds in other partitions of the domain are invisible (impetus)")
+      ->check([](const std::string& name) { return name.empty() ? std::string("must not be empty") : std::string(); });
+}
+
 void add_output_flag(CLI::App& app, const std::string& flag, std::string& path, const std::string& description) {
   app.add_option(flag, path, description)->check(CLI::Validator(check_writable_path, "WRITABLE"));
 }

@@ -5,6 +5,7 @@
 
 #include "common/contract/frames.h"
 #include "common/contract/limits.h"
+#include "common/link/link_options.h"
 #include "common/runtime/lockstep.h"
 #include "common/runtime/process.h"
 
@@ -40,6 +41,9 @@ inline constexpr double kMaxFlagSeconds = 1e7;
 
 void add_clock_flag(CLI::App& app, ClockMode& clock);
 void add_shm_flag(CLI::App& app, std::string& shm);
+// --link shm|dds, --dds-domain, --dds-partition.
+void add_link_flags(CLI::App& app, LinkOptions& link);
+inline const std::map<std::string, LinkKind> kLinkNames{{"shm", LinkKind::shm}, {"dds", LinkKind::dds}};
 void add_output_flag(CLI::App& app, const std::string& flag, std::string& path, const std::string& description);
 
 // Writes a node's half of summary.json to `path` (nothing if it is empty); throws std::runtime_error naming the path

@@ -84,6 +84,14 @@ TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment 
       {device + "--trajectory tap --finger-mass -1", "must be positive, not -1"},
       {haptic + "--stiffness 1e12", "at most 1e+06"},
       {world + "--scene scenes/tap.json --substeps 99999999999999999999", "whole number from 1 to 10000"},
+      // The world link's transport: DDS is real time only, and a controller names where it looked.
+      {world + "--scene scenes/tap.json --link carrier-pigeon", "carrier-pigeon"},
+      {world + "--scene scenes/tap.json --link dds --clock lockstep", "real time only"},
+      {world + "--scene scenes/tap.json --link dds --dds-domain 233", "from 0 to 232, not 233"},
+      {world + "--scene scenes/tap.json --link dds --dds-partition ''", "must not be empty"},
+      {haptic + "--link dds --clock lockstep", "real time only"},
+      {haptic + "--clock realtime --link dds --dds-partition impetus_test_nobody_" + std::to_string(getpid()),
+       "no world manager answered on DDS domain 0 partition 'impetus_test_nobody_"},
   };
   for (const Case& test_case : cases) {
     INFO(test_case.command);

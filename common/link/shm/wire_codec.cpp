@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "common/link/shm/wire_frames.h"
 
+#include "common/link/frame_fields.h"
+
 #include <algorithm>
 
 #include <cmath>
@@ -47,82 +49,6 @@ std::uint64_t checksum_before_tail(const Frame& frame) {
 }
 
 bool finite(double value) { return std::isfinite(value); }
-
-// Each struct's fields, listed once for both directions: visit(a, b, f) calls f(a.x, b.x) for every field x.
-template <class A, class B, class F>
-void visit_contact(A& a, B& b, F&& f) {
-  f(a.normal, b.normal);
-  f(a.friction, b.friction);
-  f(a.other_velocity_mps, b.other_velocity_mps);
-  f(a.other_inverse_mass_per_kg, b.other_inverse_mass_per_kg);
-  f(a.flags, b.flags);
-}
-
-template <class A, class B, class F>
-void visit_plane(A& a, B& b, F&& f) {
-  f(a.object_id, b.object_id);
-  f(a.flags, b.flags);
-  f(a.point_m, b.point_m);
-  f(a.normal, b.normal);
-  f(a.com_m, b.com_m);
-  f(a.velocity_mps, b.velocity_mps);
-  f(a.angular_velocity_radps, b.angular_velocity_radps);
-  f(a.static_friction, b.static_friction);
-  f(a.dynamic_friction, b.dynamic_friction);
-  f(a.extent_m, b.extent_m);
-  f(a.box_axis_x, b.box_axis_x);
-  f(a.box_axis_y, b.box_axis_y);
-  f(a.box_half_m, b.box_half_m);
-  f(a.inverse_mass_per_kg, b.inverse_mass_per_kg);
-  f(a.inverse_inertia_world, b.inverse_inertia_world);
-  f(a.local_contact_count, b.local_contact_count);
-  for (std::size_t c = 0; c < kMaxLocalContacts; ++c) visit_contact(a.local_contacts[c], b.local_contacts[c], f);
-}
-
-template <class A, class B, class F>
-void visit_frame_header(A& a, B& b, F&& f) {
-  f(a.frame_index, b.frame_index);
-  f(a.world_session, b.world_session);
-  f(a.endpoint, b.endpoint);
-  f(a.report_tick_applied, b.report_tick_applied);
-  f(a.report_session_applied, b.report_session_applied);
-  f(a.world_time_s, b.world_time_s);
-  f(a.world_period_s, b.world_period_s);
-  f(a.coupling, b.coupling);
-  f(a.plane_count, b.plane_count);
-  f(a.stiffness_Npm, b.stiffness_Npm);
-  f(a.damping_Nspm, b.damping_Nspm);
-  f(a.gravity_mps2, b.gravity_mps2);
-  f(a.world_substep_s, b.world_substep_s);
-  f(a.reach_radius_m, b.reach_radius_m);
-}
-
-template <class A, class B, class F>
-void visit_entry(A& a, B& b, F&& f) {
-  f(a.object_id, b.object_id);
-  f(a.epoch, b.epoch);
-  f(a.impulse_Ns, b.impulse_Ns);
-  f(a.angular_impulse_Nms, b.angular_impulse_Nms);
-  f(a.impulse_moment_Nss, b.impulse_moment_Nss);
-  f(a.angular_impulse_moment_Nmss, b.angular_impulse_moment_Nmss);
-  f(a.last_tick, b.last_tick);
-}
-
-template <class A, class B, class F>
-void visit_report_header(A& a, B& b, F&& f) {
-  f(a.tick, b.tick);
-  f(a.haptic_session, b.haptic_session);
-  f(a.endpoint, b.endpoint);
-  f(a.world_session, b.world_session);
-  f(a.haptic_time_s, b.haptic_time_s);
-  f(a.finger_m, b.finger_m);
-  f(a.finger_velocity_mps, b.finger_velocity_mps);
-  f(a.proxy_m, b.proxy_m);
-  f(a.force_N, b.force_N);
-  f(a.finger_valid, b.finger_valid);
-  f(a.entry_count, b.entry_count);
-  f(a.static_impulse_Ns, b.static_impulse_Ns);
-}
 
 struct CopyInto {
   template <class From, class To>
@@ -265,16 +191,16 @@ FrameError validate(const wire::DeviceState& state) {
 // Encoding copies the counted slots only: the rest is not part of the frame (used_bytes()), never sealed, sent or read.
 // A count over capacity is copied as it is, so the reader rejects the frame rather than receive a truncated one.
 void encode(const PlaneFrame& frame, wire::PlaneFrame& out) {
-  visit_frame_header(frame, out, CopyInto{});
+  fields::visit_frame_header(frame, out, CopyInto{});
   const std::uint32_t count = std::min(frame.plane_count, kMaxPlanes);
-  for (std::size_t k = 0; k < count; ++k) visit_plane(frame.planes[k], out.planes[k], CopyInto{});
+  for (std::size_t k = 0; k < count; ++k) fields::visit_plane(frame.planes[k], out.planes[k], CopyInto{});
   seal(out);
 }
 
 void encode(const HapticReport& report, wire::HapticReport& out) {
-  visit_report_header(report, out, CopyInto{});
+  fields::visit_report_header(report, out, CopyInto{});
   const std::uint32_t count = std::min(report.entry_count, kMaxImpulseEntries);
-  for (std::size_t k = 0; k < count; ++k) visit_entry(report.entries[k], out.entries[k], CopyInto{});
+  for (std::size_t k = 0; k < count; ++k) fields::visit_entry(report.entries[k], out.entries[k], CopyInto{});
   seal(out);
 }
 
@@ -296,10 +222,10 @@ void encode(const DeviceState& state, wire::DeviceState& out) {
 FrameError decode(const wire::PlaneFrame& in, PlaneFrame& out) {
   const FrameError error = validate(in);
   if (error != FrameError::ok) return error;
-  visit_frame_header(in, out, CopyInto{});
+  fields::visit_frame_header(in, out, CopyInto{});
   for (std::size_t k = 0; k < kMaxPlanes; ++k) {
     if (k < in.plane_count) {
-      visit_plane(in.planes[k], out.planes[k], CopyInto{});
+      fields::visit_plane(in.planes[k], out.planes[k], CopyInto{});
       for (std::size_t c = in.planes[k].local_contact_count; c < kMaxLocalContacts; ++c) {
         out.planes[k].local_contacts[c] = LocalContact{};
       }
@@ -313,10 +239,10 @@ FrameError decode(const wire::PlaneFrame& in, PlaneFrame& out) {
 FrameError decode(const wire::HapticReport& in, HapticReport& out) {
   const FrameError error = validate(in);
   if (error != FrameError::ok) return error;
-  visit_report_header(in, out, CopyInto{});
+  fields::visit_report_header(in, out, CopyInto{});
   for (std::size_t k = 0; k < kMaxImpulseEntries; ++k) {
     if (k < in.entry_count) {
-      visit_entry(in.entries[k], out.entries[k], CopyInto{});
+      fields::visit_entry(in.entries[k], out.entries[k], CopyInto{});
     } else {
       out.entries[k] = ObjectImpulse{};
     }

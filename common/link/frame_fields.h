@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// The fields of the contract frames (common/contract/frames.h), listed once for every encoding of them: the contract
+// structs, the shared-memory wire frames (shm/wire_frames.h) and the DDS topic types (dds/world_link.idl) name their
+// fields alike, so visit_X(a, b, f) calls f(a.field, b.field) for every field of X, whichever two of them a and b
+// are. A transport's f converts or copies; adding a field to the contract means adding it here and to each encoding.
+//
+// Not visited: each frame's checksum and reserved words (the encodings' own), and the planes and entries beyond the
+// headers' counts (the codecs loop over them).
+
+#include "common/contract/frames.h"
+
+#include <cstddef>
+
+namespace impetus::fields {
+
+template <class A, class B, class F>
+void visit_contact(A& a, B& b, F&& f) {
+  f(a.normal, b.normal);
+  f(a.friction, b.friction);
+  f(a.other_velocity_mps, b.other_velocity_mps);
+  f(a.other_inverse_mass_per_kg, b.other_inverse_mass_per_kg);
+  f(a.flags, b.flags);
+}
+
+template <class A, class B, class F>
+void visit_plane(A& a, B& b, F&& f) {
+  f(a.object_id, b.object_id);
+  f(a.flags, b.flags);
+  f(a.point_m, b.point_m);
+  f(a.normal, b.normal);
+  f(a.com_m, b.com_m);
+  f(a.velocity_mps, b.velocity_mps);
+  f(a.angular_velocity_radps, b.angular_velocity_radps);
+  f(a.static_friction, b.static_friction);
+  f(a.dynamic_friction, b.dynamic_friction);
+  f(a.extent_m, b.extent_m);
+  f(a.box_axis_x, b.box_axis_x);
+  f(a.box_axis_y, b.box_axis_y);
+  f(a.box_half_m, b.box_half_m);
+  f(a.inverse_mass_per_kg, b.inverse_mass_per_kg);
+  f(a.inverse_inertia_world, b.inverse_inertia_world);
+  f(a.local_contact_count, b.local_contact_count);
+  for (std::size_t c = 0; c < kMaxLocalContacts; ++c) visit_contact(a.local_contacts[c], b.local_contacts[c], f);
+}
+
+template <class A, class B, class F>
+void visit_frame_header(A& a, B& b, F&& f) {
+  f(a.frame_index, b.frame_index);
+  f(a.world_session, b.world_session);
+  f(a.endpoint, b.endpoint);
+  f(a.report_tick_applied, b.report_tick_applied);
+  f(a.report_session_applied, b.report_session_applied);
+  f(a.world_time_s, b.world_time_s);
+  f(a.world_period_s, b.world_period_s);
+  f(a.coupling, b.coupling);
+  f(a.plane_count, b.plane_count);
+  f(a.stiffness_Npm, b.stiffness_Npm);
+  f(a.damping_Nspm, b.damping_Nspm);
+  f(a.gravity_mps2, b.gravity_mps2);
+  f(a.world_substep_s, b.world_substep_s);
+  f(a.reach_radius_m, b.reach_radius_m);
+}
+
+template <class A, class B, class F>
+void visit_entry(A& a, B& b, F&& f) {
+  f(a.object_id, b.object_id);
+  f(a.epoch, b.epoch);
+  f(a.impulse_Ns, b.impulse_Ns);
+  f(a.angular_impulse_Nms, b.angular_impulse_Nms);
+  f(a.impulse_moment_Nss, b.impulse_moment_Nss);
+  f(a.angular_impulse_moment_Nmss, b.angular_impulse_moment_Nmss);
+  f(a.last_tick, b.last_tick);
+}
+
+template <class A, class B, class F>
+void visit_report_header(A& a, B& b, F&& f) {
+  f(a.tick, b.tick);
+  f(a.haptic_session, b.haptic_session);
+  f(a.endpoint, b.endpoint);
+  f(a.world_session, b.world_session);
+  f(a.haptic_time_s, b.haptic_time_s);
+  f(a.finger_m, b.finger_m);
+  f(a.finger_velocity_mps, b.finger_velocity_mps);
+  f(a.proxy_m, b.proxy_m);
+  f(a.force_N, b.force_N);
+  f(a.finger_valid, b.finger_valid);
+  f(a.entry_count, b.entry_count);
+  f(a.static_impulse_Ns, b.static_impulse_Ns);
+}
+
+}  // namespace impetus::fields

@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// Which transport carries the world link (DESIGN.md §2), as the daemons' --link flags choose it: shared memory on one
+// host (the default; lockstep and real time), or DDS across hosts (real time; common/link/dds).
+
+#include <cstdint>
+#include <string>
+
+namespace impetus {
+
+enum class LinkKind { shm, dds };
+
+// Where a DDS world link meets: a DDS domain (an id) and a partition (a name) within it. Worlds and controllers with
+// the same pair see each other, on this host or across the network; any other pair is invisible.
+struct DdsLinkOptions {
+  std::uint32_t domain_id = 0;
+  std::string partition = "impetus";
+};
+
+// Highest domain id: the RTPS port mapping (7400 + 250·domain + offsets) stays below 65536 up to 232.
+inline constexpr std::uint32_t kMaxDdsDomainId = 232;
+
+struct LinkOptions {
+  LinkKind kind = LinkKind::shm;
+  DdsLinkOptions dds;
+};
+
+}  // namespace impetus
