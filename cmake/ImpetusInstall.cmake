@@ -23,9 +23,9 @@ install(TARGETS ${exported_targets} impetus_warnings EXPORT ImpetusTargets
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/impetus)
 install(TARGETS world_manager haptic_controller spidar_sim RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 foreach(dir common world_manager haptic_controller spidar_sim loop)
-  # dds_codec.h needs the idlc-generated types, which are the transport's own and not installed.
+  # dds_codec.h and dds_entities.h need Cyclone's headers and the idlc-generated types, which the package does not ship.
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/impetus/${dir}
-          FILES_MATCHING PATTERN "*.h" PATTERN "dds_codec.h" EXCLUDE)
+          FILES_MATCHING PATTERN "*.h" PATTERN "dds_codec.h" EXCLUDE PATTERN "dds_entities.h" EXCLUDE)
 endforeach()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${IMPETUS_INSTALL_DATADIR}/scenes
         FILES_MATCHING PATTERN "*.json")

@@ -9,9 +9,11 @@ int main(int argc, char** argv) {
   using namespace impetus;
   view::ViewerOptions options;
   std::string web_dir;
-  CLI::App app{"viewer: watch an Impetus world in a browser. Attaches read-only to a running world (--shm) or replays "
+  CLI::App app{"viewer: watch an Impetus world in a browser. Attaches read-only to a running world (--shm on its host, or "
+               "--link dds from any host) or replays "
                "a finished trial (--replay), and serves a 3-D page at --listen."};
   add_shm_flag(app, options.shm);
+  add_link_flags(app, options.link);
   app.add_option("--replay", options.replay_dir, "replay a finished trial: its folder (scripts/run.sh --out DIR)")
       ->check(CLI::ExistingDirectory);
   app.add_option("--listen", options.listen, "HOST:PORT to serve the page on (port 0: any free port)")

@@ -13,8 +13,29 @@
 
 namespace impetus::view {
 
-LiveFeed::LiveFeed(std::string shm)
-    : shm_(std::move(shm)), scene_(std::make_unique<ViewScene>()), snapshot_(std::make_unique<WorldSnapshot>()) {}
+ViewReaderOpener shm_view_opener(const std::string& shm) {
+  return [shm]() -> std::unique_ptr<WorldViewReader> {
+    try {
+      auto reader = std::make_unique<ShmWorldViewReader>(shm);
+      // A segment left by a world that died: its successor will replace it.
+      if (!reader->world_alive()) return nullptr;
+      return reader;
+    } catch (const SegmentError& error) {
+      // Missing or under construction: the world has not started yet. Anything else (another build's layout) is
+      // worth saying.
+      if (error.transient()) return nullptr;
+      throw std::runtime_error(error.what());
+    }
+  };
+}
+
+LiveFeed::LiveFeed(const std::string& shm) : LiveFeed(shm, shm_view_opener(shm)) {}
+
+LiveFeed::LiveFeed(std::string where, ViewReaderOpener open)
+    : where_(std::move(where)),
+      open_(std::move(open)),
+      scene_(std::make_unique<ViewScene>()),
+      snapshot_(std::make_unique<WorldSnapshot>()) {}
 
 std::uint64_t LiveFeed::rejected() const { return rejected_before_ + (reader_ ? reader_->rejected() : 0); }
 
@@ -23,17 +44,13 @@ void LiveFeed::try_attach() {
   if (now_ns < next_attach_ns_) return;
   next_attach_ns_ = now_ns + 100'000'000;  // a world is looked for every 100 ms while there is none
   try {
-    reader_.emplace(shm_);
-    if (!reader_->world_alive()) {  // a segment left by a world that died: its successor will replace it
-      reader_.reset();
-      return;
-    }
-    std::fprintf(stderr, "viewer: attached to the world at '%s'\n", reader_->name().c_str());
+    reader_ = open_();
+    if (!reader_) return;
+    std::fprintf(stderr, "viewer: attached to the world at %s\n", reader_->name().c_str());
     last_problem_.clear();
-  } catch (const SegmentError& error) {
-    // Missing or under construction: the world has not started yet. Anything else (another build's layout) is said
-    // once, and looked for again in case the world is restarted with a matching build.
-    if (!error.transient() && last_problem_ != error.what()) {
+  } catch (const std::runtime_error& error) {
+    // Said once, and looked for again in case the world is restarted with a matching build.
+    if (last_problem_ != error.what()) {
       last_problem_ = error.what();
       std::fprintf(stderr, "viewer: %s\n", error.what());
     }
@@ -45,7 +62,7 @@ void LiveFeed::poll() {
   if (!reader_) return;
   if (reader_->read_scene(*scene_)) {
     have_scene_ = true;
-    scene_message_ = std::make_shared<const std::string>(scene_message(*scene_, shm_, std::nullopt));
+    scene_message_ = std::make_shared<const std::string>(scene_message(*scene_, where_, std::nullopt));
     ++scene_serial_;
   }
   if (have_scene_ && reader_->read_snapshot(*snapshot_) && snapshot_->body_count == scene_->body_count) {
@@ -56,7 +73,7 @@ void LiveFeed::poll() {
     ++snapshots_read_;
   }
   if (!reader_->world_alive()) {
-    std::fprintf(stderr, "viewer: the world at '%s' has left; waiting for one to start\n", reader_->name().c_str());
+    std::fprintf(stderr, "viewer: the world at %s has left; waiting for one to start\n", reader_->name().c_str());
     rejected_before_ += reader_->rejected();
     reader_.reset();
   }

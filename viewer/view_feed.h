@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Where a viewer's frames come from: a running world (LiveFeed, read-only shared memory) or a finished trial's logs
-// (ReplayFeed). The server calls a feed from its one thread only.
+// Where a viewer's frames come from: a running world (LiveFeed: read-only shared memory on the world's host, or DDS
+// from anywhere) or a finished trial's logs (ReplayFeed). The server calls a feed from its one thread only.
 
 #include "common/contract/world_view.h"
 #include "common/link/shm/shm_world_view.h"
@@ -10,6 +10,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -43,9 +44,18 @@ class ViewFeed {
   virtual double poll_period_s() const = 0;
 };
 
+// Opens a reader of a running world's view: nullptr while there is none yet (looked for again later); throws
+// std::runtime_error for a problem worth saying (said once, and looked for again in case it goes away).
+using ViewReaderOpener = std::function<std::unique_ptr<WorldViewReader>()>;
+// The world's view in shared memory "<shm>.view", on this host.
+ViewReaderOpener shm_view_opener(const std::string& shm);
+
 class LiveFeed final : public ViewFeed {
  public:
-  explicit LiveFeed(std::string shm);
+  // A world in shared memory.
+  explicit LiveFeed(const std::string& shm);
+  // Any world `open` finds; `where` names it on the page.
+  LiveFeed(std::string where, ViewReaderOpener open);
 
   void poll() override;
   std::shared_ptr<const std::string> scene() const override { return scene_message_; }
@@ -61,8 +71,9 @@ class LiveFeed final : public ViewFeed {
  private:
   void try_attach();
 
-  std::string shm_;
-  std::optional<ShmWorldViewReader> reader_;
+  std::string where_;
+  ViewReaderOpener open_;
+  std::unique_ptr<WorldViewReader> reader_;
   std::uint64_t rejected_before_ = 0;  // rejections counted by readers of worlds that left
   std::int64_t next_attach_ns_ = 0;
   std::string last_problem_;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "viewer/viewer_node.h"
 
+#include "common/link/dds/dds_world_view.h"
+
 #include "common/runtime/process.h"
 #include "viewer/view_feed.h"
 #include "viewer/view_server.h"
@@ -63,7 +65,15 @@ int ViewerNode::run() {
                  replay->replay().frame_count(), replay->replay().start_s(), replay->replay().end_s());
     feed = std::move(replay);
   } else {
-    auto live_feed = std::make_unique<LiveFeed>(options_.shm);
+    std::unique_ptr<LiveFeed> live_feed;
+    if (options_.link.kind == LinkKind::dds) {
+      const DdsLinkOptions dds = options_.link.dds;
+      live_feed = std::make_unique<LiveFeed>(describe(dds), [dds]() -> std::unique_ptr<WorldViewReader> {
+        return std::make_unique<DdsWorldViewReader>(dds);
+      });
+    } else {
+      live_feed = std::make_unique<LiveFeed>(options_.shm);
+    }
     live = live_feed.get();
     feed = std::move(live_feed);
   }
@@ -84,7 +94,10 @@ int ViewerNode::run() {
   const auto bound = server.local_endpoint();
   const std::string host = bound.address().is_v6() ? "[" + bound.address().to_string() + "]" : bound.address().to_string();
   std::printf("viewer: serving http://%s:%u/ (%s)\n", host.c_str(), static_cast<unsigned>(bound.port()),
-              options_.replay_dir.empty() ? ("live, world '" + options_.shm + "'").c_str()
+              options_.replay_dir.empty()
+                  ? (options_.link.kind == LinkKind::dds ? "live, world on " + describe(options_.link.dds)
+                                                         : "live, world '" + options_.shm + "'")
+                        .c_str()
                                           : ("replay of " + options_.replay_dir).c_str());
   std::fflush(stdout);
   server.start();

@@ -4,6 +4,8 @@
 // finished trial, and serves the page that shows it. It never writes anything the world, the haptic loop or the
 // device reads.
 
+#include "common/link/link_options.h"
+
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -12,6 +14,7 @@ namespace impetus::view {
 
 struct ViewerOptions {
   std::string shm = "impetus";   // live: the world's --shm name
+  LinkOptions link;              // live: shared memory on this host (shm), or DDS from any host (link.dds)
   std::string replay_dir;        // replay: a trial folder (run.sh --out); takes precedence over shm
   std::string listen = "127.0.0.1:8080";
   bool allow_remote = false;     // serve on an address other than loopback

@@ -3,8 +3,10 @@
 // and runs a WorldNode on it; writes the world half of summary.json at exit.
 
 #include "common/link/dds/dds_world_link.h"
+#include "common/link/dds/dds_world_view.h"
 #include "common/link/shm/shm_world_link.h"
 #include "common/link/shm/shm_world_view.h"
+#include "common/link/world_view_tee.h"
 #include "common/runtime/cli.h"
 #include "world_manager/engine/ode_runtime.h"
 #include "world_manager/world_node.h"
@@ -64,7 +66,15 @@ int main(int argc, char** argv) {
       link = std::move(server);
     }
     node.connect(*link);
-    ShmWorldViewPublisher view(shm);  // "<shm>.view": viewers attach to it read-only
+    // The world view: "<shm>.view" for viewers on this host (read-only), and over DDS too with --link dds.
+    ShmWorldViewPublisher shm_view(shm);
+    std::unique_ptr<DdsWorldViewPublisher> dds_view;
+    WorldViewTee view;
+    view.add(shm_view);
+    if (link_options.kind == LinkKind::dds) {
+      dds_view = std::make_unique<DdsWorldViewPublisher>(link_options.dds);
+      view.add(*dds_view);
+    }
     node.connect_view(view);
     const WorldLinkInfo info = node.link_info();
     std::fprintf(stderr, "world_manager: '%s', %zu objects, %.1f Hz, %s coupling, %s clock, link %s\n",

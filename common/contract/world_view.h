@@ -11,6 +11,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <type_traits>
 
 namespace impetus {
@@ -97,6 +98,22 @@ class WorldViewPublisher {
   virtual ~WorldViewPublisher() = default;
   virtual void publish_scene(const ViewScene& scene) = 0;
   virtual void publish_snapshot(const WorldSnapshot& snapshot) = 0;
+};
+
+// A viewer's end of the view link (one per viewer thread; not thread-safe).
+class WorldViewReader {
+ public:
+  virtual ~WorldViewReader() = default;
+  // The scene if it was (re)published since the last call and passed scene_problem(); false otherwise.
+  virtual bool read_scene(ViewScene& out) = 0;
+  // The newest snapshot if new since the last call and valid; false otherwise. Invalid ones are counted.
+  virtual bool read_snapshot(WorldSnapshot& out) = 0;
+  // False once the world this reader follows has exited: open another to follow a restarted world. A transport
+  // that follows whichever world publishes (DDS) says true.
+  virtual bool world_alive() const = 0;
+  virtual std::uint64_t rejected() const = 0;
+  // Where it reads from, for messages.
+  virtual const std::string& name() const = 0;
 };
 
 // Checks what a viewer read (it cannot trust a segment another process writes): counts within capacity, numbers

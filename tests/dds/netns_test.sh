@@ -12,7 +12,7 @@
 # 2. the link pulled down for longer than the DDS lease mid-press and brought back: the controller holds its last
 #    planes, the world drops the finger, and after the link returns the controller is served again, the totals still
 #    agree and the cube shows no burst;
-# 3. one world serves four controllers on the other host.
+# 3. one world serves four controllers on the other host, and a viewer there watches it (--link dds).
 # netem: the tap trial with 10 and 50 ms of one-way delay on the veth (tc netem on both ends): the world applies
 #    exactly what was rendered, and the cube's stop position is printed beside the in-process delay line's
 #    (docs/latency.md). Exits 77 where the kernel has no netem qdisc.
@@ -158,6 +158,9 @@ grep -q "is free again" "$dir/world.out" || fail "link down: the world never rel
 # 3. Four controllers on one world, pressing the cube's top near its corners.
 dir="$out/four"; mkdir -p "$dir"
 start_world "$dir"
+ip netns exec "$hands_ns" "$build/viewer/viewer" "${link[@]:2}" --listen 127.0.0.1:0 --duration 6 \
+  >"$dir/viewer.out" 2>"$dir/viewer.err" &
+viewer=$!; pids+=("$viewer")
 devices=() haptics=()
 for user in a b c d; do
   case "$user" in a) x=0.015 y=-0.012 ;; b) x=0.045 y=-0.012 ;; c) x=0.015 y=0.012 ;; d) x=0.045 y=0.012 ;; esac
@@ -168,4 +171,7 @@ for pid in "${devices[@]}"; do wait "$pid" || fail "four: a spidar_sim exited wi
 for pid in "${haptics[@]}"; do stop "$pid" "four: a haptic_controller"; done
 stop "$world" "four: world_manager"
 check_ledger "$dir" a b c d || fail "four controllers: the ledger disagrees"
+wait "$viewer" || fail "four: the viewer exited with status $?"
+grep -q "attached to the world at DDS domain 0 partition '$tag'" "$dir/viewer.err" ||
+  fail "four: the viewer on the other host never saw the world: $(cat "$dir/viewer.err")"
 echo "netns_test: passed"

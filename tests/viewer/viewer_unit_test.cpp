@@ -2,6 +2,7 @@
 // The viewer's parts without a browser: what the world publishes for it, the frame encoding, which files it serves,
 // its listen address, and reading a trial back.
 
+#include "common/link/dds/dds_world_view.h"
 #include "common/link/shm/shm_world_view.h"
 #include "viewer/replay.h"
 #include "viewer/view_feed.h"
@@ -18,8 +19,10 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <thread>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -85,6 +88,50 @@ TEST_CASE("the world's snapshot carries every body's pose and the finger, the sh
   CHECK(read->endpoints[0].endpoint == 3);
   CHECK(read->endpoints[0].force_N == Vec3{1.0, 2.0, 3.0});
   CHECK(reader.rejected() == 0);
+}
+
+TEST_CASE("over DDS a live feed shows a world publishing in its partition, every body and every plane whole") {
+  init_ode_once();
+  const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/stack.json");
+  World world(scene, WorldOptions{});
+  HapticReport report{};
+  report.finger_valid = 1;
+  report.finger_m = {0.03, 0.0, 0.21};  // 1 cm above the top box
+  report.proxy_m = report.finger_m;
+  for (int step = 0; step < 3; ++step) world.step(&report);
+
+  DdsLinkOptions dds;
+  dds.partition = "impetus_test_view_" + std::to_string(getpid());
+  DdsWorldViewPublisher publisher(dds);
+  auto described = std::make_unique<ViewScene>();
+  describe_scene(scene, Coupling::local, 20.0, 1, *described);
+  auto snapshot = std::make_unique<WorldSnapshot>();
+  take_snapshot(world, &report, LoopStats{}, nullptr, *snapshot);
+  REQUIRE(snapshot->body_count == scene.objects.size());
+  REQUIRE(snapshot->endpoint_count == 1);
+  REQUIRE(snapshot->endpoints[0].plane_count > 0);
+  publisher.publish_scene(*described);  // before the viewer exists: transient local, it still gets it
+
+  view::LiveFeed feed(describe(dds), [dds]() -> std::unique_ptr<WorldViewReader> {
+    return std::make_unique<DdsWorldViewReader>(dds);
+  });
+  // Snapshots are best effort: keep publishing, as a world does every step, until one is shown.
+  view::Playback playback;
+  std::shared_ptr<const std::string> frame;
+  for (int attempt = 0; attempt < 400 && frame == nullptr; ++attempt) {
+    publisher.publish_snapshot(*snapshot);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    feed.poll();
+    frame = feed.next_frame(playback, 0.0);
+  }
+  REQUIRE(feed.scene() != nullptr);
+  CHECK(feed.scene()->find(scene.objects[0].name) != std::string::npos);
+  REQUIRE(frame != nullptr);
+  // The frame the page gets is the one a shared-memory viewer would get from the same snapshot.
+  std::string expected;
+  view::encode_frame(*snapshot, true, 1.0, expected);
+  CHECK(*frame == expected);
+  CHECK(feed.rejected() == 0);
 }
 
 TEST_CASE("a snapshot with a bad count, a non-finite pose or a non-unit quaternion is named, not used") {

@@ -109,4 +109,31 @@ bool from_dds(const impetus_dds_HapticReport& in, wire::HapticReport& out) {
   return true;
 }
 
+void to_dds(const LoopStats& in, impetus_dds_LoopStats& out) {
+  out.heartbeat_ns = in.heartbeat_ns;
+  out.pid = in.pid;
+  out.ticks = in.ticks;
+  out.skipped_periods = in.skipped_periods;
+  out.faults = in.faults;
+  out.rejected_frames = in.rejected_frames;
+  out.lateness_p50_ns = in.lateness_p50_ns;
+  out.lateness_p99_ns = in.lateness_p99_ns;
+  out.lateness_p999_ns = in.lateness_p999_ns;
+  out.lateness_max_ns = in.lateness_max_ns;
+}
+
+void from_dds(const impetus_dds_LoopStats& in, LoopStats& out) {
+  out = LoopStats{};
+  out.heartbeat_ns = in.heartbeat_ns;
+  out.pid = in.pid;
+  out.ticks = in.ticks;
+  out.skipped_periods = in.skipped_periods;
+  out.faults = in.faults;
+  out.rejected_frames = in.rejected_frames;
+  out.lateness_p50_ns = in.lateness_p50_ns;
+  out.lateness_p99_ns = in.lateness_p99_ns;
+  out.lateness_p999_ns = in.lateness_p999_ns;
+  out.lateness_max_ns = in.lateness_max_ns;
+}
+
 }  // namespace impetus

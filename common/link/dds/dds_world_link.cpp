@@ -2,6 +2,7 @@
 #include "common/link/dds/dds_world_link.h"
 
 #include "common/link/dds/dds_codec.h"
+#include "common/link/dds/dds_entities.h"
 #include "common/link/shm/seqlock.h"
 #include "common/runtime/process.h"
 
@@ -24,6 +25,7 @@ namespace {
 constexpr const char* kFrameTopic = "impetus_plane_frame";
 constexpr const char* kReportTopic = "impetus_haptic_report";
 constexpr const char* kInfoTopic = "impetus_world_info";
+constexpr const char* kStatsTopic = "impetus_haptic_stats";
 
 // The sender looks for a new report of each endpoint this often and publishes it: a quarter of the servo's period, so
 // a report leaves at most a quarter period after the servo wrote it (polling at the servo's own period would add a
@@ -35,53 +37,6 @@ constexpr double kReportRepeat_s = 0.1;
 constexpr dds_duration_t kReceiveWait = DDS_MSECS(100);
 // Samples taken per call: more than a world's endpoints' frames in one period.
 constexpr std::uint32_t kTakeBatch = 16;
-
-struct Qos {
-  dds_qos_t* qos = dds_create_qos();
-  ~Qos() { dds_delete_qos(qos); }
-};
-
-// Publisher and subscriber QoS: the partition is what separates worlds sharing a domain.
-dds_entity_t make_publisher(dds_entity_t participant, const std::string& partition) {
-  Qos qos;
-  dds_qset_partition1(qos.qos, partition.c_str());
-  return dds_check(dds_create_publisher(participant, qos.qos, nullptr), "cannot create a DDS publisher");
-}
-dds_entity_t make_subscriber(dds_entity_t participant, const std::string& partition) {
-  Qos qos;
-  dds_qset_partition1(qos.qos, partition.c_str());
-  return dds_check(dds_create_subscriber(participant, qos.qos, nullptr), "cannot create a DDS subscriber");
-}
-
-enum class Delivery { best_effort, reliable, reliable_durable };
-
-// Frames best effort (the next step's frame replaces a lost one), reports reliable, the info reliable and transient
-// local (a late joiner reads it at once); keep last 1 everywhere: only the newest of each matters.
-void set_delivery(dds_qos_t* qos, Delivery delivery) {
-  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-  if (delivery == Delivery::best_effort) {
-    dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
-  } else {
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(10));
-  }
-  dds_qset_durability(qos, delivery == Delivery::reliable_durable ? DDS_DURABILITY_TRANSIENT_LOCAL
-                                                                    : DDS_DURABILITY_VOLATILE);
-}
-
-dds_entity_t make_topic(dds_entity_t participant, const dds_topic_descriptor_t* type, const char* name) {
-  return dds_check(dds_create_topic(participant, type, name, nullptr, nullptr),
-                   std::string("cannot create DDS topic ") + name);
-}
-dds_entity_t make_writer(dds_entity_t publisher, dds_entity_t topic, Delivery delivery) {
-  Qos qos;
-  set_delivery(qos.qos, delivery);
-  return dds_check(dds_create_writer(publisher, topic, qos.qos, nullptr), "cannot create a DDS writer");
-}
-dds_entity_t make_reader(dds_entity_t subscriber, dds_entity_t topic, Delivery delivery) {
-  Qos qos;
-  set_delivery(qos.qos, delivery);
-  return dds_check(dds_create_reader(subscriber, topic, qos.qos, nullptr), "cannot create a DDS reader");
-}
 
 using Key = std::pair<std::uint64_t, std::uint32_t>;  // (client id, client endpoint)
 
@@ -95,6 +50,8 @@ struct DdsWorldLinkServer::State {
     Key key{0, 0};  // client id 0: free
     HapticReport latest{};
     bool have = false;
+    LoopStats stats{};
+    bool have_stats = false;
   };
 
   State(const DdsLinkOptions& options, const WorldLinkInfo& link_info)
@@ -107,6 +64,8 @@ struct DdsWorldLinkServer::State {
         subscriber, make_topic(participant.handle(), &impetus_dds_HapticReport_desc, kReportTopic), Delivery::reliable);
     info_writer = make_writer(publisher, make_topic(participant.handle(), &impetus_dds_WorldInfo_desc, kInfoTopic),
                               Delivery::reliable_durable);
+    stats_reader = make_reader(
+        subscriber, make_topic(participant.handle(), &impetus_dds_HapticStats_desc, kStatsTopic), Delivery::best_effort);
     for (std::uint32_t k = 0; k < kTakeBatch; ++k) buffers[k] = &*samples[k];
     publish_info();
   }
@@ -137,7 +96,7 @@ struct DdsWorldLinkServer::State {
   int take_slot(const Key& key) {
     for (std::uint32_t k = 0; k < kMaxEndpoints; ++k) {
       if (slots[k].key.first == 0) {
-        slots[k] = Slot{key, HapticReport{}, false};
+        slots[k] = Slot{key, HapticReport{}, false, LoopStats{}, false};
         std::fprintf(stderr, "world_manager: endpoint slot %u serves controller %016llx, its endpoint %u\n", k,
                      static_cast<unsigned long long>(key.first), key.second);
         publish_info();
@@ -188,12 +147,29 @@ struct DdsWorldLinkServer::State {
     }
   }
 
+  // The newest loop statistics of each controller, by client id, into the slots it holds.
+  void take_stats() {
+    impetus_dds_HapticStats sample{};
+    void* buffer = &sample;
+    dds_sample_info_t sample_info{};
+    while (dds_take(stats_reader, &buffer, &sample_info, 1, 1) > 0) {
+      if (!sample_info.valid_data) continue;
+      for (Slot& slot : slots) {
+        if (slot.key.first == sample.client_id) {
+          from_dds(sample.stats, slot.stats);
+          slot.have_stats = true;
+        }
+      }
+    }
+  }
+
   DdsParticipant participant;
   WorldLinkInfo info;
   std::uint64_t world_id;
   dds_entity_t frame_writer = 0;
   dds_entity_t report_reader = 0;
   dds_entity_t info_writer = 0;
+  dds_entity_t stats_reader = 0;
   std::array<Slot, kMaxEndpoints> slots{};
   std::array<DdsReportSample, kTakeBatch> samples;
   std::array<void*, kTakeBatch> buffers{};
@@ -235,6 +211,14 @@ void DdsWorldLinkServer::publish_frame(std::uint32_t slot, const PlaneFrame& fra
   dds_write(state.frame_writer, &*state.frame_sample);
 }
 
+bool DdsWorldLinkServer::latest_haptic_stats(std::uint32_t slot, LoopStats& out) {
+  if (slot >= kMaxEndpoints) return false;
+  state_->take_stats();
+  if (!state_->slots[slot].have_stats) return false;
+  out = state_->slots[slot].stats;
+  return true;
+}
+
 std::uint64_t DdsWorldLinkServer::rejected_reports() const { return state_->rejected; }
 std::uint64_t DdsWorldLinkServer::refused_endpoints() const { return state_->refused_keys.size(); }
 std::uint64_t DdsWorldLinkServer::released_slots() const { return state_->released; }
@@ -254,6 +238,8 @@ struct DdsWorldLinkClient::State {
         publisher, make_topic(participant.handle(), &impetus_dds_HapticReport_desc, kReportTopic), Delivery::reliable);
     info_reader = make_reader(subscriber, make_topic(participant.handle(), &impetus_dds_WorldInfo_desc, kInfoTopic),
                               Delivery::reliable_durable);
+    stats_writer = make_writer(
+        publisher, make_topic(participant.handle(), &impetus_dds_HapticStats_desc, kStatsTopic), Delivery::best_effort);
     waitset = dds_check(dds_create_waitset(participant.handle()), "cannot create a DDS waitset");
     wake = dds_check(dds_create_guardcondition(participant.handle()), "cannot create a DDS guard condition");
     dds_check(dds_set_status_mask(frame_reader, DDS_DATA_AVAILABLE_STATUS), "DDS status mask");
@@ -349,6 +335,7 @@ struct DdsWorldLinkClient::State {
   void send() {
     std::array<std::uint64_t, kMaxEndpoints> last_sequence{};
     std::array<std::chrono::steady_clock::time_point, kMaxEndpoints> last_sent{};
+    std::uint64_t stats_sequence = 0;
     auto next = std::chrono::steady_clock::now();
     while (!stop.load()) {
       next += kSendPeriod;
@@ -363,6 +350,11 @@ struct DdsWorldLinkClient::State {
         if (dds_write(report_writer, &*send_sample) >= 0) sent.fetch_add(1);
         last_sent[k] = now;
       }
+      if (stats.try_read(sent_stats.stats_local, stats_sequence)) {
+        sent_stats.sample.client_id = client_id;
+        to_dds(sent_stats.stats_local, sent_stats.sample.stats);
+        dds_write(stats_writer, &sent_stats.sample);
+      }
     }
   }
 
@@ -372,12 +364,14 @@ struct DdsWorldLinkClient::State {
   dds_entity_t frame_reader = 0;
   dds_entity_t report_writer = 0;
   dds_entity_t info_reader = 0;
+  dds_entity_t stats_writer = 0;
   dds_entity_t waitset = 0;
   dds_entity_t wake = 0;
 
   // World → servo and servo → world, one channel per endpoint (~30 KB and ~8 KB each: on the heap with the state).
   std::array<SeqlockChannel<wire::PlaneFrame>, kMaxEndpoints> frames;
   std::array<SeqlockChannel<wire::HapticReport>, kMaxEndpoints> reports;
+  SeqlockChannel<LoopStats> stats;  // the controller's loop statistics, now and then
 
   // Servo thread.
   wire::PlaneFrame frame_wire{};
@@ -395,6 +389,10 @@ struct DdsWorldLinkClient::State {
   // Sender thread.
   std::array<wire::HapticReport, kMaxEndpoints> sent_wire{};
   DdsReportSample send_sample;
+  struct {
+    LoopStats stats_local{};
+    impetus_dds_HapticStats sample{};
+  } sent_stats;
   std::atomic<std::uint64_t> sent{0};
 
   // The world's info (written by the receiver; info is read by the constructor before the servo starts).
@@ -473,6 +471,8 @@ bool DdsWorldLinkClient::receive_frame(EndpointId endpoint, PlaneFrame& out) {
   }
   return true;
 }
+
+void DdsWorldLinkClient::publish_stats(const LoopStats& stats) { state_->stats.write(stats); }
 
 void DdsWorldLinkClient::publish_report(const HapticReport& report) {
   State& state = *state_;

@@ -35,6 +35,7 @@ class DdsWorldLinkServer final : public WorldLinkServer {
   bool latest_report(std::uint32_t slot, HapticReport& out) override;
   void publish_frame(std::uint32_t slot, const PlaneFrame& frame) override;
   void publish_stats(const LoopStats&) override {}
+  bool latest_haptic_stats(std::uint32_t slot, LoopStats& out) override;
   TurnResult wait_turn() override { return TurnResult::shutdown; }  // real time only
   void finish_turn() override {}
   std::uint64_t rejected_reports() const override;
@@ -62,7 +63,8 @@ class DdsWorldLinkClient final : public WorldLinkClient {
   std::uint32_t endpoints() const override;
   bool receive_frame(EndpointId endpoint, PlaneFrame& out) override;
   void publish_report(const HapticReport& report) override;
-  void publish_stats(const LoopStats&) override {}
+  // To the world (for its viewers), through the sender thread: a seqlock write here.
+  void publish_stats(const LoopStats& stats) override;
   bool step_world(std::uint64_t) override { return false; }  // real time only
   void end_session() override {}
   bool world_alive() const override;

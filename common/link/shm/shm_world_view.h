@@ -25,19 +25,17 @@ class ShmWorldViewPublisher final : public WorldViewPublisher {
 };
 
 // A viewer's read-only end. Not thread-safe; one per viewer thread.
-class ShmWorldViewReader {
+class ShmWorldViewReader final : public WorldViewReader {
  public:
   // Opens "<shm>.view" read-only; throws SegmentError (missing: the world has not started or has left).
   explicit ShmWorldViewReader(const std::string& shm);
 
-  // The scene if it was (re)published since the last call and passed scene_problem(); false otherwise.
-  bool read_scene(ViewScene& out);
-  // The newest snapshot if new since the last call and valid; false otherwise. Invalid ones are counted.
-  bool read_snapshot(WorldSnapshot& out);
+  bool read_scene(ViewScene& out) override;
+  bool read_snapshot(WorldSnapshot& out) override;
   // False once the world that created the segment has exited: open it again to follow a restarted world.
-  bool world_alive() const { return segment_.creator_alive(); }
-  std::uint64_t rejected() const { return rejected_; }
-  const std::string& name() const { return segment_.name(); }
+  bool world_alive() const override { return segment_.creator_alive(); }
+  std::uint64_t rejected() const override { return rejected_; }
+  const std::string& name() const override { return segment_.name(); }
 
  private:
   ReadOnlySegment<WorldViewLayout> segment_;
