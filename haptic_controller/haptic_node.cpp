@@ -140,12 +140,13 @@ bool HapticNode::lockstep_tick(std::uint64_t t) {
   const double now_s = static_cast<double>(t) * period_s_;
   tick(t, now_s, period_s_, 0);
   world_.lead_followers(t);  // other controllers on this world take tick t too, before the world steps
-  if (schedule_->world_step_due(t)) {
-    if (world_.step_world(t)) {
-      receive_frames(now_s);
-    } else {
-      world_lost_ = true;
-    }
+  // Frames are taken after every tick, not only after a step: a link with a delay line (the in-process link of a
+  // latency experiment) hands a frame over d ticks after the step that sent it, whichever tick that is. Without a
+  // delay nothing new arrives between steps, so the trial is the same.
+  if (schedule_->world_step_due(t) && !world_.step_world(t)) {
+    world_lost_ = true;
+  } else {
+    receive_frames(now_s);
   }
   if (t % kStatsEveryTicks == 0) publish_stats(nullptr);
   return true;

@@ -4,6 +4,7 @@
 #include "common/link/inproc/inproc_device_port.h"
 #include "common/link/inproc/inproc_world_link.h"
 #include "common/runtime/cli.h"
+#include "common/runtime/lockstep_schedule.h"
 #include "common/runtime/log_paths.h"
 #include "haptic_controller/device/finger_set.h"
 #include "haptic_controller/device/spidar_driver.h"
@@ -58,6 +59,13 @@ void check_options(const InProcessTrialOptions& options) {
     check_option("damping_Nspm", options.damping_Nspm, number_in(0.0, limits::kMaxDamping_Nspm));
   }
   if (options.duration_s != 0.0) check_option("duration_s", options.duration_s, positive_number(kMaxFlagSeconds));
+  // Written out rather than through a flag's validator: no daemon flag mirrors it, and the message names the unit.
+  if (!(options.link_delay_s >= 0.0 && options.link_delay_s <= kMaxLinkDelay_s)) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.17g", options.link_delay_s);
+    throw std::invalid_argument(std::string("link_delay_s: the link's one-way delay must be between 0 and ") +
+                                std::to_string(static_cast<int>(kMaxLinkDelay_s)) + " s, not " + text);
+  }
 }
 
 // One user: a haptic node and its device, a SPIDAR string set, port and simulated finger per finger.
@@ -120,7 +128,13 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   world_options.phase_ticks = options.phase_ticks;
   world_options.log_path = log_path(options.out_dir, "world.csv");
   WorldNode world(world_options);
-  InProcessWorldLink world_link(world.link_info());
+  const HapticNodeOptions haptic_defaults;  // every controller runs at the default rate
+  InProcessLinkDelay link_delay;
+  // The delay in whole haptic ticks, to the nearest: the lockstep schedule has no time between two ticks.
+  link_delay.delay_ticks = static_cast<std::uint64_t>(std::llround(options.link_delay_s * haptic_defaults.rate_hz));
+  link_delay.ticks_per_world_step =
+      LockstepSchedule::ticks_per_world_step(world.link_info().world_period_s, haptic_defaults.rate_hz);
+  InProcessWorldLink world_link(world.link_info(), link_delay);
   world.connect(world_link);
   world_link.connect(world);
 
@@ -160,6 +174,11 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   for (std::size_t u = 1; u < users.size(); ++u) users[u]->haptic->run();  // their session is over: they finish
   nlohmann::json summary = world.summary();
   summary.update(users[0]->summary());
+  summary["link"] = {
+      {"delay_s", static_cast<double>(link_delay.delay_ticks) / haptic_defaults.rate_hz},
+      {"delay_ticks", link_delay.delay_ticks},
+      {"dropped", world_link.dropped()},
+  };
   if (users.size() > 1) {
     nlohmann::json followers = nlohmann::json::array();
     for (std::size_t u = 1; u < users.size(); ++u) followers.push_back(users[u]->summary());

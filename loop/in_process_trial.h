@@ -20,6 +20,10 @@
 
 namespace impetus {
 
+// The longest link delay a trial takes: a second each way is beyond any network a haptic user would put up with, and
+// keeps the delay line's reports (one per tick) to a thousand per finger at 1 kHz.
+inline constexpr double kMaxLinkDelay_s = 1.0;
+
 struct InProcessTrialOptions {
   std::string scene_path;  // a scene file (world_manager/scene.h)
   std::string trajectory;  // a trajectory CSV file or a built-in spec, as spidar_sim --trajectory takes
@@ -38,11 +42,18 @@ struct InProcessTrialOptions {
   double stiffness_Npm = std::numeric_limits<double>::quiet_NaN();  // haptic_controller --stiffness; NaN: the scene's
   double damping_Nspm = std::numeric_limits<double>::quiet_NaN();   // haptic_controller --damping; NaN: the scene's
   double duration_s = 0.0;  // haptic_controller --duration: the longest trial in seconds; 0: the whole trajectory
+  // One-way delay of the world link, the same both ways, in seconds: 0 (none) to kMaxLinkDelay_s, rounded to the
+  // nearest whole haptic tick (a delay below half a tick is none). Frames reach the haptic side and reports the world
+  // that many ticks late (common/link/inproc/inproc_world_link.h says exactly when); summary.json's "link" records
+  // it. For latency experiments: the daemons' links (shared memory, DDS) have no delay line, so no flag mirrors it.
+  double link_delay_s = 0.0;
   // world.csv, haptic.csv and device.csv are written here when it is not empty; nothing is written otherwise.
   std::filesystem::path out_dir;
 };
 
-// Runs the trial to the end of its trajectory; returns the world, haptic and device halves of summary.json merged.
+// Runs the trial to the end of its trajectory; returns the world, haptic and device halves of summary.json merged,
+// and "link": {"delay_s", "delay_ticks", "dropped"} (the delay applied, in seconds and whole ticks, and entries its
+// delay line dropped: always 0 unless a node stopped taking its frames).
 // Thread-safe: concurrent calls run one after another (ODE's state is process-wide); for trials in parallel use
 // processes. Nothing else in the process may step an ODE world meanwhile.
 // Throws std::invalid_argument for an option out of its range (naming the option, the value and the range) and

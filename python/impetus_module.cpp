@@ -33,8 +33,8 @@ impetus::Coupling parse_coupling(const std::string& name) {
 std::string run_trial(const std::string& scene, const std::string& trajectory, const std::vector<std::string>& fingers,
                       const std::string& coupling,
                       std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
-                      std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm, double duration_s,
-                      const std::string& out_dir) {
+                      std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm, double link_delay_s,
+                      double duration_s, const std::string& out_dir) {
   impetus::InProcessTrialOptions options;
   options.scene_path = scene;
   options.trajectory = trajectory;
@@ -45,6 +45,7 @@ std::string run_trial(const std::string& scene, const std::string& trajectory, c
   options.substeps = substeps;
   if (stiffness_Npm) options.stiffness_Npm = *stiffness_Npm;
   if (damping_Nspm) options.damping_Nspm = *damping_Nspm;
+  options.link_delay_s = link_delay_s;
   options.duration_s = duration_s;
   options.out_dir = out_dir;
   std::string text;
@@ -100,6 +101,6 @@ PYBIND11_MODULE(_impetus, module) {
   module.doc() = "Impetus' compiled core; use the impetus package, not this module.";
   module.def("run_trial", &run_trial, py::arg("scene"), py::arg("trajectory"), py::arg("fingers"), py::arg("coupling"),
              py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("stiffness_Npm"),
-             py::arg("damping_Nspm"), py::arg("duration_s"), py::arg("out_dir"));
+             py::arg("damping_Nspm"), py::arg("link_delay_s"), py::arg("duration_s"), py::arg("out_dir"));
   module.def("read_log", &read_log, py::arg("path"));
 }

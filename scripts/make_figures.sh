@@ -21,6 +21,10 @@ cp out/figures/tap_task/tap_task.md docs/tap_task.md
 /usr/bin/python3 scripts/grasp_figure.py --out out/figures/grasp
 cp out/figures/grasp/grasp.png docs/grasp.png
 cp out/figures/grasp/grasp.md docs/grasp.md
+# One-way delay on the world link: the tap under each coupling and the grasp, in-process (docs/latency.md).
+/usr/bin/python3 scripts/latency_experiment.py --out out/figures/latency
+cp out/figures/latency/latency.png docs/latency.png
+cp out/figures/latency/latency.md docs/latency_table.md
 # The viewer replaying a lockstep tap trial at its hardest push, in headless Chromium (the browser test's replay case
 # takes the picture).
 bash scripts/deps.sh --browser

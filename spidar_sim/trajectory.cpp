@@ -490,9 +490,11 @@ Trajectory make_tap(const BuiltinParams& p, const std::string& spec) {
   const double y = p.number("y", 0.0, Range::any, "m");
   const double standoff = p.number("standoff", 0.03, Range::positive, "m");
   const double hold = p.number("hold", 1.5, Range::non_negative, "s");
+  const double rest = p.number("rest", 0.0, Range::non_negative, "s");
 
   const Eigen::Vector3d start(face_x - standoff, y, height);
   PathBuilder path(start);
+  if (rest > 0.0) path.hold(rest);  // no segment at all for 0: the default tap is the tap it always was
   path.strike(Eigen::Vector3d::UnitX(), standoff, depth, speed);
   // Withdraw with s = (1 − cos πτ)/2, whose peak speed is π·distance/(2·duration): choose the duration so it is `speed`.
   const double withdraw_m = standoff + depth;
@@ -575,7 +577,7 @@ struct Builtin {
 
 const std::array<Builtin, 4>& builtins() {
   static const std::array<Builtin, 4> table{{
-      {"tap", {"speed", "depth", "height", "face_x", "y", "standoff", "hold"}, &make_tap},
+      {"tap", {"speed", "depth", "height", "face_x", "y", "standoff", "hold", "rest"}, &make_tap},
       {"press", {"x", "y", "surface_z", "depth", "standoff", "speed", "hold"}, &make_press},
       {"slide",
        {"x", "y", "surface_z", "depth", "standoff", "press_speed", "settle", "distance", "speed", "hold"},

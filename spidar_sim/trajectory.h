@@ -19,7 +19,8 @@
 // starts at rest on the target can follow them without an initial jolt.
 //
 //   tap     The paper's task: strike the −x face of a cube along +x, push past it, withdraw, hold.
-//           The finger starts at rest at (face_x − standoff, y, height), accelerates over the first half of the
+//           The finger starts at rest at (face_x − standoff, y, height), waits there for `rest`, accelerates over the
+//           first half of the
 //           standoff to `speed`, meets the face's rest position at `speed`, decelerates to rest `depth` past it
 //           (x = face_x + depth; the cube gives way, so the real penetration is much smaller), withdraws back to the
 //           start with a smooth (cosine) profile whose peak speed is `speed`, and holds there for `hold`.
@@ -32,6 +33,8 @@
 //             y        = 0      m    y of the strike
 //             standoff = 0.03   m    start distance in front of the face               (> 0)
 //             hold     = 1.5    s    time held at the start after withdrawing, so the cube can come to rest (>= 0)
+//             rest     = 0      s    time at rest at the start before the stroke, e.g. for a delayed world link
+//                                    to bring the first frames before the finger moves (>= 0)
 //
 //   press   Down onto a horizontal surface and hold below it.
 //           Starts at rest at (x, y, surface_z + standoff), accelerates over the first half of the standoff to

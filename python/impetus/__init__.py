@@ -91,7 +91,7 @@ def read_log(path):
 
 
 def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_ticks=0, substeps=None,
-              stiffness_Npm=None, damping_Nspm=None, duration_s=60.0, out_dir=None, logs=True):
+              stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, duration_s=60.0, out_dir=None, logs=True):
     """Runs one trial and returns its Trial.
 
     scene          a scene file (str or path; shipped_scene("tap") for a shipped one)
@@ -105,6 +105,9 @@ def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_tick
     substeps       ODE steps per world period (world_manager --substeps); None: the scene's
     stiffness_Npm, damping_Nspm   the contact spring and damper (haptic_controller --stiffness, --damping); None:
                    the scene's
+    link_delay_s   a one-way delay of the world link, the same both ways, 0 to 1 s, rounded to the nearest whole
+                   haptic tick: frames reach the haptic side and reports reach the world that much later (latency
+                   experiments; the daemons have no delay line). summary["link"] records it.
     duration_s     the longest trial; it ends earlier when the trajectory does (run.sh --duration, default 60)
     out_dir        a directory for world.csv, haptic.csv, device.csv and summary.json, created if missing; None: a
                    temporary one, removed before returning
@@ -128,7 +131,7 @@ def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_tick
         fingers = [f"{name}={path}" for name, path in trajectory.items()] if isinstance(trajectory, dict) else []
         summary = json.loads(_impetus.run_trial(str(scene), "" if fingers else str(trajectory), fingers, coupling,
                                                 phase_ticks, rate_hz, substeps,
-                                                stiffness_Npm, damping_Nspm, float(duration_s),
+                                                stiffness_Npm, damping_Nspm, float(link_delay_s), float(duration_s),
                                                 str(directory) if (out_dir is not None or logs) else ""))
         # What run.sh adds to the daemons' config (impetus_py/summary.py): the trial's own arguments.
         trajectory_text = " ".join(fingers) if fingers else str(trajectory)

@@ -13,7 +13,9 @@ summarize_trial.py merge it from the daemons' own summaries; every other script 
                "tension_min_N", "tension_max_N", "max_force_N", ...},   spidar_sim
    "config":  {"scene", "coupling", "world_rate_hz", "substeps", "gravity_mps2", "phase_ticks", "clock", ...,
                                                                      world_manager
-               "trajectory", "rate", "substeps_override", "duration_s", "wall_time_s"}}  run.sh (strings but the last)
+               "trajectory", "rate", "substeps_override", "duration_s", "wall_time_s"},  run.sh (strings but the last)
+   "link":    {"delay_s", "delay_ticks", "dropped"}}                 in-process trials only (the impetus package):
+                                                                     the world link's delay line
 """
 import json
 import math
@@ -51,6 +53,7 @@ class Summary:
         self.haptic = document["haptic"]
         self.device = document["device"]
         self.config = document["config"]
+        self.link = document.get("link", {})  # in-process trials only
 
     @classmethod
     def read(cls, trial_dir):

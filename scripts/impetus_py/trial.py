@@ -53,23 +53,29 @@ def backend():
 
 
 def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=None, substeps=None,
-              stiffness_Npm=None, damping_Nspm=None):
+              stiffness_Npm=None, damping_Nspm=None, link_delay_s=None):
     """Runs one lockstep trial of `scene` (a path) driven by `trajectory` (a spidar_sim --trajectory spec or file, or
     a dict {finger name: spec or file} for a device of several fingers)
     into out_dir and returns its Summary. rate_hz, phase_ticks and substeps are world_manager's --rate, --phase and
     --substeps, stiffness_Npm and damping_Nspm haptic_controller's --stiffness and --damping (None: the scene's
-    values, phase 0). Raises RuntimeError naming the trial if it failed."""
+    values, phase 0). link_delay_s is the world link's one-way delay (s, both ways; None or 0: none): only the
+    in-process link has a delay line, so a nonzero delay needs the impetus package. Raises RuntimeError naming the
+    trial if it failed."""
     out_dir.mkdir(parents=True, exist_ok=True)
     module = _impetus_module()
     if module:
         try:
             trial = module.run_trial(scene, trajectory, coupling, rate_hz=rate_hz, phase_ticks=phase_ticks or 0,
                                      substeps=substeps, stiffness_Npm=stiffness_Npm, damping_Nspm=damping_Nspm,
-                                     out_dir=out_dir, logs=False)
+                                     link_delay_s=link_delay_s or 0.0, out_dir=out_dir, logs=False)
         except (ValueError, RuntimeError, OSError) as error:
             raise RuntimeError(f"trial failed ({scene}, {trajectory}, {coupling} coupling, rate {rate_hz}, "
-                               f"phase {phase_ticks}): {error}") from None
+                               f"phase {phase_ticks}, link delay {link_delay_s or 0.0} s): {error}") from None
         return Summary(trial.summary)
+    if link_delay_s:
+        raise RuntimeError(f"a link delay ({link_delay_s} s) needs the in-process link of the impetus package; the "
+                           f"daemons' links have no delay line (build the package, do not set "
+                           f"IMPETUS_TRIALS=processes)")
     # A dict {finger name: trajectory} is a device of several fingers (run.sh --finger NAME=SPEC each).
     fingers = [["--finger", f"{name}={each}"] for name, each in trajectory.items()] if isinstance(trajectory, dict) \
         else [["--trajectory", str(trajectory)]]

@@ -87,12 +87,23 @@ class Arguments(unittest.TestCase):
         self.assertEqual(base.logs, {})
         self.assertIsNone(base.out_dir)
 
+    def test_link_delay_reaches_the_link(self):
+        # 20 ms each way at 1 kHz is 20 ticks; the delay changes the trial (the cube starts later and stops elsewhere),
+        # and the summary says what the link held back.
+        base = impetus.run_trial(self.scene(), "tap", logs=False)
+        delayed = impetus.run_trial(self.scene(), "tap", link_delay_s=0.02, logs=False)
+        self.assertEqual(base.summary["link"], {"delay_s": 0.0, "delay_ticks": 0, "dropped": 0})
+        self.assertEqual(delayed.summary["link"]["delay_ticks"], 20)
+        self.assertEqual(delayed.summary["link"]["dropped"], 0)
+        self.assertNotEqual(base.summary["objects"], delayed.summary["objects"])
+
     def test_out_of_range_values_name_the_argument(self):
         cases = [(dict(rate_hz=1e300), "world_rate_hz"), (dict(rate_hz=math.nan), "world_rate_hz"),
                  (dict(substeps=0), "substeps"), (dict(stiffness_Npm=-5.0), "stiffness_Npm"),
                  (dict(damping_Nspm=1e9), "damping_Nspm"), (dict(duration_s=math.inf), "duration_s"),
                  (dict(phase_ticks=50), "phase"), (dict(phase_ticks=-1), "phase_ticks"),
-                 (dict(coupling="springy"), "coupling")]
+                 (dict(coupling="springy"), "coupling"), (dict(link_delay_s=1.5), "link_delay_s"),
+                 (dict(link_delay_s=-0.001), "link_delay_s"), (dict(link_delay_s=math.nan), "link_delay_s")]
         for kwargs, name in cases:
             with self.subTest(**{k: str(v) for k, v in kwargs.items()}):
                 with self.assertRaises(ValueError) as raised:

@@ -105,6 +105,19 @@ TEST_CASE("tap parameters move the start, peak and hold") {
   check_smooth(tap);
 }
 
+TEST_CASE("a tap with a rest waits at its start, then strikes as the tap without one") {
+  const Trajectory tap = load_trajectory("tap");
+  const Trajectory rested = load_trajectory("tap:rest=0.25");
+  CHECK(rested.duration_s() == Approx(tap.duration_s() + 0.25).epsilon(1e-12));
+  for (double t = 0.0; t <= 0.25; t += 0.01) check_vec(at(rested, t), at(tap, 0.0));
+  CHECK(velocity(rested, 0.1).norm() == 0.0);
+  for (double t = 0.0; t <= tap.duration_s(); t += 0.001) {
+    INFO("t = " << t);
+    CHECK((at(rested, t + 0.25) - at(tap, t)).norm() < 1e-9);
+  }
+  check_smooth(rested);
+}
+
 TEST_CASE("the documented example spec loads") {
   const Trajectory tap = load_trajectory("tap:speed=0.5,depth=0.035,height=0.025");
   CHECK(tap.description() == "tap:speed=0.5,depth=0.035,height=0.025");
@@ -176,7 +189,7 @@ TEST_CASE("circle: stays on the circle, full-speed laps take a period, starts an
 
 TEST_CASE("every built-in parameter rejects a non-number, naming the key and the value") {
   const std::vector<std::pair<std::string, std::vector<std::string>>> builtins = {
-      {"tap", {"speed", "depth", "height", "face_x", "y", "standoff", "hold"}},
+      {"tap", {"speed", "depth", "height", "face_x", "y", "standoff", "hold", "rest"}},
       {"press", {"x", "y", "surface_z", "depth", "standoff", "speed", "hold"}},
       {"slide", {"x", "y", "surface_z", "depth", "standoff", "press_speed", "settle", "distance", "speed", "hold"}},
       {"circle", {"radius", "period", "cx", "cy", "cz", "turns"}},
@@ -202,7 +215,7 @@ TEST_CASE("built-in parameter errors name the key and the value") {
   CHECK(error_of("circle:radius=0") == "circle: radius='0': must be > 0 (m)");
   CHECK(error_of("circle:plane=xw") == "circle: plane='xw': must be one of xy, xz, yz");
   CHECK(error_of("tap:sped=0.5") ==
-        "tap: unknown parameter 'sped' (value '0.5'); known: speed, depth, height, face_x, y, standoff, hold");
+        "tap: unknown parameter 'sped' (value '0.5'); known: speed, depth, height, face_x, y, standoff, hold, rest");
   CHECK(error_of("tap:speed=0.5,speed=0.6") == "tap: parameter 'speed' given twice (value '0.6')");
   CHECK(error_of("tap:speed") == "tap: parameter 'speed' has no value (expected key=value)");
   CHECK(error_of("tap:speed=0.5,,depth=0.01") == "tap: empty parameter in 'speed=0.5,,depth=0.01'");

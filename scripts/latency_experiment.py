@@ -1,0 +1,393 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
+"""Latency tolerance of the couplings: the tap and the grasp with a one-way delay on the world link.
+
+Every trial runs in this process through the impetus package (in-process link with its delay line: frames and reports
+each arrive DELAY later, rounded to whole haptic ticks; common/link/inproc/inproc_world_link.h). The three daemons
+have no delay line, so the package must be built (scripts/build.sh).
+
+  tap    scenes/tap.json, trajectory tap with a rest at the start (--rest-s: the first frames reach the haptic side
+         a round trip after the start, and a finger that strikes before would meet a cube nobody told it about),
+         world 20 Hz, PHASES world-clock phases per (coupling, delay) for position, impulse and local coupling: the
+         cube's stop position (mean, phase spread, bias against the zero-delay single-rate 1 kHz reference as
+         scripts/phase_experiment.py computes it), and stability: the largest energy
+         gain beyond the hand's work (impetus_py/energy.py), the largest finger force, and how many separate contacts
+         the single stroke made (1 for a clean push; more when the cube is bounced back and forth).
+  grasp  scenes/grasp.json, thumb and index (scenes/grasp_*.csv) lifting the cube, impulse and local coupling: lift at
+         the start of the hold, slip during the hold, peak-to-peak of each finger's force during the hold, energy
+         gain.
+
+Writes OUT/latency.csv (one row per scene, coupling and delay), OUT/latency_trials.csv (one row per trial),
+OUT/latency.md (the tables) and OUT/latency.png. --check exits 1 unless every number is finite and, for every impulse
+and local trial, the impulse the world applied to each object equals what the haptic side rendered (the ledger stays
+exact under delay; the fingers leave the objects long before the end, so the totals are final).
+"""
+import argparse
+import csv
+import math
+import os
+import pathlib
+import sys
+
+import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from impetus_py import logs  # noqa: E402
+from impetus_py.daemon_defaults import HAPTIC_RATE_HZ  # noqa: E402
+from impetus_py.energy import energy_balance  # noqa: E402
+from impetus_py.parallel import run_parallel  # noqa: E402
+from impetus_py.paths import ROOT  # noqa: E402
+from impetus_py.progress import track  # noqa: E402
+from impetus_py.scene import Scene  # noqa: E402
+from impetus_py.trial import backend, run_trial  # noqa: E402
+
+TAP_SCENE = ROOT / "scenes/tap.json"
+GRASP_SCENE = ROOT / "scenes/grasp.json"
+GRASP_FINGERS = {"thumb": str(ROOT / "scenes/grasp_thumb.csv"), "index": str(ROOT / "scenes/grasp_index.csv")}
+# The fingers hold the cube up over this window (scripts/grasp_figure.py): lift, slip and force ripple are read here.
+GRASP_HOLD_S = (2.5, 7.0)
+# A finger is in contact while its force exceeds this (N): 1 % of the device's 10 N limit, far above the 1e-12 N of
+# rounding, far below any push.
+CONTACT_FORCE_N = 0.1
+# The ledger holds to rounding: a running total of ~1e3 tick impulses, each exact to 1e-16 relative.
+LEDGER_TOLERANCE = 1e-9
+
+FULL_DELAYS_MS = (0, 1, 2, 5, 10, 20, 50, 100)
+FULL_GRASP_DELAYS_MS = (0, 5, 20, 50, 100)
+
+
+def contact_episodes(force_N):
+    """How many separate runs of contact (|f| > CONTACT_FORCE_N) a force trace holds."""
+    touching = force_N > CONTACT_FORCE_N
+    return int(np.count_nonzero(touching[1:] & ~touching[:-1]) + (1 if len(touching) and touching[0] else 0))
+
+
+def force_magnitude_N(haptic):
+    return np.linalg.norm(haptic.vectors("force_"), axis=1)
+
+
+def ledger_error_Ns(summary):
+    """The largest |applied − rendered| impulse component over every endpoint and object (N·s), or None when the
+    coupling applies no rendered impulse (position coupling applies a penalty from the sampled finger)."""
+    if summary.config["coupling"] == "position":
+        return None
+    rendered = summary.haptic["endpoints"]
+    applied = summary.world["endpoints"]
+    worst = 0.0
+    for k, endpoint in enumerate(rendered):
+        objects = set(endpoint["impulse_by_object_Ns"]) | set(applied[k]["impulse_by_object_Ns"])
+        for name in objects:
+            r = endpoint["impulse_by_object_Ns"].get(name, [0.0, 0.0, 0.0])
+            a = applied[k]["impulse_by_object_Ns"].get(name, [0.0, 0.0, 0.0])
+            worst = max(worst, max(abs(x - y) / (1.0 + abs(x)) for x, y in zip(r, a)))
+    return worst
+
+
+def energy_gain(out_dir, summary, scene, devices, phase_ticks):
+    """energy_balance of the trial: (largest energy gain beyond the hand's work, its tolerance), J. energy_balance
+    pairs each world step with the haptic tick of a phase-0 clock; with phase p the step was taken p ticks later,
+    so the world log's times are shifted by p ticks first."""
+    world = logs.read_log(out_dir / logs.WORLD)
+    haptic_period_s = summary.haptic_period_s
+    world.columns["time_s"] = world["time_s"] + phase_ticks * haptic_period_s
+    balance = energy_balance(scene, devices, world, summary.device, summary.world_period_s, haptic_period_s)
+    return balance["excess_J"], balance["tolerance_J"]
+
+
+def tap_trial(out_dir, trajectory, coupling, rate_hz, phase_ticks, delay_ms):
+    """One tap trial; returns its row of measurements."""
+    summary = run_trial(out_dir, TAP_SCENE, trajectory, coupling, rate_hz, phase_ticks, link_delay_s=delay_ms * 1e-3)
+    haptic = logs.read_log(out_dir / logs.HAPTIC)
+    device = logs.read_log(out_dir / logs.DEVICE)
+    force = force_magnitude_N(haptic)
+    gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(TAP_SCENE), [device], phase_ticks)
+    return {"stop_x_m": summary.final_position_m("cube")[0], "energy_gain_J": gain_J,
+            "energy_tolerance_J": tolerance_J, "max_force_N": float(force.max()),
+            "contacts": contact_episodes(force), "ledger_error": ledger_error_Ns(summary),
+            "delay_ticks": summary.link["delay_ticks"],
+            "link_dropped": summary.link["dropped"]}
+
+
+def grasp_trial(out_dir, coupling, phase_ticks, delay_ms):
+    """One grasp trial; returns its row of measurements."""
+    summary = run_trial(out_dir, GRASP_SCENE, GRASP_FINGERS, coupling, None, phase_ticks,
+                        link_delay_s=delay_ms * 1e-3)
+    world = logs.read_log(out_dir / logs.WORLD)
+    t, z = world["time_s"], world["cube.z_m"]
+    hold = z[(t >= GRASP_HOLD_S[0]) & (t <= GRASP_HOLD_S[1])]
+    devices = [logs.read_log(out_dir / logs.DEVICE), logs.read_log(out_dir / "device.endpoint1.csv")]
+    ripple, largest = [], 0.0
+    for name in (logs.HAPTIC, "haptic.endpoint1.csv"):
+        haptic = logs.read_log(out_dir / name)
+        force = force_magnitude_N(haptic)
+        held = force[(haptic["time_s"] >= GRASP_HOLD_S[0]) & (haptic["time_s"] <= GRASP_HOLD_S[1])]
+        ripple.append(float(held.max() - held.min()))
+        largest = max(largest, float(force.max()))
+    gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(GRASP_SCENE), devices, phase_ticks)
+    return {"lift_mm": 1e3 * (hold[0] - z[0]), "lift_end_mm": 1e3 * (hold[-1] - z[0]),
+            "slip_mm": 1e3 * (hold.max() - hold.min()),
+            "hold_force_p2p_N": max(ripple), "max_force_N": largest, "energy_gain_J": gain_J,
+            "energy_tolerance_J": tolerance_J, "ledger_error": ledger_error_Ns(summary),
+            "delay_ticks": summary.link["delay_ticks"],
+            "link_dropped": summary.link["dropped"]}
+
+
+def parse_ms(text, name):
+    try:
+        values = [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        sys.exit(f"latency_experiment: {name} must be comma-separated numbers of milliseconds, not '{text}'")
+    if not values or any(not 0 <= v <= 1000 for v in values):
+        sys.exit(f"latency_experiment: {name} must be delays from 0 to 1000 ms, not '{text}'")
+    return values
+
+
+def ms_label(delay_ms):
+    return f"{delay_ms:g}"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                     epilog="\n".join(__doc__.splitlines()[2:]),
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "out/latency")
+    parser.add_argument("--delays-ms", default=",".join(map(str, FULL_DELAYS_MS)),
+                        help="one-way link delays of the tap sweep, ms (default %(default)s)")
+    parser.add_argument("--couplings", default="position,impulse,local", help="tap couplings (default %(default)s)")
+    parser.add_argument("--phases", type=int, default=10, help="world-clock phases per tap cell (default 10)")
+    parser.add_argument("--rate", type=float, default=20.0, help="world rate under test, Hz (default 20)")
+    parser.add_argument("--rest-s", type=float, default=None,
+                        help="time the tap's finger rests at its start before the stroke (tap:rest=...), s; default: "
+                             "whole world periods covering two longest delays plus two periods, so the first frames "
+                             "(a round trip late) are there before the finger moves at every delay swept; 0: the "
+                             "plain tap of scripts/phase_experiment.py, whose finger moves at once")
+    parser.add_argument("--grasp-delays-ms", default=",".join(map(str, FULL_GRASP_DELAYS_MS)),
+                        help="delays of the grasp, ms (default %(default)s; empty: no grasp)")
+    parser.add_argument("--grasp-couplings", default="impulse,local", help="grasp couplings (default %(default)s)")
+    parser.add_argument("--grasp-phases", type=int, default=5, help="world-clock phases per grasp cell (default 5)")
+    parser.add_argument("--quick", action="store_true",
+                        help="a small sweep for CTest: the tap at delays 0 and 20 ms, 2 phases, and the grasp at 20 ms "
+                             "under local coupling, 1 phase")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--quiet", action="store_true", help="no progress bar (it shows only on a terminal anyway)")
+    parser.add_argument("--plot", action=argparse.BooleanOptionalAction, default=True)
+    parser.add_argument("--check", action="store_true",
+                        help="exit 1 unless every number is finite and the ledger is exact in every impulse and local "
+                             "trial")
+    args = parser.parse_args()
+    if args.quick:
+        args.delays_ms, args.phases = "0,20", 2
+        args.grasp_delays_ms, args.grasp_couplings, args.grasp_phases = "20", "local", 1
+    if args.phases < 1 or args.grasp_phases < 1:
+        sys.exit(f"latency_experiment: --phases and --grasp-phases must be 1 or more, not {args.phases} and "
+                 f"{args.grasp_phases}")
+    if backend() != "module":
+        sys.exit("latency_experiment: the delay line lives in the in-process link; build the impetus package "
+                 "(scripts/build.sh) and do not set IMPETUS_TRIALS=processes")
+    delays = parse_ms(args.delays_ms, "--delays-ms")
+    grasp_delays = parse_ms(args.grasp_delays_ms, "--grasp-delays-ms") if args.grasp_delays_ms.strip() else []
+    couplings = [c for c in args.couplings.split(",") if c]
+    grasp_couplings = [c for c in args.grasp_couplings.split(",") if c] if grasp_delays else []
+
+    ticks_per_step = round(HAPTIC_RATE_HZ / args.rate)
+    phases = sorted({round(k * ticks_per_step / args.phases) for k in range(args.phases)})
+    # A rest of whole world periods keeps the stroke where it was against the world clock: at zero delay the trials
+    # are those of the plain tap, the cube resting meanwhile.
+    world_period_s = 1.0 / args.rate
+    if args.rest_s is None:
+        args.rest_s = (math.ceil(2e-3 * max(delays) / world_period_s - 1e-9) + 2) * world_period_s
+    if args.rest_s < 0:
+        sys.exit(f"latency_experiment: --rest-s must be 0 or more, not {args.rest_s}")
+    tap = f"tap:rest={args.rest_s:.6g}" if args.rest_s > 0 else "tap"
+    tasks = []
+    for coupling in couplings:
+        for delay in delays:
+            for phase in phases:
+                out_dir = args.out / "tap" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
+                tasks.append((("tap", coupling, delay, phase), tap_trial,
+                              (out_dir, tap, coupling, args.rate, phase, delay)))
+    # The reference: impulse coupling with the world at the haptic rate and no delay (one phase: its period is a tick).
+    tasks.append((("tap", "reference", 0.0, 0), tap_trial,
+                  (args.out / "tap" / "reference", tap, "impulse", float(HAPTIC_RATE_HZ), 0, 0.0)))
+    grasp_phases = sorted({round(k * ticks_per_step / args.grasp_phases) for k in range(args.grasp_phases)})
+    for coupling in grasp_couplings:
+        for delay in grasp_delays:
+            for phase in grasp_phases:
+                out_dir = args.out / "grasp" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
+                tasks.append((("grasp", coupling, delay, phase), grasp_trial, (out_dir, coupling, phase, delay)))
+
+    # A grasp runs 10 s of trajectory, a tap about 2 s; the reference steps its world 50 times as often.
+    def weight(key):
+        return {"grasp": 5.0}.get(key[0], 1.0) * (3.0 if key[1] == "reference" else 1.0)
+
+    trials = {}
+    try:
+        for key, row in track(run_parallel(tasks, args.jobs), [key for key, _, _ in tasks], "latency sweep",
+                              args.quiet, weight):
+            trials[key] = row
+    except RuntimeError as error:  # a trial that failed names itself
+        sys.exit(f"latency_experiment: {error}")
+
+    reference_x = trials[("tap", "reference", 0.0, 0)]["stop_x_m"]
+    start_x = Scene(TAP_SCENE).start_position_m("cube")[0]
+    travel = reference_x - start_x
+    cells = []
+    for coupling in couplings:
+        for delay in delays:
+            rows = [trials[("tap", coupling, delay, p)] for p in phases]
+            stops = [r["stop_x_m"] for r in rows]
+            mean = sum(stops) / len(stops)
+            ledger = [r["ledger_error"] for r in rows if r["ledger_error"] is not None]
+            cells.append({"scene": "tap", "coupling": coupling, "delay_ms": delay,
+                          "delay_ticks": rows[0]["delay_ticks"], "trials": len(rows), "stop_x_mean_m": mean,
+                          "phase_spread_m": max(stops) - min(stops),
+                          "bias_m": mean - reference_x, "bias_pct_of_travel": 100.0 * (mean - reference_x) / travel,
+                          "energy_gain_max_J": max(r["energy_gain_J"] for r in rows),
+                          "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
+                          "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
+                          "max_force_N": max(r["max_force_N"] for r in rows),
+                          "contacts_max": max(r["contacts"] for r in rows),
+                          "contacts_mean": sum(r["contacts"] for r in rows) / len(rows),
+                          "ledger_error_max": max(ledger) if ledger else math.nan,
+                          "link_dropped": sum(r["link_dropped"] for r in rows)})
+    for coupling in grasp_couplings:
+        for delay in grasp_delays:
+            rows = [trials[("grasp", coupling, delay, p)] for p in grasp_phases]
+            ledger = [r["ledger_error"] for r in rows if r["ledger_error"] is not None]
+            # Held: the cube is still at least half as high at the hold's end as at its start.
+            held = sum(r["lift_end_mm"] >= 0.5 * r["lift_mm"] > 0 for r in rows)
+            cells.append({"scene": "grasp", "coupling": coupling, "delay_ms": delay,
+                          "delay_ticks": rows[0]["delay_ticks"], "trials": len(rows),
+                          "lift_mm": min(r["lift_mm"] for r in rows),
+                          "lift_end_mm": min(r["lift_end_mm"] for r in rows), "held": held,
+                          "slip_mm": max(r["slip_mm"] for r in rows),
+                          "hold_force_p2p_N": max(r["hold_force_p2p_N"] for r in rows),
+                          "max_force_N": max(r["max_force_N"] for r in rows),
+                          "energy_gain_max_J": max(r["energy_gain_J"] for r in rows),
+                          "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
+                          "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
+                          "ledger_error_max": max(ledger) if ledger else math.nan,
+                          "link_dropped": sum(r["link_dropped"] for r in rows)})
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    fields = ["scene", "coupling", "delay_ms", "delay_ticks", "trials", "stop_x_mean_m", "phase_spread_m", "bias_m",
+              "bias_pct_of_travel", "lift_mm", "lift_end_mm", "held", "slip_mm", "hold_force_p2p_N",
+              "energy_gain_max_J",
+              "energy_tolerance_J", "energy_over_tolerance", "max_force_N", "contacts_max", "contacts_mean",
+              "ledger_error_max", "link_dropped"]
+    with open(args.out / "latency.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=fields, restval="")
+        writer.writeheader()
+        writer.writerows(cells)
+    with open(args.out / "latency_trials.csv", "w", newline="") as f:
+        trial_fields = ["scene", "coupling", "delay_ms", "phase_ticks", "delay_ticks", "stop_x_m", "lift_mm",
+                        "lift_end_mm", "slip_mm", "hold_force_p2p_N", "energy_gain_J", "energy_tolerance_J",
+                        "max_force_N",
+                        "contacts", "ledger_error", "link_dropped"]
+        writer = csv.DictWriter(f, fieldnames=trial_fields, restval="")
+        writer.writeheader()
+        for (scene, coupling, delay, phase), row in sorted(trials.items(), key=lambda item: item[0]):
+            writer.writerow({"scene": scene, "coupling": coupling, "delay_ms": delay, "phase_ticks": phase, **row})
+
+    lines = [f"Tap trial (`{tap}`), world {args.rate:g} Hz, {len(phases)} world-clock phases per cell, one-way link "
+             f"delay each way; reference: impulse coupling, world at {HAPTIC_RATE_HZ} Hz, no delay (stop x = "
+             f"{reference_x:.4f} m, travel {travel:.4f} m)", "",
+             "| coupling | delay (ms) | stop x mean (m) | phase spread (mm) | bias vs reference (mm) | "
+             "bias (% of travel) | energy gain, worst phase (mJ) | phases over tolerance | max force (N) | "
+             "contacts per stroke (mean, max) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    ref = trials[("tap", "reference", 0.0, 0)]
+    lines.append(f"| reference (1 kHz world) | 0 | {reference_x:.4f} | – | – | – | {1e3 * ref['energy_gain_J']:+.2f} | "
+                 f"{int(ref['energy_gain_J'] > ref['energy_tolerance_J'])}/1 | {ref['max_force_N']:.2f} | "
+                 f"{ref['contacts']:.1f}, {ref['contacts']} |")
+    for c in cells:
+        if c["scene"] != "tap":
+            continue
+        lines.append(f"| {c['coupling']} | {ms_label(c['delay_ms'])} | {c['stop_x_mean_m']:.4f} | "
+                     f"{1e3 * c['phase_spread_m']:.2f} | {1e3 * c['bias_m']:+.2f} | {c['bias_pct_of_travel']:+.1f} | "
+                     f"{1e3 * c['energy_gain_max_J']:+.2f} | {c['energy_over_tolerance']}/{c['trials']} | "
+                     f"{c['max_force_N']:.2f} | {c['contacts_mean']:.1f}, {c['contacts_max']} |")
+    if grasp_couplings:
+        lines += ["", f"Grasp and lift (thumb and index), {len(grasp_phases)} world-clock phases per cell, worst phase "
+                  f"shown; hold window {GRASP_HOLD_S[0]:g}–{GRASP_HOLD_S[1]:g} s; held: the cube still at least half "
+                  f"as high at the hold's end as at its start", "",
+                  "| coupling | delay (ms) | held (phases) | lift at hold start (mm) | lift at hold end (mm) | slip in "
+                  "hold (mm) | force peak-to-peak in hold (N) | max force (N) | energy gain (mJ) | phases over "
+                  "tolerance |",
+                  "|---|---|---|---|---|---|---|---|---|---|"]
+        for c in cells:
+            if c["scene"] != "grasp":
+                continue
+            lines.append(f"| {c['coupling']} | {ms_label(c['delay_ms'])} | {c['held']}/{c['trials']} | "
+                         f"{c['lift_mm']:.1f} | {c['lift_end_mm']:.1f} | {c['slip_mm']:.2f} | "
+                         f"{c['hold_force_p2p_N']:.2f} | {c['max_force_N']:.2f} | "
+                         f"{1e3 * c['energy_gain_max_J']:+.2f} | {c['energy_over_tolerance']}/{c['trials']} |")
+    dropped = sum(c["link_dropped"] for c in cells)
+    tolerance_mJ = 1e3 * max(c["energy_tolerance_J"] for c in cells)
+    lines += ["", f"Energy tolerance (quadrature + contact slop): {tolerance_mJ:.2f} mJ at most. Delay-line entries "
+              f"dropped over all trials: {dropped}."]
+    table = "\n".join(lines)
+    (args.out / "latency.md").write_text(table + "\n")
+    print(table)
+
+    if args.plot:
+        os.environ.setdefault("MPLBACKEND", "Agg")
+        import matplotlib.pyplot as plt
+        # One categorical axis for every panel: the delays span 0 to 100 ms, too wide for a linear axis, and 0 has no
+        # place on a logarithmic one.
+        axis_delays = sorted(set(delays) | set(grasp_delays))
+        fig, axes = plt.subplots(2, 3, figsize=(13, 6.6))
+        # Bias and energy span four decades with signs: symmetric-log axes, linear within the energy tolerance
+        # (10 mJ) and within 10 mm of the reference.
+        panels = [(axes[0][0], "tap", "phase_spread_m", 1e3, "tap: phase spread of the stop (mm)", None),
+                  (axes[0][1], "tap", "bias_m", 1e3, "tap: bias vs 1 kHz reference (mm)", 10.0),
+                  (axes[0][2], "grasp", "lift_end_mm", 1.0, "grasp: lift at the hold's end, worst phase (mm)", None),
+                  (axes[1][0], "both", "energy_gain_max_J", 1e3, "energy gain, worst phase (mJ)", 10.0),
+                  (axes[1][1], "both", "max_force_N", 1.0, "largest finger force (N)", None),
+                  (axes[1][2], "grasp", "hold_force_p2p_N", 1.0, "grasp: force peak-to-peak in the hold (N)", None)]
+        colours = {"position": "tab:blue", "impulse": "tab:orange", "local": "tab:green"}
+        for ax, scene, field, scale, label, linear_within in panels:
+            for kind, kind_couplings, style in (("tap", couplings, "o-"), ("grasp", grasp_couplings, "s--")):
+                if scene not in (kind, "both"):
+                    continue
+                for coupling in kind_couplings:
+                    pairs = [(axis_delays.index(c["delay_ms"]), scale * c[field]) for c in cells
+                             if c["scene"] == kind and c["coupling"] == coupling]
+                    if pairs:
+                        ax.plot(*zip(*pairs), style, ms=4, lw=1.2, color=colours.get(coupling),
+                                label=f"{kind}, {coupling}")
+            if linear_within is not None:
+                ax.set_yscale("symlog", linthresh=linear_within)
+            ax.set_xticks(range(len(axis_delays)), [ms_label(d) for d in axis_delays])
+            ax.set_xlabel("one-way link delay (ms)")
+            ax.set_title(label, fontsize=10)
+            ax.grid(alpha=0.3)
+            if ax.lines:
+                ax.legend(fontsize=7)
+        axes[0][1].axhline(0.0, color="k", lw=0.8)
+        fig.suptitle(f"Link delay: tap (world {args.rate:g} Hz, {len(phases)} phases) and grasp "
+                     f"({len(grasp_phases)} phases)")
+        fig.tight_layout()
+        fig.savefig(args.out / "latency.png", dpi=80)
+        print(f"plot: {args.out / 'latency.png'}")
+
+    if args.check:
+        failures = []
+        for c in cells:
+            numbers = [v for k, v in c.items() if isinstance(v, float) and k != "ledger_error_max"]
+            if not all(math.isfinite(v) for v in numbers):
+                failures.append(f"{c['scene']} {c['coupling']} {ms_label(c['delay_ms'])} ms: a number is not finite")
+        # Every trial whose coupling applies the rendered impulse (the reference included), one by one.
+        for (scene, coupling, delay, phase), row in trials.items():
+            error = row["ledger_error"]
+            if error is not None and not error <= LEDGER_TOLERANCE:
+                failures.append(f"{scene} {coupling} {ms_label(delay)} ms phase {phase}: the impulse applied differs "
+                                f"from the impulse rendered by {error:.3g} (relative)")
+        if failures:
+            print("CHECK FAILED: " + "; ".join(failures))
+            sys.exit(1)
+        print("check passed")
+
+
+if __name__ == "__main__":
+    main()
