@@ -31,7 +31,7 @@ impetus::Coupling parse_coupling(const std::string& name) {
 
 // The trial's summary.json document as text (the Python half parses it into a dict).
 std::string run_trial(const std::string& scene, const std::string& trajectory, const std::vector<std::string>& fingers,
-                      const std::string& coupling,
+                      const std::vector<std::vector<std::string>>& followers, const std::string& coupling,
                       std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
                       std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm, double link_delay_s,
                       double duration_s, const std::string& out_dir) {
@@ -39,6 +39,7 @@ std::string run_trial(const std::string& scene, const std::string& trajectory, c
   options.scene_path = scene;
   options.trajectory = trajectory;
   options.fingers = fingers;
+  options.followers = followers;
   options.coupling = parse_coupling(coupling);
   options.phase_ticks = phase_ticks;
   options.world_rate_hz = world_rate_hz;
@@ -99,7 +100,8 @@ py::tuple read_log(const std::string& path) {
 
 PYBIND11_MODULE(_impetus, module) {
   module.doc() = "Impetus' compiled core; use the impetus package, not this module.";
-  module.def("run_trial", &run_trial, py::arg("scene"), py::arg("trajectory"), py::arg("fingers"), py::arg("coupling"),
+  module.def("run_trial", &run_trial, py::arg("scene"), py::arg("trajectory"), py::arg("fingers"), py::arg("followers"),
+             py::arg("coupling"),
              py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("stiffness_Npm"),
              py::arg("damping_Nspm"), py::arg("link_delay_s"), py::arg("duration_s"), py::arg("out_dir"));
   module.def("read_log", &read_log, py::arg("path"));

@@ -9,6 +9,7 @@
 // headers' counts (the codecs loop over them).
 
 #include "common/contract/frames.h"
+#include "common/runtime/loop_stats.h"
 
 #include <cstddef>
 
@@ -87,6 +88,21 @@ void visit_report_header(A& a, B& b, F&& f) {
   f(a.finger_valid, b.finger_valid);
   f(a.entry_count, b.entry_count);
   f(a.static_impulse_Ns, b.static_impulse_Ns);
+}
+
+// A loop's statistics (not a frame: no seal, no counts), for the transports that carry them.
+template <class A, class B, class F>
+void visit_loop_stats(A& a, B& b, F&& f) {
+  f(a.heartbeat_ns, b.heartbeat_ns);
+  f(a.pid, b.pid);
+  f(a.ticks, b.ticks);
+  f(a.skipped_periods, b.skipped_periods);
+  f(a.faults, b.faults);
+  f(a.rejected_frames, b.rejected_frames);
+  f(a.lateness_p50_ns, b.lateness_p50_ns);
+  f(a.lateness_p99_ns, b.lateness_p99_ns);
+  f(a.lateness_p999_ns, b.lateness_p999_ns);
+  f(a.lateness_max_ns, b.lateness_max_ns);
 }
 
 }  // namespace impetus::fields

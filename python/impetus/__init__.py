@@ -90,7 +90,7 @@ def read_log(path):
     return {name: table[:, i] for i, name in enumerate(header)}
 
 
-def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_ticks=0, substeps=None,
+def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, phase_ticks=0, substeps=None,
               stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, duration_s=60.0, out_dir=None, logs=True):
     """Runs one trial and returns its Trial.
 
@@ -100,6 +100,11 @@ def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_tick
                    order (spidar_sim --finger NAME=PATH), each finger an endpoint of the world (Trial.logs holds
                    the first finger's logs)
     coupling       one of COUPLINGS
+    users          other users on the same world, each a haptic controller of its own following this trial's lockstep
+                   ticks: a list whose items are a trajectory (one finger) or a dict {name: trajectory} (several).
+                   User u's logs are userU.haptic.csv and userU.device.csv in out_dir, its summary
+                   summary["followers"][u - 1] (its haptic_session tells its ledger apart in
+                   summary["world"]["endpoints"])
     rate_hz        the world rate (world_manager --rate); None: the scene's
     phase_ticks    the world clock's lockstep phase in haptic ticks, within one world period (world_manager --phase)
     substeps       ODE steps per world period (world_manager --substeps); None: the scene's
@@ -119,6 +124,8 @@ def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_tick
     """
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling: must be one of {', '.join(COUPLINGS)}, not {coupling!r}")
+    if isinstance(users, (str, dict)) or not all(isinstance(user, (str, dict, pathlib.Path)) for user in users):
+        raise ValueError(f"users: must be a list of trajectories or {{name: trajectory}} dicts, not {users!r}")
     if isinstance(phase_ticks, bool) or not isinstance(phase_ticks, int) or phase_ticks < 0:
         raise ValueError(f"phase_ticks: must be a whole number of ticks, 0 or more, not {phase_ticks!r}")
     scene = pathlib.Path(scene)
@@ -129,7 +136,10 @@ def run_trial(scene, trajectory, coupling="impulse", *, rate_hz=None, phase_tick
         directory.mkdir(parents=True, exist_ok=True)
         start = time.monotonic()
         fingers = [f"{name}={path}" for name, path in trajectory.items()] if isinstance(trajectory, dict) else []
-        summary = json.loads(_impetus.run_trial(str(scene), "" if fingers else str(trajectory), fingers, coupling,
+        followers = [[f"{name}={path}" for name, path in user.items()] if isinstance(user, dict)
+                     else [f"finger={user}"] for user in users]
+        summary = json.loads(_impetus.run_trial(str(scene), "" if fingers else str(trajectory), fingers, followers,
+                                                coupling,
                                                 phase_ticks, rate_hz, substeps,
                                                 stiffness_Npm, damping_Nspm, float(link_delay_s), float(duration_s),
                                                 str(directory) if (out_dir is not None or logs) else ""))

@@ -97,6 +97,30 @@ class Arguments(unittest.TestCase):
         self.assertEqual(delayed.summary["link"]["dropped"], 0)
         self.assertNotEqual(base.summary["objects"], delayed.summary["objects"])
 
+    def test_users_on_one_world(self):
+        # Two users squeeze the tap scene's cube (sides at x = 0.005 and 0.055 m) 10 mm deep from either side: the
+        # pushes cancel, the cube stays, and the world applied for each user exactly what that user rendered.
+        paths = {}
+        for name, from_x, to_x in (("a", -0.01, 0.015), ("b", 0.07, 0.045)):
+            paths[name] = OUT / f"users-{name}.csv"
+            paths[name].write_text(f"t,x,y,z\n0,{from_x},0,0.025\n0.5,{to_x},0,0.025\n3,{to_x},0,0.025\n")
+        trial = impetus.run_trial(impetus.shipped_scene("tap"), str(paths["a"]), "local", users=[str(paths["b"])],
+                                  out_dir=OUT / "users", logs=False)
+        self.assertTrue((trial.out_dir / "user1.haptic.csv").is_file())
+        self.assertEqual(len(trial.summary["followers"]), 1)
+        moved_mm = 1e3 * abs(trial.summary["objects"]["cube"]["position"][0] - 0.03)
+        self.assertLess(moved_mm, 1.0)
+        applied = {(entry["haptic_session"], entry["endpoint"]): entry["impulse_by_object_Ns"]["0"]
+                   for entry in trial.summary["world"]["endpoints"]}
+        for haptic in (trial.summary["haptic"], trial.summary["followers"][0]["haptic"]):
+            rendered = haptic["impulse_by_object_Ns"]["0"]
+            self.assertGreater(abs(rendered[0]), 0.5)  # each pushed for seconds
+            world_side = applied[(haptic["haptic_session"], 0)]
+            for axis in range(3):
+                self.assertAlmostEqual(world_side[axis], rendered[axis], delta=1e-12 * max(1.0, abs(rendered[axis])))
+        with self.assertRaises(ValueError):
+            impetus.run_trial(impetus.shipped_scene("tap"), "tap", users="tap")
+
     def test_out_of_range_values_name_the_argument(self):
         cases = [(dict(rate_hz=1e300), "world_rate_hz"), (dict(rate_hz=math.nan), "world_rate_hz"),
                  (dict(substeps=0), "substeps"), (dict(stiffness_Npm=-5.0), "stiffness_Npm"),

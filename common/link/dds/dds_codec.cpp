@@ -47,23 +47,15 @@ struct DdsToWire {
   }
 };
 
-template <class Sequence, class Element>
-void allocate(Sequence& sequence, std::uint32_t capacity) {
-  sequence._buffer = static_cast<Element*>(dds_alloc(sizeof(Element) * capacity));
-  sequence._maximum = capacity;
-  sequence._length = 0;
-  sequence._release = true;
-}
-
 }  // namespace
 
 DdsFrameSample::DdsFrameSample() {
-  allocate<dds_sequence_impetus_dds_Plane, impetus_dds_Plane>(sample_.planes, kMaxPlanes);
+  allocate_sequence(sample_.planes, kMaxPlanes);
 }
 DdsFrameSample::~DdsFrameSample() { dds_sample_free(&sample_, &impetus_dds_PlaneFrame_desc, DDS_FREE_CONTENTS); }
 
 DdsReportSample::DdsReportSample() {
-  allocate<dds_sequence_impetus_dds_ObjectImpulse, impetus_dds_ObjectImpulse>(sample_.entries, kMaxImpulseEntries);
+  allocate_sequence(sample_.entries, kMaxImpulseEntries);
 }
 DdsReportSample::~DdsReportSample() {
   dds_sample_free(&sample_, &impetus_dds_HapticReport_desc, DDS_FREE_CONTENTS);
@@ -109,31 +101,11 @@ bool from_dds(const impetus_dds_HapticReport& in, wire::HapticReport& out) {
   return true;
 }
 
-void to_dds(const LoopStats& in, impetus_dds_LoopStats& out) {
-  out.heartbeat_ns = in.heartbeat_ns;
-  out.pid = in.pid;
-  out.ticks = in.ticks;
-  out.skipped_periods = in.skipped_periods;
-  out.faults = in.faults;
-  out.rejected_frames = in.rejected_frames;
-  out.lateness_p50_ns = in.lateness_p50_ns;
-  out.lateness_p99_ns = in.lateness_p99_ns;
-  out.lateness_p999_ns = in.lateness_p999_ns;
-  out.lateness_max_ns = in.lateness_max_ns;
-}
+void to_dds(const LoopStats& in, impetus_dds_LoopStats& out) { fields::visit_loop_stats(in, out, WireToDds{}); }
 
 void from_dds(const impetus_dds_LoopStats& in, LoopStats& out) {
   out = LoopStats{};
-  out.heartbeat_ns = in.heartbeat_ns;
-  out.pid = in.pid;
-  out.ticks = in.ticks;
-  out.skipped_periods = in.skipped_periods;
-  out.faults = in.faults;
-  out.rejected_frames = in.rejected_frames;
-  out.lateness_p50_ns = in.lateness_p50_ns;
-  out.lateness_p99_ns = in.lateness_p99_ns;
-  out.lateness_p999_ns = in.lateness_p999_ns;
-  out.lateness_max_ns = in.lateness_max_ns;
+  fields::visit_loop_stats(out, in, DdsToWire{});
 }
 
 }  // namespace impetus

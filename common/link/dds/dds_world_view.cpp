@@ -19,14 +19,6 @@ constexpr const char* kSnapshotTopic = "impetus_view_snapshot";
 impetus_dds_Vec3 to_dds(const Vec3& v) { return {v[0], v[1], v[2]}; }
 Vec3 from_dds(const impetus_dds_Vec3& v) { return {v.x, v.y, v.z}; }
 
-template <class Sequence, class Element>
-void allocate(Sequence& sequence, std::uint32_t capacity) {
-  sequence._buffer = static_cast<Element*>(dds_alloc(sizeof(Element) * capacity));
-  sequence._maximum = capacity;
-  sequence._length = 0;
-  sequence._release = true;
-}
-
 }  // namespace
 
 struct DdsWorldViewPublisher::State {
@@ -37,9 +29,9 @@ struct DdsWorldViewPublisher::State {
     snapshot_writer = make_writer(
         publisher, make_topic(participant.handle(), &impetus_dds_WorldSnapshot_desc, kSnapshotTopic),
         Delivery::best_effort);
-    allocate<dds_sequence_impetus_dds_ViewBodyInfo, impetus_dds_ViewBodyInfo>(scene.bodies, kMaxViewBodies);
-    allocate<dds_sequence_impetus_dds_ViewEndpoint, impetus_dds_ViewEndpoint>(snapshot.endpoints, kMaxViewEndpoints);
-    allocate<dds_sequence_impetus_dds_ViewBodyPose, impetus_dds_ViewBodyPose>(snapshot.bodies, kMaxViewBodies);
+    allocate_sequence(scene.bodies, kMaxViewBodies);
+    allocate_sequence(snapshot.endpoints, kMaxViewEndpoints);
+    allocate_sequence(snapshot.bodies, kMaxViewBodies);
   }
   ~State() {
     dds_sample_free(&scene, &impetus_dds_ViewScene_desc, DDS_FREE_CONTENTS);
