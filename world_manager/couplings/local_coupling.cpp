@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 namespace impetus {
 
@@ -31,7 +32,17 @@ void LocalCoupling::schedule(std::size_t id, const ImpulseDelta& delta, const Im
   const double scale = period_s / window.length_s;  // lockstep: 1; real time: the window mapped onto this step
   // A body touching something gets its impulse within the substeps, where its contacts see it (apply_slot); a free
   // body may also take some at the window's end, as a velocity change after the last substep.
-  const int slot_count = context_.engine.contacts().touching(static_cast<std::int32_t>(id)) ? substeps : substeps + 1;
+  const bool touching = context_.engine.contacts().touching(static_cast<std::int32_t>(id));
+  const int slot_count = touching ? substeps : substeps + 1;
+  // What friction can hold in one substep: μ·N·h. A push friction could hold, spread evenly over the step, goes in
+  // evenly, its moment of force too: the ramp's centroid may lie near the step's end (one haptic tick per world step:
+  // a 1 kHz world), and there it puts most of the push in one substep, beyond what friction holds there, and most of
+  // its torque, which rocks a box off an edge; a resting object then creeps under a push it should resist. The push's
+  // timing shifts by up to one step, which an object friction holds does not show. A push friction cannot hold keeps
+  // its exact timing: the object slides anyway.
+  const double holdable_per_slot_Ns =
+      touching ? context_.engine.contacts().friction_capacity_N(static_cast<std::int32_t>(id)) * h : 0.0;
+  const bool even = touching && delta.impulse_Ns.norm() <= holdable_per_slot_Ns * slot_count;
   auto place = [&](double amount, double first_moment, int axis, std::vector<Eigen::Vector3d>& slots) {
     // Moment about the window's start, mapped onto this step: Σ J_k·c_k with c_k ∈ [0, T_w].
     const double moment_about_start = (first_moment - window.start_s * amount) * scale;
@@ -40,7 +51,9 @@ void LocalCoupling::schedule(std::size_t id, const ImpulseDelta& delta, const Im
       return;
     }
     const double c = amount != 0.0 ? moment_about_start / amount : -1.0;
-    if (c >= 0.0 && c <= period_s) {
+    if (even) {
+      for (int slot = 0; slot < slot_count; ++slot) slots[static_cast<std::size_t>(slot)][axis] += amount / slot_count;
+    } else if (c >= 0.0 && c <= period_s) {
       spread_over_slots(c / h, slot_count,
                         [&](int slot, double weight) { slots[static_cast<std::size_t>(slot)][axis] += weight * amount; });
     } else if (amount != 0.0 || moment_about_start != 0.0) {
