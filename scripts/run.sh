@@ -3,13 +3,17 @@
 # Runs one trial: world_manager + haptic_controller + spidar_sim (DESIGN.md §4), collects their logs under DIR,
 # prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
 #
-#   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ...) [--coupling impulse|position|local]
+#   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ...) [--user SPEC ...]
+#                  [--coupling impulse|position|local]
 #                  [--rate HZ] [--phase TICKS] [--substeps N]
 #                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet]
 #                  [--view [--view-listen HOST:PORT] [--view-wait S]]
 #                  [-- extra haptic_controller flags, e.g. --stiffness 5000]
 # --finger (once per finger, up to 8) runs a several-finger device: one endpoint of the world per finger; logs of
 # finger k > 0 are haptic.endpointK.csv and device.endpointK.csv.
+# --user SPEC (once per user) adds another user on the same world: a haptic controller of its own with one finger on
+# trajectory SPEC (in lockstep it follows the first controller's ticks); user U's logs are userU.haptic.csv and
+# userU.device.csv, its summary summary.json's "followers"[U-1].
 # --view starts a viewer beside the trial (default address 127.0.0.1:8080) and prints where to watch it; with
 # --view-wait S the finger starts S seconds after the world, time to open the page. Afterwards
 # `build/viewer/viewer --replay DIR` plays the trial back.
@@ -19,18 +23,20 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${IMPETUS_BUILD_DIR:-$root/build}"
 
-usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "run.sh: $*" >&2; exit 2; }
 
 view=0 view_listen="127.0.0.1:8080" view_wait=0
 substeps="" scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
 haptic_extra=()
 fingers=()
+users=()
 while (($#)); do
   case "$1" in
     --scene) scene="${2:?}"; shift 2 ;;
     --trajectory) trajectory="${2:?}"; shift 2 ;;
     --finger) fingers+=("${2:?}"); shift 2 ;;
+    --user) users+=("${2:?}"); shift 2 ;;
     --coupling) coupling="${2:?}"; shift 2 ;;
     --rate) rate="${2:?}"; shift 2 ;;
     --substeps) substeps="${2:?}"; shift 2 ;;
@@ -56,6 +62,10 @@ else
   [ -n "$trajectory" ] || die "--trajectory (or --finger NAME=SPEC for each finger) is required"
 fi
 case "$clock" in realtime|lockstep) ;; *) die "--clock must be realtime or lockstep, not '$clock'" ;; esac
+first_fingers=$(( ${#fingers[@]} > 0 ? ${#fingers[@]} : 1 ))
+endpoints=$(( first_fingers + ${#users[@]} ))
+((endpoints <= 8)) || die "a world serves at most 8 endpoints: the first controller's $first_fingers finger(s) and \
+${#users[@]} other user(s) make $endpoints"
 [[ "$view_wait" =~ ^[0-9]+([.][0-9]+)?$ ]] || die "--view-wait must be a number of seconds, not '$view_wait'"
 bins=(world_manager haptic_controller spidar_sim)
 ((view)) && bins+=(viewer)
@@ -84,6 +94,11 @@ fi
 # Every segment the trial may create: the world's, the viewer's and one device port per finger.
 segments=("/dev/shm/$shm.world" "/dev/shm/$shm.view" "/dev/shm/$shm.device")
 for ((k = 1; k < ${#fingers[@]}; ++k)); do segments+=("/dev/shm/$shm.device$k"); done
+# Another user's controller has a device port of its own: NAME_uU.device.
+for ((u = 1; u <= ${#users[@]}; ++u)); do segments+=("/dev/shm/${shm}_u$u.device"); done
+if ((${#users[@]})) && [ "$clock" = lockstep ]; then
+  haptic_args+=(--followers "${#users[@]}")  # the first controller leads, and starts when every user is there
+fi
 
 pids=()
 viewer_pid=""
@@ -120,11 +135,39 @@ if ((view)); then
 fi
 "$build/haptic_controller/haptic_controller" "${haptic_args[@]}" 2>"$out/haptic.err" & haptic=$!; pids+=("$haptic")
 "$build/spidar_sim/spidar_sim" "${device_args[@]}" 2>"$out/device.err" & device=$!; pids+=("$device")
+user_haptics=() user_devices=()
+if ((${#users[@]})); then
+  if [ "$clock" = lockstep ]; then
+    # The others follow once the first holds the world's lockstep (it says it is waiting for them), so it leads.
+    for _ in $(seq 600); do
+      grep -q "waiting for" "$out/haptic.err" 2>/dev/null && break
+      kill -0 "$haptic" 2>/dev/null || break
+      sleep 0.05
+    done
+  fi
+  for ((u = 1; u <= ${#users[@]}; ++u)); do
+    "$build/haptic_controller/haptic_controller" --clock "$clock" --duration "$duration" --shm "${shm}_u$u" \
+      --world-shm "$shm" --log "$out/user$u.haptic.csv" --summary "$out/user$u.haptic.json" "${haptic_extra[@]}" \
+      2>"$out/user$u.haptic.err" & user_haptics+=($!); pids+=($!)
+    "$build/spidar_sim/spidar_sim" --clock "$clock" --shm "${shm}_u$u" --trajectory "${users[u - 1]}" \
+      --log "$out/user$u.device.csv" --summary "$out/user$u.device.json" 2>"$out/user$u.device.err" &
+    user_devices+=($!); pids+=($!)
+  done
+fi
 
 # The trial lasts as long as the trajectory (its final hold lets the objects come to rest), capped by --duration.
 # Then the haptic controller and the world are stopped like a user would, and must exit cleanly.
 device_status=0 haptic_status=0 world_status=0
 wait "$device" || device_status=$?
+# Other users: their devices end with their trajectories; then their controllers leave before the first one.
+user_status=()
+for ((u = 1; u <= ${#users[@]}; ++u)); do
+  status_u=0
+  wait "${user_devices[u - 1]}" || status_u=$?
+  kill -TERM "${user_haptics[u - 1]}" 2>/dev/null || true
+  wait "${user_haptics[u - 1]}" || status_u=$((status_u ? status_u : $?))
+  user_status+=("$status_u")
+done
 kill -TERM "$haptic" 2>/dev/null || true
 wait "$haptic" || haptic_status=$?
 kill -TERM "$world" 2>/dev/null || true
@@ -143,6 +186,13 @@ for name in world haptic device; do
     case "$name" in world) bin=world_manager ;; haptic) bin=haptic_controller ;; device) bin=spidar_sim ;; esac
     echo "run.sh: $bin failed (exit ${!var}):" >&2
     cat "$out/$name.err" >&2
+    status=1
+  fi
+done
+for ((u = 1; u <= ${#users[@]}; ++u)); do
+  if ((user_status[u - 1] != 0)); then
+    echo "run.sh: user $u's haptic_controller or spidar_sim failed (exit ${user_status[u - 1]}):" >&2
+    cat "$out/user$u.haptic.err" "$out/user$u.device.err" >&2
     status=1
   fi
 done

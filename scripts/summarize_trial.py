@@ -31,6 +31,13 @@ def main():
     entries = {key: value for key, _, value in (item.partition("=") for item in args.set)}
     merged = summary.merge(load(args.dir / summary.WORLD_FILE_NAME), load(args.dir / summary.HAPTIC_FILE_NAME),
                            load(args.dir / summary.DEVICE_FILE_NAME), entries)
+    # Other users on the same world (run.sh --user): userU.haptic.json and userU.device.json, U = 1, 2, ...
+    followers = []
+    while (args.dir / f"user{len(followers) + 1}.haptic.json").exists():
+        u = len(followers) + 1
+        followers.append({**load(args.dir / f"user{u}.haptic.json"), **load(args.dir / f"user{u}.device.json")})
+    if followers:
+        merged["followers"] = followers
     (args.dir / summary.FILE_NAME).write_text(summary.to_json(merged))
 
     if args.quiet:

@@ -97,6 +97,30 @@ class Arguments(unittest.TestCase):
         self.assertEqual(delayed.summary["link"]["dropped"], 0)
         self.assertNotEqual(base.summary["objects"], delayed.summary["objects"])
 
+    def test_users_same_as_run_sh(self):
+        # run.sh --user: a second user's controller and device as processes of their own, following the first's
+        # lockstep ticks; the same world as run_trial(users=...) in one process, every log byte for byte.
+        paths = []
+        for name, from_x, to_x in (("a", -0.01, 0.012), ("b", 0.07, 0.05)):
+            path = OUT / f"users-sh-{name}.csv"
+            path.write_text(f"t,x,y,z\n0,{from_x},0,0.025\n0.5,{to_x},0,0.025\n2,{to_x},0,0.025\n")
+            paths.append(str(path))
+        out = OUT / "users-sh-processes"
+        subprocess.run(["bash", str(ROOT / "scripts/run.sh"), "--scene", str(impetus.shipped_scene("tap")),
+                        "--trajectory", paths[0], "--user", paths[1], "--coupling", "local", "--out", str(out),
+                        "--quiet"], check=True, env=dict(os.environ))
+        trial = impetus.run_trial(impetus.shipped_scene("tap"), paths[0], "local", users=[paths[1]],
+                                  out_dir=OUT / "users-sh-python", logs=False)
+        for log in ("world.csv", "haptic.csv", "device.csv", "user1.haptic.csv", "user1.device.csv"):
+            with self.subTest(log=log):
+                text = (trial.out_dir / log).read_text()
+                self.assertGreater(len(text), 1000)
+                self.assertEqual(text, (out / log).read_text())
+        processes = json.loads((out / "summary.json").read_text())
+        self.assertEqual(len(processes["followers"]), 1)
+        self.assertEqual(processes["followers"][0]["haptic"]["impulse_by_object_Ns"],
+                         trial.summary["followers"][0]["haptic"]["impulse_by_object_Ns"])
+
     def test_users_on_one_world(self):
         # Two users squeeze the tap scene's cube (sides at x = 0.005 and 0.055 m) 10 mm deep from either side: the
         # pushes cancel, the cube stays, and the world applied for each user exactly what that user rendered.
