@@ -5,7 +5,7 @@
 #   scripts/bench.sh [--short]       --short: 5 s instead of 30 s for the real-time loop benchmark
 #
 #   1. haptic tick cost vs number of planes            build/tests/bench_haptic_tick
-#   2. world step and feature query vs object count    build/tests/bench_world
+#   2. world step and feature query vs object count, physics in the 1 kHz loop vs the 20 Hz world   build/tests/bench_world
 #   3. channel latency between processes               build/tests/bench_channel
 #   4. 1 kHz real-time loop lateness (FIFO + mlock)    build/tests/bench_rt_loop SECONDS
 #   5. lockstep throughput of the tap trial (simulated s per wall s, target >= 50x) via scripts/run.sh
@@ -44,7 +44,7 @@ bench() {
 section "1. Haptic tick cost vs number of planes (ns)"
 bench bench_haptic_tick
 
-section "2. World step and feature query vs number of objects"
+section "2. World step and feature query vs number of objects; physics in the 1 kHz loop vs the 20 Hz world"
 bench bench_world
 
 section "3. Channel latency between processes"

@@ -3,6 +3,8 @@
 //  1. World::step time for 20 / 200 / 2000 dynamic spheres on the floor (ODE dominates).
 //  2. FeatureExtractor::extract time vs number of objects at a constant density around the finger: the query must
 //     cost what is near the finger, not the size of the world. index() (once per step, O(N log N)) is shown apart.
+//  3. Physics inside the 1 kHz loop (one 1 ms ODE step per haptic tick, as CHAI3D's ODE examples run it) against our
+//     20 Hz world (ten 5 ms substeps per 50 ms period): the most spheres each holds within its own period at p99.
 // Uses world_manager symbols only.
 
 #include "world_manager/scene.h"
@@ -114,11 +116,51 @@ void bench_features() {
   }
 }
 
+// p99 of World::step over `steps` steps of `scene` at `rate_hz` with `substeps` substeps (µs).
+double step_p99_us(Scene scene, double rate_hz, int substeps, int steps) {
+  scene.physics.world_rate_hz = rate_hz;
+  scene.physics.substeps = substeps;
+  impetus::World world(scene, impetus::WorldOptions{});
+  impetus::HapticReport report{};
+  report.haptic_session = 1;
+  report.world_session = impetus::WorldOptions{}.world_session;
+  report.finger_valid = 1;
+  report.finger_m = {0.0, 0.0, 0.05};
+  std::vector<double> samples_us;
+  for (int i = 0; i < steps; ++i) {
+    report.tick = static_cast<std::uint64_t>(i);
+    const auto start = Clock::now();
+    world.step(&report);
+    samples_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+  }
+  return percentiles(samples_us).p99_us;
+}
+
+void bench_physics_in_loop() {
+  std::printf("\nPhysics in the 1 kHz loop (1 ms step, 1 substep) vs the 20 Hz world (50 ms, 10 substeps), spheres\n");
+  std::printf("%8s %22s %22s\n", "spheres", "in-loop step p99 [us]", "20 Hz step p99 [ms]");
+  int in_loop_1ms = 0, in_loop_half = 0, slow_world = 0;
+  for (int count : {125, 250, 500, 1000, 2000, 4000}) {
+    const Scene scene = sphere_field(count, 0.05);
+    const double loop_us = step_p99_us(scene, 1000.0, 1, count >= 2000 ? 100 : 300);
+    const double world_us = step_p99_us(scene, 20.0, 10, count >= 2000 ? 10 : 30);
+    std::printf("%8d %22.1f %22.2f\n", count, loop_us, world_us / 1e3);
+    if (loop_us <= 1000.0) in_loop_1ms = count;
+    if (loop_us <= 500.0) in_loop_half = count;
+    if (world_us <= 50'000.0) slow_world = count;
+  }
+  std::printf("most spheres within the period: in the 1 kHz loop %d (1 ms) / %d (0.5 ms, room for the servo); "
+              "20 Hz world %d (50 ms): %.1fx / %.1fx (of the sweep's counts)\n",
+              in_loop_1ms, in_loop_half, slow_world, in_loop_1ms > 0 ? double(slow_world) / in_loop_1ms : 0.0,
+              in_loop_half > 0 ? double(slow_world) / in_loop_half : 0.0);
+}
+
 }  // namespace
 
 int main() {
   impetus::init_ode_once();
   bench_step();
   bench_features();
+  bench_physics_in_loop();
   return 0;
 }
