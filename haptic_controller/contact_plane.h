@@ -27,8 +27,9 @@ struct ContactPlane {
   double static_friction = 0.0;
   double dynamic_friction = 0.0;
   double extent_m = 0.0;  // how far from point_m the plane describes its object; 0: unbounded (link_types.h)
-  // kPlaneBox: the box's axes (columns: body x, y, z in the world frame) and half sizes along them, m; its centre is
-  // com_m. Moved with the plane by the interpolation and the local model (shape_planes.h).
+  // kPlaneBox, kPlaneCapsule: the body's axes (columns: body x, y, z in the world frame) and half sizes along them, m
+  // (a capsule's: radius, radius, half length between its cap centres); its centre is com_m. Moved with the plane by
+  // the interpolation and the local model (shape_planes.h).
   Eigen::Matrix3d box_axes = Eigen::Matrix3d::Identity();
   Eigen::Vector3d box_half_m = Eigen::Vector3d::Zero();
 
@@ -39,13 +40,15 @@ struct ContactPlane {
   bool dynamic() const { return (flags & kPlaneDynamic) != 0; }
   bool sphere() const { return (flags & kPlaneSphere) != 0 && extent_m > 0.0; }
   bool box() const { return (flags & kPlaneBox) != 0 && (box_half_m.array() > 0.0).all(); }
+  bool capsule() const { return (flags & kPlaneCapsule) != 0 && extent_m > 0.0; }
 
   // Angular impulse about the CoM of `impulse_Ns` applied by a finger at `proxy_m`. On a flat face the push acts at
   // the proxy. On a sphere its normal part acts through the centre, so only the part along the surface (friction)
   // turns the ball, wherever on the tangent plane the proxy sits (an edge with another plane can hold it off the
-  // tangent point, and a lever there would spin a ball pushed straight).
+  // tangent point, and a lever there would spin a ball pushed straight). On a capsule likewise through the axis point
+  // under the plane's point (point − radius·normal), which may lie off the centre: a push near an end turns it.
   Eigen::Vector3d angular_impulse_Nms(const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& impulse_Ns) const {
-    if (!sphere()) return (proxy_m - com_m).cross(impulse_Ns);
+    if (!sphere() && !capsule()) return (proxy_m - com_m).cross(impulse_Ns);
     const Eigen::Vector3d normal_part = impulse_Ns.dot(normal) * normal;
     const Eigen::Vector3d centre_m = point_m - extent_m * normal;
     return (centre_m - com_m).cross(normal_part) + (proxy_m - com_m).cross(impulse_Ns - normal_part);

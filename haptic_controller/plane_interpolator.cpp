@@ -40,7 +40,7 @@ ContactPlane to_contact_plane(const Plane& plane) {
   out.static_friction = plane.static_friction;
   out.dynamic_friction = plane.dynamic_friction;
   out.extent_m = plane.extent_m;
-  if ((plane.flags & kPlaneBox) != 0) {
+  if ((plane.flags & kPlaneCarriesShape) != 0) {
     const Eigen::Vector3d x = to_eigen(plane.box_axis_x);
     const Eigen::Vector3d y = to_eigen(plane.box_axis_y);
     out.box_axes << x, y, x.cross(y);
@@ -68,7 +68,8 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, d
     const int match = find_plane(previous, now.object_id, occurrence_of(current, k));
     if (match < 0) continue;  // new object: starts at frame i's value
     const Plane& before = previous.planes[match];
-    const bool box_both = plane.box() && (before.flags & kPlaneBox) != 0;
+    // A box or capsule in both frames: its axes turn between them (the same body's: they correspond one to one).
+    const bool box_both = (plane.box() || plane.capsule()) && (before.flags & kPlaneCarriesShape) != 0;
 
     if (normals_flip(to_eigen(before.normal), to_eigen(now.normal))) {
       if (!flip_switched(w)) {

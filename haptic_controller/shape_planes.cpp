@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/shape_planes.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace impetus {
@@ -15,6 +16,20 @@ void retake_sphere(ContactPlane& plane, const Eigen::Vector3d& around_m) {
   const Eigen::Vector3d offset_m = around_m - centre_m;
   const double distance_m = offset_m.norm();
   if (!(distance_m > 0.0) || !std::isfinite(distance_m)) return;
+  plane.normal = offset_m / distance_m;
+  plane.point_m = centre_m + plane.extent_m * plane.normal;
+}
+
+// A capsule: the sphere of its radius about the axis point nearest `around_m` (the axis is the body's z through com_m,
+// between the cap centres at ±box_half_m[2]).
+void retake_capsule(ContactPlane& plane, const Eigen::Vector3d& around_m) {
+  const Eigen::Vector3d axis = plane.box_axes.col(2);
+  const double half_length_m = plane.box_half_m.z();
+  const double along_m = std::clamp(axis.dot(around_m - plane.com_m), -half_length_m, half_length_m);
+  const Eigen::Vector3d centre_m = plane.com_m + along_m * axis;
+  const Eigen::Vector3d offset_m = around_m - centre_m;
+  const double distance_m = offset_m.norm();
+  if (!(distance_m > 0.0) || !std::isfinite(distance_m)) return;  // on the axis: no direction, the plane stays
   plane.normal = offset_m / distance_m;
   plane.point_m = centre_m + plane.extent_m * plane.normal;
 }
@@ -78,6 +93,8 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m) {
       retake_sphere(plane, around_m);
     } else if (plane.box()) {
       retake_box(plane, around_m);
+    } else if (plane.capsule()) {
+      retake_capsule(plane, around_m);
     }
   }
 }

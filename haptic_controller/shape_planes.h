@@ -31,8 +31,12 @@
 
 namespace impetus {
 
+// Capsules. A capsule is the set of points within its radius of its axis segment: its plane is a sphere's about the
+// axis point nearest the proxy (kPlaneCapsule: the axes, half length and radius travel with it), so the finger
+// follows the side and rounds the caps every tick, and leaves the capsule where the capsule ends.
+//
 // Replaces each sphere plane of `planes` by the tangent plane at the sphere's point nearest `around_m` (the last
-// proxy), and each box plane whose face `around_m` has passed the rim of by the box's plane at its nearest point.
+// proxy), each capsule plane likewise about the axis point nearest it, and each box plane whose face `around_m` has passed the rim of by the box's plane at its nearest point.
 // A point at a sphere's centre, or on the box's surface, keeps the plane as it is.
 void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m);
 

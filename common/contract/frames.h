@@ -49,6 +49,12 @@ inline constexpr std::uint32_t kPlaneFlat = 1u << 2;
 // so the haptic side can take the plane again at its proxy every tick (haptic_controller/shape_planes.h) and a face's
 // plane ends where the face does.
 inline constexpr std::uint32_t kPlaneBox = 1u << 3;
+// A capsule's plane: the capsule travels with it (its axis is box_axis_x × box_axis_y through com_m, its radius
+// extent_m, the half distance between its cap centres box_half_m[2]), so the haptic side takes the tangent plane again
+// at the point nearest its proxy every tick, as for a sphere about the axis point nearest the proxy.
+inline constexpr std::uint32_t kPlaneCapsule = 1u << 4;
+// The planes that carry their body's axes and half sizes (box_axis_x, box_axis_y, box_half_m).
+inline constexpr std::uint32_t kPlaneCarriesShape = kPlaneBox | kPlaneCapsule;
 
 // LocalContact flags.
 // The other side holds a push along −normal: static geometry, or a body joined to static geometry by a chain of
@@ -83,8 +89,9 @@ struct Plane {
   // How far from point_m the plane still describes the object (world_manager/features/body_geometry.h plane_extent_m): a
   // sphere's radius, a box's diagonal. 0: unbounded (the floor).
   double extent_m = 0.0;
-  // kPlaneBox only: the box's body x and y axes in the world frame (unit, orthogonal; z = x × y) and its half sizes
-  // along x, y, z (m, > 0). Zero otherwise.
+  // kPlaneBox or kPlaneCapsule: the body's x and y axes in the world frame (unit, orthogonal; z = x × y) and its half
+  // sizes along x, y, z (m): a box's (> 0), a capsule's radius, radius and half length between its cap centres (≥ 0).
+  // Zero otherwise.
   Vec3 box_axis_x{};
   Vec3 box_axis_y{};
   Vec3 box_half_m{};

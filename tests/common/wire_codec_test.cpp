@@ -90,6 +90,17 @@ TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {
   CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_axis_y = {0.1, 0.995, 0.0}; }) == FrameError::bad_box);
   CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_half_m[1] = 0.0; }) == FrameError::bad_box);
   CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_half_m[2] = nan; }) == FrameError::not_finite);
+  // A capsule's likewise, its half length between the cap centres may be 0 (a ball), its radius not.
+  const auto capsule = [&](PlaneFrame& f) {
+    box(f);
+    f.planes[0].flags = kPlaneCapsule;
+    f.planes[0].box_half_m = {0.01, 0.01, 0.0};
+  };
+  CHECK(rejected(capsule) == FrameError::ok);
+  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].box_half_m[0] = 0.0; }) == FrameError::bad_box);
+  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].box_half_m[2] = -0.01; }) == FrameError::bad_box);
+  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].box_axis_x = {0.0, 1.0, 0.0}; }) ==
+        FrameError::bad_box);
   // Planes past the count are not looked at: garbage there is harmless.
   CHECK(rejected([&](PlaneFrame& f) { f.planes[5].point_m[0] = nan; }) == FrameError::ok);
 

@@ -177,3 +177,96 @@ TEST_CASE("box planes: between world frames a finger that slides off an edge is 
   CHECK(std::abs(final_force.z()) < 1e-9);
   CHECK(proxies.back().x() == Approx(0.05).margin(1e-12));
 }
+
+namespace {
+
+// A capsule of radius 1 cm, 6 cm between its cap centres, its axis along the turned body z, lying at `centre`; its
+// plane as the world gave it for a query above its middle.
+Plane capsule_plane(const Vector3d& centre, const Eigen::Quaterniond& turn) {
+  const Eigen::Matrix3d axes = turn.toRotationMatrix();
+  const Vector3d up = axes.col(0);  // the body x: square to the axis
+  Plane plane = test::wire_plane(6, centre + 0.01 * up, up, false);
+  plane.flags |= kPlaneCapsule;
+  plane.extent_m = 0.01;
+  plane.com_m = to_vec3(centre);
+  plane.box_axis_x = to_vec3(axes.col(0));
+  plane.box_axis_y = to_vec3(axes.col(1));
+  plane.box_half_m = {0.01, 0.01, 0.03};
+  return plane;
+}
+
+}  // namespace
+
+TEST_CASE("capsule planes: the tangent plane about the axis point nearest the proxy, along the side and round the "
+          "caps, in any orientation") {
+  for (const Eigen::Quaterniond& turn :
+       {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()))}) {
+    const Eigen::Matrix3d axes = turn.toRotationMatrix();
+    const Vector3d centre(0.02, -0.01, 0.03);
+    const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
+    ContactPlane plane = to_contact_plane(capsule_plane(centre, turn));
+    REQUIRE(plane.capsule());
+    PlaneSet planes = make_set({plane});
+    // Beside the side, 2 cm along the axis from the middle: the side's plane there, not the middle's.
+    retake_shape_planes(planes, at(0.0, 0.015, 0.02));
+    CHECK((planes.planes[0].normal - axes.col(1)).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(0.0, 0.01, 0.02)).norm() < 1e-12);
+    // Beyond an end, off the axis: the cap's sphere about the cap centre.
+    const Vector3d beyond = at(0.01, 0.0, 0.04);
+    retake_shape_planes(planes, beyond);
+    const Vector3d cap_centre = at(0.0, 0.0, 0.03);
+    CHECK((planes.planes[0].normal - (beyond - cap_centre).normalized()).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - (cap_centre + 0.01 * (beyond - cap_centre).normalized())).norm() < 1e-12);
+    // A push along the normal at a cap turns the capsule about its centre (its line of action misses the CoM); one
+    // straight into the side at the middle does not.
+    const Vector3d push = -0.002 * planes.planes[0].normal;
+    CHECK(planes.planes[0].angular_impulse_Nms(planes.planes[0].point_m, push).norm() > 1e-6);
+    retake_shape_planes(planes, at(0.02, 0.0, 0.0));
+    CHECK(planes.planes[0].angular_impulse_Nms(planes.planes[0].point_m, -0.002 * planes.planes[0].normal).norm() <
+          1e-17);
+    // On the axis: no direction, the plane stays.
+    const ContactPlane before = planes.planes[0];
+    retake_shape_planes(planes, at(0.0, 0.0, 0.01));
+    CHECK(planes.planes[0].normal == before.normal);
+  }
+}
+
+TEST_CASE("capsule planes: between world frames a finger that slides off a capsule's end is let go as it leaves, and "
+          "it follows the cap down") {
+  // A capsule lying along x on the floor (axis at z = 1 cm, cap centres at x = ±3 cm), one world frame with its plane
+  // at the top of its middle, and a finger that within that period presses 2 mm into the top and slides along x past
+  // the +x cap.
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitY()));  // body z along world x
+  const Vector3d centre(0.0, 0.0, 0.01);
+  Plane world_plane = capsule_plane(centre, turn);
+  world_plane.point_m = to_vec3(centre + Vector3d(0, 0, 0.01));
+  world_plane.normal = {0.0, 0.0, 1.0};
+  ServoOptions options;
+  HapticServo servo(options, 5);
+  servo.on_plane_frame(test::make_frame({world_plane}), 0.0);
+  int tick = 0;
+  double last_force_x_m = -1.0, max_force_N = 0.0;
+  for (int k = 0; k <= 40; ++k) {
+    // From above the top, 2 mm into it over 5 ticks (a finger that starts inside is not pushed out), then along x out
+    // to x = 7 cm.
+    FingerSample finger;
+    finger.position_m = k <= 5 ? Vector3d(-0.01, 0.0, 0.03 - 0.012 * k / 5.0)
+                               : Vector3d(-0.01 + 0.08 * (k - 5) / 35.0, 0.0, 0.018);
+    finger.valid = true;
+    ++tick;
+    const TickResult& r = servo.tick(&finger, tick * 1e-3, 1e-3);
+    const Vector3d force = to_eigen(r.force_N);
+    const Vector3d proxy = to_eigen(r.proxy_m);
+    max_force_N = std::max(max_force_N, force.norm());
+    if (force.norm() > 1e-9) last_force_x_m = finger.position_m.x();
+    // The proxy never enters the capsule (beyond rounding): its distance from the axis segment is at least the radius.
+    const double along_m = std::clamp(proxy.x(), -0.03, 0.03);
+    CHECK((proxy - Vector3d(along_m, 0.0, 0.01)).norm() > 0.01 - 1e-9);
+  }
+  REQUIRE(tick < 50);  // all within one world period
+  CHECK(max_force_N > 1.0);
+  // The finger 18 mm up leaves the cap's sphere (radius 1 cm about x = 3 cm, z = 1 cm) at x = 3 cm + √(1e-4 − 0.8²e-4)
+  // = 3.6 cm; with the face's plane it would have been pressed until the next frame.
+  CHECK(last_force_x_m < 0.036 + 0.002);
+  CHECK(last_force_x_m > 0.03);
+}

@@ -151,6 +151,35 @@ TEST_CASE("more objects within reach than a frame holds: the nearest kMaxPlanes 
   }
 }
 
+TEST_CASE("a capsule's plane carries the capsule: its axes, radius and half length, not a flat face's flag") {
+  impetus::Scene scene;
+  scene.source_name = "test";
+  impetus::SceneObject rod;
+  rod.name = "rod";
+  rod.shape.kind = impetus::ShapeKind::capsule;
+  rod.shape.radius_m = 0.01;
+  rod.shape.length_m = 0.06;
+  rod.dynamic = true;
+  rod.mass_kg = 0.1;
+  rod.position_m = {0.0, 0.0, 0.01};
+  rod.orientation_wxyz = {std::cos(M_PI / 4), 0.0, std::sin(M_PI / 4), 0.0};  // lying along x
+  scene.objects.push_back(rod);
+  auto world = impetus::test::make_world(scene);
+  impetus::HapticReport report = impetus::test::make_report(1, 50, {0.02, 0.0, 0.03}, true);
+  report.proxy_m = report.finger_m;  // the world takes the planes around the proxy
+  const impetus::PlaneFrame& frame = world->step(&report);
+  REQUIRE(frame.plane_count >= 1);
+  const impetus::Plane& plane = frame.planes[0].object_id == 0 ? frame.planes[0] : frame.planes[1];
+  CHECK(plane.flags == (impetus::kPlaneDynamic | impetus::kPlaneCapsule));
+  CHECK(plane.extent_m == 0.01);
+  CHECK(plane.box_half_m == impetus::Vec3{0.01, 0.01, 0.03});
+  // Its axis (x × y, the body z) lies along the world x, and the plane is the side's above the query.
+  const Eigen::Vector3d axis = impetus::to_eigen(plane.box_axis_x).cross(impetus::to_eigen(plane.box_axis_y));
+  CHECK(std::abs(axis.x()) == Approx(1.0).margin(1e-3));
+  CHECK(plane.normal[2] == Approx(1.0).margin(1e-3));
+  CHECK(plane.point_m[0] == Approx(0.02).margin(1e-3));
+}
+
 TEST_CASE("planes carry the object's state, friction and the floor") {
   const Scene scene = impetus::load_scene(impetus::test::scene_path("tap.json"));
   auto world = impetus::test::make_world(scene);

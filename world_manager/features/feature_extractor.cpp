@@ -191,12 +191,14 @@ Plane FeatureExtractor::make_plane(const ReachCandidate& candidate, std::span<co
   const SceneObject& object = scene_.objects[static_cast<std::size_t>(candidate.object_id)];
   plane.flags = object.dynamic ? kPlaneDynamic : 0u;
   if (object.shape.kind == ShapeKind::sphere) plane.flags |= kPlaneSphere;
-  if (object.shape.kind == ShapeKind::box) {
-    plane.flags |= kPlaneFlat | kPlaneBox;
+  if (object.shape.kind == ShapeKind::box || object.shape.kind == ShapeKind::capsule) {
+    const bool box = object.shape.kind == ShapeKind::box;
+    plane.flags |= box ? (kPlaneFlat | kPlaneBox) : kPlaneCapsule;
     const Eigen::Matrix3d axes = state.pose.orientation.toRotationMatrix();
     plane.box_axis_x = to_vec3(axes.col(0));
     plane.box_axis_y = to_vec3(axes.col(1));
-    plane.box_half_m = to_vec3(0.5 * to_eigen(object.shape.box_size_m));
+    plane.box_half_m = box ? to_vec3(0.5 * to_eigen(object.shape.box_size_m))
+                           : Vec3{object.shape.radius_m, object.shape.radius_m, 0.5 * object.shape.length_m};
   }
   plane.extent_m = plane_extent_m(object.shape);
   plane.com_m = to_vec3(state.pose.position_m);

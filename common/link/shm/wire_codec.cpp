@@ -118,7 +118,7 @@ FrameError validate(const wire::PlaneFrame& frame) {
       return FrameError::not_finite;
     }
     if (plane.extent_m < 0.0) return FrameError::bad_reach;
-    if ((plane.flags & kPlaneBox) != 0) {
+    if ((plane.flags & kPlaneCarriesShape) != 0) {
       if (!all_finite(plane.box_axis_x) || !all_finite(plane.box_axis_y) || !all_finite(plane.box_half_m)) {
         return FrameError::not_finite;
       }
@@ -126,7 +126,8 @@ FrameError validate(const wire::PlaneFrame& frame) {
       if (std::fabs(dot(plane.box_axis_x, plane.box_axis_x) - 1.0) > kUnitNormalTolerance ||
           std::fabs(dot(plane.box_axis_y, plane.box_axis_y) - 1.0) > kUnitNormalTolerance ||
           std::fabs(dot(plane.box_axis_x, plane.box_axis_y)) > kUnitNormalTolerance ||
-          !(plane.box_half_m[0] > 0.0 && plane.box_half_m[1] > 0.0 && plane.box_half_m[2] > 0.0)) {
+          !(plane.box_half_m[0] > 0.0 && plane.box_half_m[1] > 0.0 &&
+            ((plane.flags & kPlaneBox) != 0 ? plane.box_half_m[2] > 0.0 : plane.box_half_m[2] >= 0.0))) {
         return FrameError::bad_box;
       }
     }
