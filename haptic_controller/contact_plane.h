@@ -41,6 +41,7 @@ struct ContactPlane {
   bool sphere() const { return (flags & kPlaneSphere) != 0 && extent_m > 0.0; }
   bool box() const { return (flags & kPlaneBox) != 0 && (box_half_m.array() > 0.0).all(); }
   bool capsule() const { return (flags & kPlaneCapsule) != 0 && extent_m > 0.0; }
+  bool cylinder() const { return (flags & kPlaneCylinder) != 0 && extent_m > 0.0 && box_half_m.z() > 0.0; }
 
   // Angular impulse about the CoM of `impulse_Ns` applied by a finger at `proxy_m`. On a flat face the push acts at
   // the proxy. On a sphere its normal part acts through the centre, so only the part along the surface (friction)

@@ -69,7 +69,8 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, d
     if (match < 0) continue;  // new object: starts at frame i's value
     const Plane& before = previous.planes[match];
     // A box or capsule in both frames: its axes turn between them (the same body's: they correspond one to one).
-    const bool box_both = (plane.box() || plane.capsule()) && (before.flags & kPlaneCarriesShape) != 0;
+    const bool box_both =
+        (plane.box() || plane.capsule() || plane.cylinder()) && (before.flags & kPlaneCarriesShape) != 0;
 
     if (normals_flip(to_eigen(before.normal), to_eigen(now.normal))) {
       if (!flip_switched(w)) {

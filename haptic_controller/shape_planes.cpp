@@ -34,6 +34,31 @@ void retake_capsule(ContactPlane& plane, const Eigen::Vector3d& around_m) {
   plane.point_m = centre_m + plane.extent_m * plane.normal;
 }
 
+// A cylinder: its side is curved, its caps flat. The plane is the side's (normal square to the axis) or a cap's (the
+// normal nearer the axis). Beside the side a side plane is the tangent plane under the proxy; over its cap a cap plane
+// stays as the interpolation or the local model made it, as a box face's does; past the plane's own part (round a
+// rim, or onto the other part) the cylinder's nearest point, its normal from there to the proxy. A proxy on the
+// surface or inside keeps the plane (the world chose it).
+void retake_cylinder(ContactPlane& plane, const Eigen::Vector3d& around_m) {
+  const Eigen::Vector3d local_m = plane.box_axes.transpose() * (around_m - plane.com_m);  // body frame, axis z
+  const double radius_m = plane.extent_m;
+  const double half_length_m = plane.box_half_m.z();
+  const Eigen::Vector3d normal_local = plane.box_axes.transpose() * plane.normal;
+  const bool cap_plane = std::abs(normal_local.z()) > std::hypot(normal_local.x(), normal_local.y());
+  const double radial_m = std::hypot(local_m.x(), local_m.y());
+  const bool beside = radial_m > radius_m + kOnSurface_m;
+  const bool beyond_cap = std::abs(local_m.z()) > half_length_m + kOnSurface_m;
+  if (!beside && !beyond_cap) return;  // on the surface or inside
+  if (cap_plane && !beside && local_m.z() * normal_local.z() > 0.0) return;  // over its own cap
+  Eigen::Vector3d nearest_local_m(local_m.x(), local_m.y(), std::clamp(local_m.z(), -half_length_m, half_length_m));
+  if (beside) nearest_local_m.head<2>() *= radius_m / radial_m;
+  const Eigen::Vector3d offset_local_m = local_m - nearest_local_m;
+  const double distance_m = offset_local_m.norm();
+  if (!(distance_m > 0.0) || !std::isfinite(distance_m)) return;
+  plane.normal = plane.box_axes * (offset_local_m / distance_m);
+  plane.point_m = plane.com_m + plane.box_axes * nearest_local_m;
+}
+
 void retake_box(ContactPlane& plane, const Eigen::Vector3d& around_m) {
   const Eigen::Vector3d local_m = plane.box_axes.transpose() * (around_m - plane.com_m);  // box frame
   const Eigen::Vector3d& half_m = plane.box_half_m;
@@ -95,6 +120,8 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m) {
       retake_box(plane, around_m);
     } else if (plane.capsule()) {
       retake_capsule(plane, around_m);
+    } else if (plane.cylinder()) {
+      retake_cylinder(plane, around_m);
     }
   }
 }

@@ -35,6 +35,10 @@ namespace impetus {
 // axis point nearest the proxy (kPlaneCapsule: the axes, half length and radius travel with it), so the finger
 // follows the side and rounds the caps every tick, and leaves the capsule where the capsule ends.
 //
+// Cylinders. Flat caps and a curved side (kPlaneCylinder: axes, half length and radius travel with it): a cap's plane
+// ends at its rim as a box face's does, a side's plane is taken again under the proxy every tick, and past either
+// the plane is the cylinder's nearest rim or part.
+//
 // Replaces each sphere plane of `planes` by the tangent plane at the sphere's point nearest `around_m` (the last
 // proxy), each capsule plane likewise about the axis point nearest it, and each box plane whose face `around_m` has passed the rim of by the box's plane at its nearest point.
 // A point at a sphere's centre, or on the box's surface, keeps the plane as it is.

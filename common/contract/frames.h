@@ -53,8 +53,12 @@ inline constexpr std::uint32_t kPlaneBox = 1u << 3;
 // extent_m, the half distance between its cap centres box_half_m[2]), so the haptic side takes the tangent plane again
 // at the point nearest its proxy every tick, as for a sphere about the axis point nearest the proxy.
 inline constexpr std::uint32_t kPlaneCapsule = 1u << 4;
+// A cylinder's plane: the cylinder travels with it (its axis is box_axis_x × box_axis_y through com_m, its radius
+// extent_m, its half length box_half_m[2]), so the haptic side takes its side's tangent plane again at the proxy every
+// tick and a cap's plane ends at the cap's rim, as a box face's does.
+inline constexpr std::uint32_t kPlaneCylinder = 1u << 5;
 // The planes that carry their body's axes and half sizes (box_axis_x, box_axis_y, box_half_m).
-inline constexpr std::uint32_t kPlaneCarriesShape = kPlaneBox | kPlaneCapsule;
+inline constexpr std::uint32_t kPlaneCarriesShape = kPlaneBox | kPlaneCapsule | kPlaneCylinder;
 
 // LocalContact flags.
 // The other side holds a push along −normal: static geometry, or a body joined to static geometry by a chain of
@@ -90,7 +94,8 @@ struct Plane {
   // sphere's radius, a box's diagonal. 0: unbounded (the floor).
   double extent_m = 0.0;
   // kPlaneBox or kPlaneCapsule: the body's x and y axes in the world frame (unit, orthogonal; z = x × y) and its half
-  // sizes along x, y, z (m): a box's (> 0), a capsule's radius, radius and half length between its cap centres (≥ 0).
+  // sizes along x, y, z (m): a box's (> 0), a capsule's radius, radius and half length between its cap centres (≥ 0),
+  // a cylinder's radius, radius and half length (> 0).
   // Zero otherwise.
   Vec3 box_axis_x{};
   Vec3 box_axis_y{};

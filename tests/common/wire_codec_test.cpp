@@ -101,6 +101,13 @@ TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {
   CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].box_half_m[2] = -0.01; }) == FrameError::bad_box);
   CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].box_axis_x = {0.0, 1.0, 0.0}; }) ==
         FrameError::bad_box);
+  // A cylinder's: a length it must have.
+  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].flags = kPlaneCylinder; }) == FrameError::bad_box);
+  CHECK(rejected([&](PlaneFrame& f) {
+          capsule(f);
+          f.planes[0].flags = kPlaneCylinder;
+          f.planes[0].box_half_m[2] = 0.03;
+        }) == FrameError::ok);
   // Planes past the count are not looked at: garbage there is harmless.
   CHECK(rejected([&](PlaneFrame& f) { f.planes[5].point_m[0] = nan; }) == FrameError::ok);
 

@@ -270,3 +270,56 @@ TEST_CASE("capsule planes: between world frames a finger that slides off a capsu
   CHECK(last_force_x_m < 0.036 + 0.002);
   CHECK(last_force_x_m > 0.03);
 }
+
+namespace {
+
+// A cylinder of radius 2 cm and length 6 cm standing on end (axis along the turned body z) at `centre`, its plane the
+// top cap's where the world saw the finger, above the middle.
+ContactPlane cylinder_top_plane(const Vector3d& centre, const Eigen::Quaterniond& turn) {
+  const Eigen::Matrix3d axes = turn.toRotationMatrix();
+  Plane plane = test::wire_plane(7, centre + 0.03 * axes.col(2), axes.col(2), false);
+  plane.flags |= kPlaneCylinder;
+  plane.extent_m = 0.02;
+  plane.com_m = to_vec3(centre);
+  plane.box_axis_x = to_vec3(axes.col(0));
+  plane.box_axis_y = to_vec3(axes.col(1));
+  plane.box_half_m = {0.02, 0.02, 0.03};
+  return to_contact_plane(plane);
+}
+
+}  // namespace
+
+TEST_CASE("cylinder planes: a cap's plane stays over the cap and ends at its rim, the side's follows the proxy") {
+  for (const Eigen::Quaterniond& turn :
+       {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(1.1, Vector3d(3, -1, 2).normalized()))}) {
+    const Eigen::Matrix3d axes = turn.toRotationMatrix();
+    const Vector3d centre(-0.01, 0.02, 0.05);
+    const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
+    const ContactPlane top = cylinder_top_plane(centre, turn);
+    REQUIRE(top.cylinder());
+    // Over the cap, anywhere within the rim: the plane stays as it came.
+    PlaneSet planes = make_set({top});
+    retake_shape_planes(planes, at(0.015, -0.005, 0.04));
+    CHECK(planes.planes[0].normal == top.normal);
+    CHECK(planes.planes[0].point_m == top.point_m);
+    // Past the rim, above the cap's level: the rim's nearest point, its normal toward the proxy.
+    const Vector3d past = at(0.025, 0.0, 0.032);
+    retake_shape_planes(planes, past);
+    const Vector3d rim = at(0.02, 0.0, 0.03);
+    CHECK((planes.planes[0].point_m - rim).norm() < 1e-12);
+    CHECK((planes.planes[0].normal - (past - rim).normalized()).norm() < 1e-12);
+    // Beside the side, below the cap: the side's tangent plane there.
+    planes = make_set({top});
+    retake_shape_planes(planes, at(0.0, 0.03, 0.01));
+    CHECK((planes.planes[0].normal - axes.col(1)).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(0.0, 0.02, 0.01)).norm() < 1e-12);
+    // A side's plane beside the side: taken again under the proxy as it moves round.
+    retake_shape_planes(planes, at(-0.03, 0.0, -0.02));
+    CHECK((planes.planes[0].normal + axes.col(0)).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(-0.02, 0.0, -0.02)).norm() < 1e-12);
+    // On the surface or inside: as it was.
+    const ContactPlane before = planes.planes[0];
+    retake_shape_planes(planes, at(0.0, 0.0, 0.0));
+    CHECK(planes.planes[0].normal == before.normal);
+  }
+}

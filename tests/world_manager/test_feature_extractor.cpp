@@ -151,7 +151,7 @@ TEST_CASE("more objects within reach than a frame holds: the nearest kMaxPlanes 
   }
 }
 
-TEST_CASE("a capsule's plane carries the capsule: its axes, radius and half length, not a flat face's flag") {
+TEST_CASE("a capsule's and a cylinder's plane carry their body: its axes, radius and half length, not a flat face's flag") {
   impetus::Scene scene;
   scene.source_name = "test";
   impetus::SceneObject rod;
@@ -178,6 +178,14 @@ TEST_CASE("a capsule's plane carries the capsule: its axes, radius and half leng
   CHECK(std::abs(axis.x()) == Approx(1.0).margin(1e-3));
   CHECK(plane.normal[2] == Approx(1.0).margin(1e-3));
   CHECK(plane.point_m[0] == Approx(0.02).margin(1e-3));
+  // The same body as a cylinder: its own flag, the same frame.
+  scene.objects[0].shape.kind = impetus::ShapeKind::cylinder;
+  auto cylinder_world = impetus::test::make_world(scene);
+  const impetus::PlaneFrame& cylinder_frame = cylinder_world->step(&report);
+  const impetus::Plane& side =
+      cylinder_frame.planes[0].object_id == 0 ? cylinder_frame.planes[0] : cylinder_frame.planes[1];
+  CHECK(side.flags == (impetus::kPlaneDynamic | impetus::kPlaneCylinder));
+  CHECK(side.box_half_m == impetus::Vec3{0.01, 0.01, 0.03});
 }
 
 TEST_CASE("planes carry the object's state, friction and the floor") {

@@ -191,9 +191,10 @@ Plane FeatureExtractor::make_plane(const ReachCandidate& candidate, std::span<co
   const SceneObject& object = scene_.objects[static_cast<std::size_t>(candidate.object_id)];
   plane.flags = object.dynamic ? kPlaneDynamic : 0u;
   if (object.shape.kind == ShapeKind::sphere) plane.flags |= kPlaneSphere;
-  if (object.shape.kind == ShapeKind::box || object.shape.kind == ShapeKind::capsule) {
+  if (object.shape.kind != ShapeKind::sphere) {
     const bool box = object.shape.kind == ShapeKind::box;
-    plane.flags |= box ? (kPlaneFlat | kPlaneBox) : kPlaneCapsule;
+    plane.flags |= box ? (kPlaneFlat | kPlaneBox)
+                       : object.shape.kind == ShapeKind::capsule ? kPlaneCapsule : kPlaneCylinder;
     const Eigen::Matrix3d axes = state.pose.orientation.toRotationMatrix();
     plane.box_axis_x = to_vec3(axes.col(0));
     plane.box_axis_y = to_vec3(axes.col(1));

@@ -127,7 +127,7 @@ FrameError validate(const wire::PlaneFrame& frame) {
           std::fabs(dot(plane.box_axis_y, plane.box_axis_y) - 1.0) > kUnitNormalTolerance ||
           std::fabs(dot(plane.box_axis_x, plane.box_axis_y)) > kUnitNormalTolerance ||
           !(plane.box_half_m[0] > 0.0 && plane.box_half_m[1] > 0.0 &&
-            ((plane.flags & kPlaneBox) != 0 ? plane.box_half_m[2] > 0.0 : plane.box_half_m[2] >= 0.0))) {
+            ((plane.flags & kPlaneCapsule) != 0 ? plane.box_half_m[2] >= 0.0 : plane.box_half_m[2] > 0.0))) {
         return FrameError::bad_box;
       }
     }
