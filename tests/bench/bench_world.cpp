@@ -58,26 +58,31 @@ Scene sphere_field(int count, double spacing_m) {
   return scene;
 }
 
+// World::step times over `steps` steps of `scene` at `rate_hz` with `substeps` substeps, a finger resting above.
+Percentiles step_percentiles(Scene scene, double rate_hz, int substeps, int steps) {
+  scene.physics.world_rate_hz = rate_hz;
+  scene.physics.substeps = substeps;
+  impetus::World world(scene, impetus::WorldOptions{});
+  impetus::HapticReport report{};
+  report.haptic_session = 1;
+  report.world_session = impetus::WorldOptions{}.world_session;
+  report.finger_valid = 1;
+  report.finger_m = {0.0, 0.0, 0.05};
+  std::vector<double> samples_us;
+  for (int i = 0; i < steps; ++i) {
+    report.tick = static_cast<std::uint64_t>(i);
+    const auto start = Clock::now();
+    world.step(&report);
+    samples_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+  }
+  return percentiles(samples_us);
+}
+
 void bench_step() {
   std::printf("World::step (20 Hz, 10 substeps), spheres on the floor\n");
   std::printf("%8s %12s %12s\n", "spheres", "p50 [us]", "p99 [us]");
   for (int count : {20, 200, 2000}) {
-    const Scene scene = sphere_field(count, 0.05);
-    impetus::World world(scene, impetus::WorldOptions{});
-    impetus::HapticReport report{};
-    report.haptic_session = 1;
-    report.world_session = impetus::WorldOptions{}.world_session;
-    report.finger_valid = 1;
-    report.finger_m = {0.0, 0.0, 0.05};
-    const int steps = count >= 2000 ? 40 : 200;
-    std::vector<double> samples_us;
-    for (int i = 0; i < steps; ++i) {
-      report.tick = static_cast<std::uint64_t>(50 * i);
-      const auto start = Clock::now();
-      world.step(&report);
-      samples_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-    }
-    const Percentiles p = percentiles(samples_us);
+    const Percentiles p = step_percentiles(sphere_field(count, 0.05), 20.0, 10, count >= 2000 ? 40 : 200);
     std::printf("%8d %12.1f %12.1f\n", count, p.p50_us, p.p99_us);
   }
 }
@@ -116,34 +121,14 @@ void bench_features() {
   }
 }
 
-// p99 of World::step over `steps` steps of `scene` at `rate_hz` with `substeps` substeps (µs).
-double step_p99_us(Scene scene, double rate_hz, int substeps, int steps) {
-  scene.physics.world_rate_hz = rate_hz;
-  scene.physics.substeps = substeps;
-  impetus::World world(scene, impetus::WorldOptions{});
-  impetus::HapticReport report{};
-  report.haptic_session = 1;
-  report.world_session = impetus::WorldOptions{}.world_session;
-  report.finger_valid = 1;
-  report.finger_m = {0.0, 0.0, 0.05};
-  std::vector<double> samples_us;
-  for (int i = 0; i < steps; ++i) {
-    report.tick = static_cast<std::uint64_t>(i);
-    const auto start = Clock::now();
-    world.step(&report);
-    samples_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-  }
-  return percentiles(samples_us).p99_us;
-}
-
 void bench_physics_in_loop() {
   std::printf("\nPhysics in the 1 kHz loop (1 ms step, 1 substep) vs the 20 Hz world (50 ms, 10 substeps), spheres\n");
   std::printf("%8s %22s %22s\n", "spheres", "in-loop step p99 [us]", "20 Hz step p99 [ms]");
   int in_loop_1ms = 0, in_loop_half = 0, slow_world = 0;
   for (int count : {125, 250, 500, 1000, 2000, 4000}) {
     const Scene scene = sphere_field(count, 0.05);
-    const double loop_us = step_p99_us(scene, 1000.0, 1, count >= 2000 ? 100 : 300);
-    const double world_us = step_p99_us(scene, 20.0, 10, count >= 2000 ? 10 : 30);
+    const double loop_us = step_percentiles(scene, 1000.0, 1, count >= 2000 ? 100 : 300).p99_us;
+    const double world_us = step_percentiles(scene, 20.0, 10, count >= 2000 ? 10 : 30).p99_us;
     std::printf("%8d %22.1f %22.2f\n", count, loop_us, world_us / 1e3);
     if (loop_us <= 1000.0) in_loop_1ms = count;
     if (loop_us <= 500.0) in_loop_half = count;
