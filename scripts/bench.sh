@@ -12,6 +12,7 @@
 #   6. peak RSS of each process during a tap trial
 #   7. the world view: snapshot size and cost per world step, a viewer's read and encode   build/tests/bench_world_view
 #   8. world link one-way latency, shared memory and DDS, and DDS across a veth   build/tests/bench_dds_link
+#   9. ghost force, release, lost walls and pop-through in clutter   build/tests/bench_ghost_force
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -20,7 +21,7 @@ rt_seconds=30
 while (($#)); do
   case "$1" in
     --short) rt_seconds=5; shift ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -143,3 +144,6 @@ else
   remove_hosts
   echo "(DDS across a veth skipped: network namespaces need root and iproute2)"
 fi
+
+section "9. Ghost force between world frames in static clutter, scored against the true geometry (docs/ghost_force.md)"
+bench bench_ghost_force

@@ -1,0 +1,166 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// What the finger feels between world frames, scored against the true geometry: a world stepping at 20 or 10 Hz
+// sends its planes to a 1 kHz servo (as the in-process loop does, without a device), a finger wanders through static
+// clutter of boxes, capsules, cylinders and spheres in every orientation, and each tick is scored by the finger's and
+// the proxy's signed distances to the objects as they truly are. Frictionless: the exact god-object then renders no
+// force wherever its proxy can reach the finger, which it surely can when the finger is outside every object and the
+// straight way from the proxy to it is clear (the finger here follows its path whatever the force, so it may pass
+// right through an object; a god-object is then still held on the side it came in by, and that force is not a
+// ghost).
+//   ghost tick      force > 0.1 N while the finger is more than 0.1 mm outside every object and the segment from
+//                   the proxy to it clear of them
+//   contact tick    the finger more than 0.1 mm inside some object
+//   lost wall       the finger more than 1 mm inside some object and force < 0.1 N
+//   pop-through     the proxy more than 0.5 mm inside some object
+//   release         from the finger leaving the last object to the force falling under 0.1 N
+
+#include "haptic_controller/servo.h"
+#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/features/body_geometry.h"
+#include "world_manager/scene.h"
+#include "world_manager/world.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+namespace impetus::test {
+
+inline constexpr double kForce_N = 0.1;       // "some force": 0.05 mm of the 2 kN/m spring
+inline constexpr double kOutside_m = 1e-4;    // clearly outside or inside: the spring's 0.2 N
+inline constexpr double kDeep_m = 1e-3;       // a wall the exact god-object would push back from with 2 N
+inline constexpr double kPopThrough_m = 5e-4;
+
+struct Score {
+  int ticks = 0;
+  int contact_ticks = 0;
+  int ghost_ticks = 0;
+  int lost_wall_ticks = 0;
+  int pop_through_ticks = 0;
+  double worst_release_ms = 0.0;
+  double ghost_fraction() const { return contact_ticks > 0 ? double(ghost_ticks) / contact_ticks : 0.0; }
+};
+
+// `count` static objects of mixed shapes (2–3 cm) in random poses within a 12 cm cube about the origin, floating
+// (no floor), frictionless. Seeded: the same clutter every run.
+inline Scene clutter(int count, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Scene scene;
+  scene.source_name = "clutter";
+  scene.floor.present = false;
+  for (int k = 0; k < count; ++k) {
+    SceneObject object;
+    object.name = "o";  // appended, not "o" + ...: GCC 12 reports a false -Wrestrict on that
+    object.name += std::to_string(k);
+    object.dynamic = false;
+    object.material.static_friction = 0.0;
+    object.material.dynamic_friction = 0.0;
+    const int kind = k % 4;
+    const double size_m = 0.02 + 0.01 * unit(random);
+    if (kind == 0) {
+      object.shape.kind = ShapeKind::box;
+      object.shape.box_size_m = {size_m, 0.7 * size_m + 0.005, 0.5 * size_m + 0.005};
+    } else if (kind == 1) {
+      object.shape.kind = ShapeKind::capsule;
+      object.shape.radius_m = 0.3 * size_m;
+      object.shape.length_m = size_m;
+    } else if (kind == 2) {
+      object.shape.kind = ShapeKind::cylinder;
+      object.shape.radius_m = 0.4 * size_m;
+      object.shape.length_m = size_m;
+    } else {
+      object.shape.kind = ShapeKind::sphere;
+      object.shape.radius_m = 0.4 * size_m;
+    }
+    object.mass_kg = 0.1;
+    object.position_m = {0.12 * (unit(random) - 0.5), 0.12 * (unit(random) - 0.5), 0.12 * (unit(random) - 0.5)};
+    const Eigen::Quaterniond turn = Eigen::Quaterniond::UnitRandom();
+    object.orientation_wxyz = {turn.w(), turn.x(), turn.y(), turn.z()};
+    scene.objects.push_back(object);
+  }
+  return scene;
+}
+
+// A finger wandering through the clutter at about 0.2 m/s: a sum of incommensurate sines, never leaving the 12 cm
+// cube.
+inline Eigen::Vector3d wander(double t_s) {
+  return {0.05 * std::sin(2.1 * t_s) + 0.01 * std::sin(7.3 * t_s), 0.05 * std::sin(1.7 * t_s + 1.0),
+          0.05 * std::sin(1.3 * t_s + 2.0) + 0.01 * std::cos(5.9 * t_s)};
+}
+
+// Signed distance of `point` to the nearest object (negative inside).
+inline double nearest_m(const Scene& scene, const std::vector<BodyPose>& poses, const Eigen::Vector3d& point_m) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < scene.objects.size(); ++k) {
+    nearest = std::min(nearest, nearest_surface_point(scene.objects[k].shape, poses[k], point_m).signed_distance_m);
+  }
+  return nearest;
+}
+
+// Whether the segment from `from_m` to `to_m` stays clear of every object (no sample 0.1 mm inside one), sampled
+// every 0.25 mm past its first 0.25 mm (the proxy rests on a surface).
+inline bool clear_way(const Scene& scene, const std::vector<BodyPose>& poses, const Eigen::Vector3d& from_m,
+               const Eigen::Vector3d& to_m) {
+  const double length_m = (to_m - from_m).norm();
+  for (double s_m = 2.5e-4; s_m < length_m; s_m += 2.5e-4) {
+    if (nearest_m(scene, poses, from_m + (s_m / length_m) * (to_m - from_m)) < -kOutside_m) return false;
+  }
+  return true;
+}
+
+inline Score score(Scene scene, double world_rate_hz, double duration_s) {
+  init_ode_once();
+  scene.physics.world_rate_hz = world_rate_hz;
+  std::vector<BodyPose> poses;
+  for (const SceneObject& object : scene.objects) {
+    BodyPose pose;
+    pose.position_m = Eigen::Vector3d(object.position_m[0], object.position_m[1], object.position_m[2]);
+    pose.orientation = Eigen::Quaterniond(object.orientation_wxyz[0], object.orientation_wxyz[1],
+                                          object.orientation_wxyz[2], object.orientation_wxyz[3]);
+    poses.push_back(pose);
+  }
+  World world(scene, WorldOptions{});
+  HapticServo servo(ServoOptions{}, 1);
+  const int ticks_per_step = static_cast<int>(std::lround(1000.0 / world_rate_hz));
+  const int ticks = static_cast<int>(duration_s * 1000.0);
+  Score result;
+  double left_at_s = -1.0;  // when the finger last left every object, while the force has not yet let go
+  for (int j = 0; j < ticks; ++j) {
+    const double t_s = 1e-3 * j;
+    if (j % ticks_per_step == 0) {
+      HapticReport report = servo.report();
+      report.haptic_session = 1;
+      servo.on_plane_frame(world.step(&report), t_s);
+    }
+    FingerSample finger;
+    finger.position_m = wander(t_s);
+    finger.valid = true;
+    const TickResult& tick = servo.tick(&finger, t_s, 1e-3);
+    const double force_N = to_eigen(tick.force_N).norm();
+    const double finger_m = nearest_m(scene, poses, finger.position_m);
+    const double proxy_m = nearest_m(scene, poses, to_eigen(tick.proxy_m));
+    if (j < ticks_per_step) continue;  // the first frame is on its way
+    ++result.ticks;
+    if (finger_m < -kOutside_m) ++result.contact_ticks;
+    const bool free_finger = finger_m > kOutside_m && proxy_m > -kPopThrough_m &&
+                             (force_N <= kForce_N || clear_way(scene, poses, to_eigen(tick.proxy_m), finger.position_m));
+    if (free_finger && force_N > kForce_N) ++result.ghost_ticks;
+    if (finger_m < -kDeep_m && force_N < kForce_N) ++result.lost_wall_ticks;
+    if (proxy_m < -kPopThrough_m) ++result.pop_through_ticks;
+    if (free_finger && left_at_s < 0.0 && force_N > kForce_N) left_at_s = t_s;
+    if (!free_finger) left_at_s = -1.0;
+    if (left_at_s >= 0.0 && force_N <= kForce_N) {
+      result.worst_release_ms = std::max(result.worst_release_ms, 1e3 * (t_s - left_at_s));
+      left_at_s = -1.0;
+    }
+  }
+  return result;
+}
+
+}  // namespace impetus::test
