@@ -12,6 +12,7 @@
 
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,10 @@ int main(int argc, char** argv) {
     std::unique_ptr<WorldLinkClient> world;
     DdsWorldLinkClient* dds = nullptr;
     if (link_options.kind == LinkKind::dds) {
+      if (!world_shm.empty()) {
+        throw std::invalid_argument("--world-shm names a shared-memory world link; with --link dds the world is "
+                                    "found by --dds-domain and --dds-partition");
+      }
       auto client = std::make_unique<DdsWorldLinkClient>(link_options.dds, options.clock, world_wait_s, fingers);
       dds = client.get();
       world = std::move(client);

@@ -90,6 +90,7 @@ TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment 
       {world + "--scene scenes/tap.json --link dds --dds-domain 233", "from 0 to 232, not 233"},
       {world + "--scene scenes/tap.json --link dds --dds-partition ''", "must not be empty"},
       {haptic + "--link dds --clock lockstep", "real time only"},
+      {haptic + "--clock realtime --link dds --world-shm elsewhere", "--world-shm names a shared-memory world link"},
       {haptic + "--clock realtime --link dds --dds-partition impetus_test_nobody_" + std::to_string(getpid()),
        "no world manager answered on DDS domain 0 partition 'impetus_test_nobody_"},
   };
