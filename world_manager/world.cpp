@@ -39,7 +39,16 @@ World::World(const Scene& scene, const WorldOptions& options)
   const CouplingContext context{scene_, period_s_, scene_.physics.substeps, *engine_, states_, applied_};
   coupling_ = make_coupling(options.coupling, context, stiffness_Npm, damping_Nspm);
 
-  refresh_states();
+  for (std::size_t id = 0; id < states_.size(); ++id) {
+    const SceneObject& object = scene_.objects[id];
+    ObjectState& state = states_[id];
+    if (!object.dynamic) {
+      const auto& q = object.orientation_wxyz;
+      state.pose.position_m = to_eigen(object.position_m);
+      state.pose.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+    }
+  }
+  refresh_states(engine_->moved());
   features_.index(states_, period_s_);
   for (PlaneFrame& frame : frames_) {
     frame.world_session = options_.world_session;
@@ -99,10 +108,10 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   coupling_->after_step();
   ++steps_taken_;
   time_s_ = static_cast<double>(steps_taken_) * period_s_;  // no drift from summing periods
-  refresh_states();
+  refresh_states(engine_->moved());
 
   // Step 4: planes and publication.
-  features_.index(states_, period_s_);
+  features_.reindex(states_, period_s_, engine_->moved());
   for (std::size_t slot = 0; slot < reports.size(); ++slot) publish(slot, applied[slot]);
   return {frames_.data(), reports.size()};
 }
@@ -152,6 +161,11 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
     moments.impulse_Ns = entry.impulse_moment_Nss;
     moments.angular_impulse_Nms = entry.angular_impulse_moment_Nmss;
     const ImpulseDelta moment = moment_ledger_.take(owner, moments);
+    // An entry whose total has not grown since the last report brings nothing new: handing it on would only wake a
+    // sleeping object the finger touched once and left.
+    const bool nothing_new = delta.impulse_Ns.isZero(0.0) && delta.angular_impulse_Nms.isZero(0.0) &&
+                             moment.impulse_Ns.isZero(0.0) && moment.angular_impulse_Nms.isZero(0.0);
+    if (nothing_new) continue;
     if (id < floor_id && scene_.objects[id].dynamic) {
       const bool moment_finite = all_finite(entry.impulse_moment_Nss) && all_finite(entry.angular_impulse_moment_Nmss);
       coupling_->take_impulse(id, delta, moment, moment_finite, window);
@@ -177,16 +191,10 @@ std::vector<CounterOwner> World::impulse_owners() const {
 
 const std::vector<std::size_t>& World::escaped() const { return engine_->escaped(); }
 
-void World::refresh_states() {
-  for (std::size_t id = 0; id < states_.size(); ++id) {
+void World::refresh_states(std::span<const std::size_t> moved) {
+  for (const std::size_t id : moved) {
     ObjectState& state = states_[id];
     const SceneObject& object = scene_.objects[id];
-    if (!object.dynamic) {
-      const auto& q = object.orientation_wxyz;
-      state.pose.position_m = to_eigen(object.position_m);
-      state.pose.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
-      continue;
-    }
     engine_->read_state(id, state);
     state.inverse_mass_per_kg = 1.0 / object.mass_kg;
     const Eigen::Matrix3d rotation = state.pose.orientation.toRotationMatrix();

@@ -73,6 +73,11 @@ class World {
   // Objects the engine took out of the simulation after the solver threw them out of range (RigidBodyEngine::escaped).
   const std::vector<std::size_t>& escaped() const;
 
+  // Whether dynamic object `id` sleeps (scene physics.auto_disable): at rest, not simulated until something wakes it.
+  bool asleep(std::size_t id) const { return engine_->asleep(id); }
+  // The dynamic objects the last step simulated, ascending: what the step cost grows with (RigidBodyEngine::moved).
+  std::span<const std::size_t> simulated() const { return engine_->moved(); }
+
   // State of every scene object after the last step (static ones never change).
   std::span<const ObjectState> states() const { return states_; }
   // Impulse the world applied to object `id` in the last step, and since the start (N·s, N·m·s). In position coupling
@@ -112,7 +117,8 @@ class World {
 
   void take_finger(Endpoint& endpoint, const HapticReport& report);
   void take_report(Endpoint& endpoint, const HapticReport& report);
-  void refresh_states();
+  // Reads the state of the dynamic objects in `moved` (static ones are set once, sleeping ones do not change).
+  void refresh_states(std::span<const std::size_t> moved);
   void publish(std::size_t slot, const HapticReport* applied_report);
 
   Scene scene_;

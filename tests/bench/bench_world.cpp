@@ -5,7 +5,12 @@
 //     cost what is near the finger, not the size of the world. index() (once per step, O(N log N)) is shown apart.
 //  3. Physics inside the 1 kHz loop (one 1 ms ODE step per haptic tick, as CHAI3D's ODE examples run it) against our
 //     20 Hz world (ten 5 ms substeps per 50 ms period): the most spheres each holds within its own period at p99.
+//  4. "Model only what a scene needs": a world of N resting spheres, 10 rolling ones and one a finger presses, with
+//     sleeping on (physics.auto_disable) and off: World::step once the resting ones sleep. The step should cost
+//     what moves, not what exists.
 // Uses world_manager symbols only.
+//
+// --quick: section 4 only up to 10 k objects (scripts/bench.sh --short).
 
 #include "world_manager/scene.h"
 #include "world_manager/features/feature_extractor.h"
@@ -17,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace {
@@ -140,12 +146,118 @@ void bench_physics_in_loop() {
               in_loop_half > 0 ? double(slow_world) / in_loop_half : 0.0);
 }
 
+// N spheres of 2 cm radius resting on the floor 5 cm apart (y >= 0), and 10 more rolling along +x at 0.2 m/s in a lane
+// of their own at y = -0.5 m, 20 cm apart, so they never meet the resting ones within the run.
+Scene resting_field_with_rollers(int resting, bool sleeping) {
+  Scene scene;
+  scene.source_name = "bench";
+  scene.physics.auto_disable = sleeping;
+  const int side = static_cast<int>(std::ceil(std::sqrt(resting)));
+  constexpr double kRadius_m = 0.02;
+  constexpr double kSpacing_m = 0.05;
+  const auto sphere = [&](double x, double y, double vx) {
+    SceneObject object;
+    object.name = "s";
+    object.name += std::to_string(scene.objects.size());
+    object.shape.kind = impetus::ShapeKind::sphere;
+    object.shape.radius_m = kRadius_m;
+    object.dynamic = true;
+    object.mass_kg = 0.023;
+    object.position_m = {x, y, kRadius_m};
+    object.linear_velocity_mps = {vx, 0.0, 0.0};
+    object.angular_velocity_radps = {0.0, vx / kRadius_m, 0.0};  // rolling without slipping: ω × r = v
+    scene.objects.push_back(object);
+  };
+  for (int i = 0; i < resting; ++i) sphere(kSpacing_m * (i % side), kSpacing_m * (i / side), 0.0);
+  for (int i = 0; i < 10; ++i) sphere(0.2 * i, -0.5, 0.2);
+  return scene;
+}
+
+struct SleepingRun {
+  Percentiles step;
+  double build_s;
+  double settle_s;
+  std::size_t awake;
+};
+
+// Builds the world, lets it settle for 1 s (resting bodies fall asleep after 0.5 s), then times `steps` steps with a
+// finger pressing sphere 0 down into the floor (a growing running total: a new impulse every step).
+SleepingRun run_sleeping(int resting, bool sleeping, int steps) {
+  const Scene scene = resting_field_with_rollers(resting, sleeping);
+  auto start = Clock::now();
+  impetus::World world(scene, impetus::WorldOptions{});
+  const double build_s = std::chrono::duration<double>(Clock::now() - start).count();
+  impetus::HapticReport report{};
+  report.haptic_session = 1;
+  report.world_session = impetus::WorldOptions{}.world_session;
+  report.finger_valid = 1;
+  report.finger_m = {0.0, 0.0, 0.035};
+  report.proxy_m = {0.0, 0.0, 0.04};
+  report.entry_count = 1;
+  report.entries[0].object_id = 0;
+  const int settle_steps = static_cast<int>(std::ceil(1.0 * scene.physics.world_rate_hz));
+  std::uint64_t tick = 0;
+  const auto press = [&] {
+    tick += 50;
+    report.tick = tick;
+    report.haptic_time_s = 1e-3 * static_cast<double>(tick);
+    // 0.5 N down for the 50 ms of a world period.
+    report.entries[0].impulse_Ns[2] -= 0.025;
+    report.entries[0].last_tick = tick;
+    world.step(&report);
+  };
+  start = Clock::now();
+  for (int i = 0; i < settle_steps; ++i) press();
+  const double settle_s = std::chrono::duration<double>(Clock::now() - start).count();
+  std::vector<double> samples_us;
+  for (int i = 0; i < steps; ++i) {
+    start = Clock::now();
+    press();
+    samples_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+  }
+  std::size_t awake = 0;
+  for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+    if (world.states()[id].velocity_mps.norm() > 0.0) ++awake;
+  }
+  return {percentiles(samples_us), build_s, settle_s, awake};
+}
+
+void bench_sleeping(bool quick) {
+  std::printf("\nModel only what a scene needs: N resting spheres + 10 rolling + 1 pressed, World::step (20 Hz, 10 "
+              "substeps) after 1 s of settling\n");
+  std::printf("%8s %9s %12s %12s %10s %10s %8s\n", "resting", "sleeping", "p50 [us]", "p99 [us]", "build [s]",
+              "settle [s]", "moving");
+  std::vector<int> counts{1000, 10000};
+  if (!quick) counts.push_back(100000);
+  for (const int count : counts) {
+    for (const bool sleeping : {false, true}) {
+      if (!sleeping && count > 10000) {
+        // ODE's hash space clears an n×n bit matrix of tested pairs at every collide: 1.25 GB per substep here.
+        std::printf("%8d %9s %12s (not run: the hash space clears n^2 bits per substep, seconds per step)\n", count,
+                    "off", "-");
+        continue;
+      }
+      const int steps = !sleeping && count >= 10000 ? 10 : 100;
+      const SleepingRun run = run_sleeping(count, sleeping, steps);
+      std::printf("%8d %9s %12.1f %12.1f %10.2f %10.2f %8zu\n", count, sleeping ? "on" : "off", run.step.p50_us,
+                  run.step.p99_us, run.build_s, run.settle_s, run.awake);
+      std::fflush(stdout);
+    }
+  }
+}
+
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
   impetus::init_ode_once();
+  const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
+  if (argc > 1 && std::string(argv[1]) == "--sleeping") {
+    bench_sleeping(false);
+    return 0;
+  }
   bench_step();
   bench_features();
   bench_physics_in_loop();
+  bench_sleeping(quick);
   return 0;
 }

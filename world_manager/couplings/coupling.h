@@ -30,10 +30,13 @@ class AppliedImpulses {
       : step_Ns_(object_count, Eigen::Vector3d::Zero()),
         total_Ns_(object_count, Eigen::Vector3d::Zero()),
         total_angular_Nms_(object_count, Eigen::Vector3d::Zero()) {}
+  // O(objects given impulse in the last step), not O(objects).
   void begin_step() {
-    for (auto& impulse : step_Ns_) impulse.setZero();
+    for (const std::size_t id : stepped_) step_Ns_[id].setZero();
+    stepped_.clear();
   }
   void add(std::size_t id, const Eigen::Vector3d& impulse_Ns, const Eigen::Vector3d& angular_impulse_Nms) {
+    stepped_.push_back(id);
     step_Ns_[id] += impulse_Ns;
     total_Ns_[id] += impulse_Ns;
     total_angular_Nms_[id] += angular_impulse_Nms;
@@ -44,6 +47,7 @@ class AppliedImpulses {
 
  private:
   std::vector<Eigen::Vector3d> step_Ns_;
+  std::vector<std::size_t> stepped_;  // ids add() named since begin_step (repeats allowed)
   std::vector<Eigen::Vector3d> total_Ns_;
   std::vector<Eigen::Vector3d> total_angular_Nms_;
 };

@@ -11,9 +11,9 @@ namespace impetus {
 
 LocalCoupling::LocalCoupling(const CouplingContext& context)
     : CouplingStrategy(context),
-      impulse_Ns_(context.scene.objects.size(),
-                  std::vector<Eigen::Vector3d>(static_cast<std::size_t>(context.substeps) + 1, Eigen::Vector3d::Zero())),
-      angular_Nms_(impulse_Ns_) {}
+      impulse_Ns_(context.scene.objects.size()),
+      angular_Nms_(context.scene.objects.size()),
+      is_scheduled_(context.scene.objects.size(), false) {}
 
 void LocalCoupling::take_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment,
                                  bool moment_finite, const RenderWindow& window) {
@@ -65,6 +65,15 @@ void LocalCoupling::schedule(std::size_t id, const ImpulseDelta& delta, const Im
       slots[static_cast<std::size_t>(substeps)][axis] += at_end;
     }
   };
+  if (!is_scheduled_[id]) {
+    const std::size_t slots = static_cast<std::size_t>(substeps) + 1;
+    if (impulse_Ns_[id].size() != slots) {
+      impulse_Ns_[id].assign(slots, Eigen::Vector3d::Zero());
+      angular_Nms_[id].assign(slots, Eigen::Vector3d::Zero());
+    }
+    is_scheduled_[id] = true;
+    scheduled_.push_back(id);
+  }
   for (int axis = 0; axis < 3; ++axis) {
     place(delta.impulse_Ns[axis], moment.impulse_Ns[axis], axis, impulse_Ns_[id]);
     place(delta.angular_impulse_Nms[axis], moment.angular_impulse_Nms[axis], axis, angular_Nms_[id]);
@@ -83,7 +92,7 @@ void LocalCoupling::apply_slot(int slot) {
   const int substeps = context_.substeps;
   const double h = context_.world_period_s / substeps;
   const ContactGraph& contacts = context_.engine.contacts();  // still the last step's: recorded after this hook
-  for (std::size_t id = 0; id < impulse_Ns_.size(); ++id) {
+  for (const std::size_t id : scheduled_) {
     Eigen::Vector3d& impulse_Ns = impulse_Ns_[id][static_cast<std::size_t>(slot)];
     Eigen::Vector3d& angular_Nms = angular_Nms_[id][static_cast<std::size_t>(slot)];
     if (slot + 1 == substeps && contacts.touching(static_cast<std::int32_t>(id))) {
@@ -107,6 +116,10 @@ void LocalCoupling::apply_slot(int slot) {
     }
     impulse_Ns.setZero();
     angular_Nms.setZero();
+  }
+  if (slot == substeps) {  // every slot is applied and zero again
+    for (const std::size_t id : scheduled_) is_scheduled_[id] = false;
+    scheduled_.clear();
   }
 }
 

@@ -46,9 +46,12 @@ class LocalCoupling final : public CouplingStrategy {
   void apply_slot(int slot);
 
   // Per object, the impulse and angular impulse to apply in each substep of this step (slot `substeps`: after the
-  // last substep, a pure velocity change).
+  // last substep, a pure velocity change); sized when the object is first pushed.
   std::vector<std::vector<Eigen::Vector3d>> impulse_Ns_;
   std::vector<std::vector<Eigen::Vector3d>> angular_Nms_;
+  // The objects with impulse scheduled in this step: a step costs the objects pushed, not the objects that exist.
+  std::vector<std::size_t> scheduled_;
+  std::vector<bool> is_scheduled_;
 };
 
 }  // namespace impetus

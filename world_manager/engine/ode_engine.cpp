@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/engine/ode_engine.h"
 
+#include "world_manager/features/spatial_grid.h"
+
 #include <ode/ode.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -15,6 +18,40 @@ constexpr int kMaxContactsPerPair = 8;
 // Below this approach speed a contact does not bounce: resting and sliding objects would otherwise chatter on every
 // substep's tiny penetration-correction velocity (ERP pushes at a few mm/s).
 constexpr double kBounceThreshold_mps = 0.05;
+
+// Sleeping (ode_engine.h): a body sleeps once its speeds have stayed under these for kRestBeforeSleep_s. ODE's own
+// defaults for the speeds (0.01 m/s, 0.01 rad/s: a 5 cm cube's corner moves 0.25 mm/s) are far below anything the
+// haptic side renders. Half a second is ten 20 Hz world periods: a body bouncing or rocking to rest is not frozen
+// mid-motion, and one that a finger keeps pushing is woken by each push (RigidBodyEngine::wake).
+constexpr double kSleepSpeed_mps = 0.01;
+constexpr double kSleepAngularSpeed_radps = 0.01;
+constexpr double kRestBeforeSleep_s = 0.5;
+
+Eigen::AlignedBox3d geom_bounds(dGeomID geom) {
+  dReal aabb[6];
+  dGeomGetAABB(geom, aabb);  // ODE's order: min x, max x, min y, max y, min z, max z
+  return Eigen::AlignedBox3d(Eigen::Vector3d(aabb[0], aabb[2], aabb[4]), Eigen::Vector3d(aabb[1], aabb[3], aabb[5]));
+}
+
+// The median object extent: a grid cell then holds a few objects and an object spans a few cells.
+double grid_cell_size_m(const Scene& scene) {
+  std::vector<double> extents_m;
+  for (const SceneObject& object : scene.objects) {
+    const Shape& shape = object.shape;
+    switch (shape.kind) {
+      case ShapeKind::box:
+        extents_m.push_back(std::max({shape.box_size_m[0], shape.box_size_m[1], shape.box_size_m[2]}));
+        break;
+      case ShapeKind::sphere: extents_m.push_back(2.0 * shape.radius_m); break;
+      case ShapeKind::capsule: extents_m.push_back(shape.length_m + 2.0 * shape.radius_m); break;
+      case ShapeKind::cylinder: extents_m.push_back(std::max(shape.length_m, 2.0 * shape.radius_m)); break;
+    }
+  }
+  if (extents_m.empty()) return 1.0;
+  auto middle = extents_m.begin() + static_cast<std::ptrdiff_t>(extents_m.size() / 2);
+  std::nth_element(extents_m.begin(), middle, extents_m.end());
+  return *middle;
+}
 
 void* id_to_data(std::size_t id) { return reinterpret_cast<void*>(static_cast<std::uintptr_t>(id)); }
 std::size_t data_to_id(void* data) { return static_cast<std::size_t>(reinterpret_cast<std::uintptr_t>(data)); }
@@ -33,9 +70,9 @@ Eigen::Matrix3d ode_inertia(const dMass& mass) {
 struct OdeEngine::Handles {
   const Scene* scene = nullptr;
   dWorldID world = nullptr;
-  dSpaceID space = nullptr;
+  dSpaceID space = nullptr;  // with sleeping: the awake geoms only
   dJointGroupID contacts = nullptr;
-  std::vector<dBodyID> bodies;      // per object; nullptr for static objects
+  std::vector<dBodyID> bodies;      // per object; nullptr for static objects and sleeping bodies
   std::vector<dGeomID> geoms;       // per object
   std::vector<Material> materials;  // per id, the floor last
   std::vector<Eigen::Matrix3d> inverse_inertia_body;  // per object; zero for static ones
@@ -53,21 +90,139 @@ struct OdeEngine::Handles {
   std::vector<dJointFeedback> feedback;  // one per recorded contact; sized before the step so the addresses hold
   std::vector<std::size_t> escaped;      // objects taken out of the simulation (park_escaped)
   std::vector<bool> is_escaped;          // per object
+  std::vector<std::size_t> moved;        // RigidBodyEngine::moved()
+
+  // Sleeping (ode_engine.h). The awake list is in the order bodies woke; `moved` is sorted at the end of each step.
+  bool sleeping = false;
+  dSpaceID resting_space = nullptr;  // owns the geoms of static objects, sleeping bodies and the floor
+  dGeomID floor = nullptr;
+  enum class Kind : std::uint8_t { fixed, awake, asleep };
+  std::vector<Kind> kind;                     // per object
+  std::vector<std::size_t> awake;             // ids of the awake dynamic bodies (not escaped)
+  std::vector<dMass> masses;                  // per object, to rebuild a body that wakes
+  struct RestingPose {
+    dVector3 position;
+    dQuaternion orientation;
+  };
+  std::vector<RestingPose> resting_pose;      // per object, while it sleeps
+  std::vector<Eigen::AlignedBox3d> resting_bounds;  // per object in the grid: its geom's box
+  std::unique_ptr<SpatialGrid> grid;          // fixed geometry and sleeping bodies
+  std::vector<std::size_t> wake_queue;        // scratch
+  std::vector<std::int32_t> nearby;           // scratch
+
+  // Puts dynamic object `id`, which ODE has disabled, to sleep: out of ODE, its geom fixed where the body rests.
+  void fall_asleep(std::size_t id) {
+    dBodyID body = bodies[id];
+    dGeomID geom = geoms[id];
+    RestingPose& pose = resting_pose[id];
+    const dReal* p = dBodyGetPosition(body);
+    const dReal* q = dBodyGetQuaternion(body);
+    std::copy(p, p + 3, pose.position);
+    std::copy(q, q + 4, pose.orientation);
+    dGeomSetBody(geom, nullptr);
+    dGeomSetPosition(geom, pose.position[0], pose.position[1], pose.position[2]);
+    dGeomSetQuaternion(geom, pose.orientation);
+    dBodyDestroy(body);
+    bodies[id] = nullptr;
+    dSpaceRemove(space, geom);
+    dSpaceAdd(resting_space, geom);
+    kind[id] = Kind::asleep;
+    resting_bounds[id] = geom_bounds(geom);
+    grid->update(static_cast<std::int32_t>(id), resting_bounds[id]);
+    contact_graph.rest(static_cast<std::int32_t>(id));
+  }
+
+  // Wakes sleeping object `id`: a new body with its mass, at its resting pose, at rest.
+  void wake_up(std::size_t id) {
+    dGeomID geom = geoms[id];
+    const RestingPose& pose = resting_pose[id];
+    dBodyID body = dBodyCreate(world);
+    dBodySetMass(body, &masses[id]);
+    dBodySetPosition(body, pose.position[0], pose.position[1], pose.position[2]);
+    dBodySetQuaternion(body, pose.orientation);
+    dGeomSetBody(geom, body);
+    bodies[id] = body;
+    grid->remove(static_cast<std::int32_t>(id));
+    dSpaceRemove(resting_space, geom);
+    dSpaceAdd(space, geom);
+    kind[id] = Kind::awake;
+    awake.push_back(id);
+    const auto at = std::lower_bound(moved.begin(), moved.end(), id);
+    if (at == moved.end() || *at != id) moved.insert(at, id);
+    contact_graph.wake(static_cast<std::int32_t>(id));
+  }
+
+  // Wakes every sleeping body an awake one touches, and those they touch in turn (ODE's islands would).
+  void wake_touched() {
+    wake_queue.assign(awake.begin(), awake.end());
+    for (std::size_t i = 0; i < wake_queue.size(); ++i) {
+      if (is_escaped[wake_queue[i]]) continue;
+      dGeomID geom = geoms[wake_queue[i]];
+      const Eigen::AlignedBox3d bounds = geom_bounds(geom);
+      grid->query(bounds, nearby);
+      for (const std::int32_t other : nearby) {
+        const auto o = static_cast<std::size_t>(other);
+        if (kind[o] != Kind::asleep || !bounds.intersects(resting_bounds[o])) continue;
+        dContactGeom touch;
+        if (dCollide(geom, geoms[o], 1, &touch, sizeof(dContactGeom)) == 0) continue;
+        wake_up(o);
+        wake_queue.push_back(o);
+      }
+    }
+  }
+
+  // Contacts of the awake geoms: among themselves (the space), with the floor and with fixed geometry (the grid).
+  // Sleeping bodies an awake one touches were woken first (wake_touched), so none is met here.
+  void collide_awake() {
+    dSpaceCollide(space, this, &Handles::near_callback);
+    for (const std::size_t id : awake) {
+      if (is_escaped[id]) continue;
+      dGeomID geom = geoms[id];
+      if (floor != nullptr) near_callback(this, geom, floor);
+      const Eigen::AlignedBox3d bounds = geom_bounds(geom);
+      grid->query(bounds, nearby);
+      for (const std::int32_t other : nearby) {
+        const auto o = static_cast<std::size_t>(other);
+        if (kind[o] == Kind::fixed && bounds.intersects(resting_bounds[o])) near_callback(this, geom, geoms[o]);
+      }
+    }
+  }
+
+  // After a step: the bodies ODE disabled go to sleep.
+  void put_rested_to_sleep() {
+    std::size_t kept = 0;
+    for (const std::size_t id : awake) {
+      if (is_escaped[id]) continue;
+      if (dBodyIsEnabled(bodies[id]) == 0) {
+        fall_asleep(id);
+        continue;
+      }
+      awake[kept++] = id;
+    }
+    awake.resize(kept);
+  }
 
   // Takes every body the solver has thrown beyond kEscapeDistance_m, or whose state is no longer finite, out of the
   // simulation before the broadphase sees it: ODE's hash space asserts on coordinates it cannot store in its cells.
   // The body stops, its geom collides with nothing, and a non-finite position is replaced by the escape distance on
   // the ray it left along (or on +x), so every state the world reads stays finite.
   void park_escaped() {
-    for (std::size_t id = 0; id < bodies.size(); ++id) {
-      dBodyID body = bodies[id];
-      if (body == nullptr || is_escaped[id]) continue;
+    if (sleeping) {
+      for (const std::size_t id : awake) park_if_escaped(id);
+      return;
+    }
+    for (std::size_t id = 0; id < bodies.size(); ++id) park_if_escaped(id);
+  }
+  void park_if_escaped(std::size_t id) {
+    dBodyID body = bodies[id];
+    {
+      if (body == nullptr || is_escaped[id]) return;
       const dReal* p = dBodyGetPosition(body);
       const dReal* v = dBodyGetLinearVel(body);
       const dReal* w = dBodyGetAngularVel(body);
       const Eigen::Vector3d position(p[0], p[1], p[2]);
       const bool finite = position.allFinite() && std::isfinite(v[0] + v[1] + v[2]) && std::isfinite(w[0] + w[1] + w[2]);
-      if (finite && position.lpNorm<Eigen::Infinity>() <= kEscapeDistance_m) continue;
+      if (finite && position.lpNorm<Eigen::Infinity>() <= kEscapeDistance_m) return;
       Eigen::Vector3d parked = position;
       if (!parked.allFinite()) parked = Eigen::Vector3d(kEscapeDistance_m, 0.0, 0.0);
       const dReal* q = dBodyGetQuaternion(body);
@@ -88,6 +243,7 @@ struct OdeEngine::Handles {
 
   ~Handles() {
     if (contacts != nullptr) dJointGroupDestroy(contacts);
+    if (resting_space != nullptr) dSpaceDestroy(resting_space);
     if (space != nullptr) dSpaceDestroy(space);  // destroys the geoms it holds (cleanup mode on)
     if (world != nullptr) dWorldDestroy(world);  // destroys the bodies
   }
@@ -153,7 +309,13 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   Handles& ode = *ode_;
   ode.scene = &scene;
   ode.world = dWorldCreate();
-  ode.space = dHashSpaceCreate(nullptr);
+  ode.sleeping = scene.physics.auto_disable;
+  // ODE's hash space keeps an n×n bit matrix of the pairs it has tested, cleared at every collide: 1.25 GB per substep
+  // at 100 k geoms (12.5 MB at 10 k). With sleeping every body is awake at the start, so the awake space sweeps and
+  // prunes instead (sorted along x, then y: scenes spread over a floor), O(n log n). Without sleeping the hash space
+  // stays, whose contact order the published figures were made with.
+  ode.space = ode.sleeping ? dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ) : dHashSpaceCreate(nullptr);
+  if (ode.sleeping) ode.resting_space = dSimpleSpaceCreate(nullptr);  // never collided as a whole: it only owns
   ode.contacts = dJointGroupCreate(0);
   dWorldSetGravity(ode.world, scene.gravity_mps2[0], scene.gravity_mps2[1], scene.gravity_mps2[2]);
   dWorldSetERP(ode.world, scene.physics.erp);
@@ -163,12 +325,26 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   }
   dWorldSetQuickStepNumIterations(ode.world, scene.physics.solver_iterations);
   dWorldSetAutoDisableFlag(ode.world, scene.physics.auto_disable ? 1 : 0);
+  if (ode.sleeping) {
+    dWorldSetAutoDisableLinearThreshold(ode.world, kSleepSpeed_mps);
+    dWorldSetAutoDisableAngularThreshold(ode.world, kSleepAngularSpeed_radps);
+    dWorldSetAutoDisableSteps(ode.world, 0);
+    dWorldSetAutoDisableTime(ode.world, kRestBeforeSleep_s);
+  }
 
   ode.bodies.assign(scene.objects.size(), nullptr);
   ode.contact_graph.reset(scene.objects.size());
   ode.geoms.assign(scene.objects.size(), nullptr);
   ode.is_escaped.assign(scene.objects.size(), false);
   ode.inverse_inertia_body.assign(scene.objects.size(), Eigen::Matrix3d::Zero());
+  if (ode.sleeping) {
+    ode.kind.assign(scene.objects.size(), Handles::Kind::fixed);
+    ode.masses.resize(scene.objects.size());
+    ode.resting_pose.resize(scene.objects.size());
+    ode.resting_bounds.resize(scene.objects.size());
+    ode.grid = std::make_unique<SpatialGrid>(grid_cell_size_m(scene));
+    ode.grid->reset(scene.objects.size());
+  }
   for (std::size_t id = 0; id < scene.objects.size(); ++id) {
     const SceneObject& object = scene.objects[id];
     const Shape& shape = object.shape;
@@ -176,23 +352,25 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
     dMass mass;
     dMassSetZero(&mass);
     constexpr int kAxisZ = 3;  // ODE's direction code for the body z axis
+    // With sleeping, fixed geometry is never collided as a whole, only looked up in the grid around awake bodies.
+    dSpaceID home = ode.sleeping && !object.dynamic ? ode.resting_space : ode.space;
     switch (shape.kind) {
       case ShapeKind::box:
-        geom = dCreateBox(ode.space, shape.box_size_m[0], shape.box_size_m[1], shape.box_size_m[2]);
+        geom = dCreateBox(home, shape.box_size_m[0], shape.box_size_m[1], shape.box_size_m[2]);
         if (object.dynamic) {
           dMassSetBoxTotal(&mass, object.mass_kg, shape.box_size_m[0], shape.box_size_m[1], shape.box_size_m[2]);
         }
         break;
       case ShapeKind::sphere:
-        geom = dCreateSphere(ode.space, shape.radius_m);
+        geom = dCreateSphere(home, shape.radius_m);
         if (object.dynamic) dMassSetSphereTotal(&mass, object.mass_kg, shape.radius_m);
         break;
       case ShapeKind::capsule:
-        geom = dCreateCapsule(ode.space, shape.radius_m, shape.length_m);
+        geom = dCreateCapsule(home, shape.radius_m, shape.length_m);
         if (object.dynamic) dMassSetCapsuleTotal(&mass, object.mass_kg, kAxisZ, shape.radius_m, shape.length_m);
         break;
       case ShapeKind::cylinder:
-        geom = dCreateCylinder(ode.space, shape.radius_m, shape.length_m);
+        geom = dCreateCylinder(home, shape.radius_m, shape.length_m);
         if (object.dynamic) dMassSetCylinderTotal(&mass, object.mass_kg, kAxisZ, shape.radius_m, shape.length_m);
         break;
     }
@@ -213,16 +391,27 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
                          object.angular_velocity_radps[2]);
       ode.bodies[id] = body;
       ode.inverse_inertia_body[id] = ode_inertia(mass).inverse();
+      ode.moved.push_back(id);
+      if (ode.sleeping) {
+        ode.kind[id] = Handles::Kind::awake;
+        ode.masses[id] = mass;
+        ode.awake.push_back(id);
+      }
     } else {
       dGeomSetPosition(geom, object.position_m[0], object.position_m[1], object.position_m[2]);
       dGeomSetQuaternion(geom, orientation);
+      if (ode.sleeping) {
+        ode.resting_bounds[id] = geom_bounds(geom);
+        ode.grid->update(static_cast<std::int32_t>(id), ode.resting_bounds[id]);
+      }
     }
     ode.materials.push_back(object.material);
   }
   ode.materials.push_back(scene.floor.material);
   if (scene.floor.present) {
-    dGeomID floor = dCreatePlane(ode.space, 0.0, 0.0, 1.0, scene.floor.height_m);
+    dGeomID floor = dCreatePlane(ode.sleeping ? ode.resting_space : ode.space, 0.0, 0.0, 1.0, scene.floor.height_m);
     dGeomSetData(floor, id_to_data(scene.objects.size()));
+    if (ode.sleeping) ode.floor = floor;
   }
 
   dRandSetSeed(static_cast<unsigned long>(scene.physics.seed));
@@ -232,6 +421,15 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
 OdeEngine::~OdeEngine() = default;
 
 void OdeEngine::read_state(std::size_t id, ObjectState& out) const {
+  if (asleep(id)) {
+    const Handles::RestingPose& pose = ode_->resting_pose[id];
+    out.pose.position_m = Eigen::Vector3d(pose.position[0], pose.position[1], pose.position[2]);
+    out.pose.orientation = Eigen::Quaterniond(pose.orientation[0], pose.orientation[1], pose.orientation[2],
+                                              pose.orientation[3]);
+    out.velocity_mps.setZero();
+    out.angular_velocity_radps.setZero();
+    return;
+  }
   dBodyID body = ode_->bodies[id];
   const dReal* position = dBodyGetPosition(body);
   const dReal* q = dBodyGetQuaternion(body);
@@ -246,6 +444,11 @@ void OdeEngine::read_state(std::size_t id, ObjectState& out) const {
 const Eigen::Matrix3d& OdeEngine::inverse_inertia_body(std::size_t id) const { return ode_->inverse_inertia_body[id]; }
 
 void OdeEngine::velocity(std::size_t id, Eigen::Vector3d& velocity_mps, Eigen::Vector3d& angular_radps) const {
+  if (asleep(id)) {
+    velocity_mps.setZero();
+    angular_radps.setZero();
+    return;
+  }
   const dReal* v = dBodyGetLinearVel(ode_->bodies[id]);
   const dReal* w = dBodyGetAngularVel(ode_->bodies[id]);
   velocity_mps = Eigen::Vector3d(v[0], v[1], v[2]);
@@ -254,20 +457,30 @@ void OdeEngine::velocity(std::size_t id, Eigen::Vector3d& velocity_mps, Eigen::V
 
 void OdeEngine::set_velocity(std::size_t id, const Eigen::Vector3d& velocity_mps,
                              const Eigen::Vector3d& angular_radps) {
+  if (ode_->sleeping) wake(id);
   dBodyID body = ode_->bodies[id];
   dBodySetLinearVel(body, velocity_mps.x(), velocity_mps.y(), velocity_mps.z());
   dBodySetAngularVel(body, angular_radps.x(), angular_radps.y(), angular_radps.z());
 }
 
-void OdeEngine::wake(std::size_t id) { dBodyEnable(ode_->bodies[id]); }
+void OdeEngine::wake(std::size_t id) {
+  if (asleep(id)) ode_->wake_up(id);
+  dBodyEnable(ode_->bodies[id]);  // also restarts ODE's count of the time the body has rested
+}
+
+bool OdeEngine::asleep(std::size_t id) const {
+  return ode_->sleeping && ode_->kind[id] == Handles::Kind::asleep;
+}
 
 void OdeEngine::add_force(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm) {
+  if (ode_->sleeping) wake(id);
   dBodyID body = ode_->bodies[id];
   dBodyAddForce(body, force_N.x(), force_N.y(), force_N.z());
   dBodyAddTorque(body, torque_Nm.x(), torque_Nm.y(), torque_Nm.z());
 }
 
 void OdeEngine::add_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m) {
+  if (ode_->sleeping) wake(id);
   dBodyAddForceAtPos(ode_->bodies[id], force_N.x(), force_N.y(), force_N.z(), point_m.x(), point_m.y(), point_m.z());
 }
 
@@ -275,13 +488,22 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
   Handles& ode = *ode_;
   const Scene& scene = *ode.scene;
   dRandSetSeed(ode.random_state);
+  if (ode.sleeping) {
+    ode.moved.assign(ode.awake.begin(), ode.awake.end());
+    std::sort(ode.moved.begin(), ode.moved.end());
+  }
   for (int substep = 0; substep < substeps; ++substep) {
     hook.before_substep(substep);
     ode.record_contacts = record_contacts && substep + 1 == substeps;
     const bool recording = ode.record_contacts;
     if (recording) ode.recorded.clear();
     ode.park_escaped();
-    dSpaceCollide(ode.space, &ode, &Handles::near_callback);
+    if (ode.sleeping) {
+      ode.wake_touched();
+      ode.collide_awake();
+    } else {
+      dSpaceCollide(ode.space, &ode, &Handles::near_callback);
+    }
     ode.record_contacts = false;
     if (recording) {
       ode.feedback.resize(ode.recorded.size());
@@ -296,8 +518,11 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
     dJointGroupEmpty(ode.contacts);
   }
   ode.park_escaped();  // the world reads the state next
+  if (ode.sleeping) ode.put_rested_to_sleep();
   ode.random_state = dRandGetSeed();
 }
+
+const std::vector<std::size_t>& OdeEngine::moved() const { return ode_->moved; }
 
 ContactGraph& OdeEngine::contacts() { return ode_->contact_graph; }
 

@@ -3,6 +3,14 @@
 // The ODE implementation of RigidBodyEngine: a hash space, contact joints with the two materials combined
 // (scene.h combine_*), QuickStep or the direct solver as the scene asks.
 //
+// Sleeping (scene physics.auto_disable): ODE's auto-disable decides when a body rests; such a body is then taken out
+// of ODE altogether, its geom left in place as fixed geometry in a grid (features/spatial_grid.h). ODE walks every
+// body of its world in every substep, disabled or not, and a hash space collides every geom it holds; so a resting
+// body left in ODE would still cost per substep. Each substep the awake geoms are tested against the grid: a sleeping
+// body an awake one touches wakes (a new ODE body with the same mass, pose and zero velocity) before the contacts are
+// made, as ODE's own islands would wake it, and its contacts then join the step. A step costs what is awake and what
+// it touches, not what exists. Without auto_disable every body stays in ODE and nothing here applies.
+//
 // The process must have called init_ode_once() (ode_runtime.h) first. Each engine keeps its own stream of ODE's
 // global random generator (saved and restored around its steps), so runs are bitwise reproducible per engine even
 // when several live in one process. Used from one thread.
@@ -28,9 +36,11 @@ class OdeEngine final : public RigidBodyEngine {
   void velocity(std::size_t id, Eigen::Vector3d& velocity_mps, Eigen::Vector3d& angular_radps) const override;
   void set_velocity(std::size_t id, const Eigen::Vector3d& velocity_mps, const Eigen::Vector3d& angular_radps) override;
   void wake(std::size_t id) override;
+  bool asleep(std::size_t id) const override;
   void add_force(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm) override;
   void add_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m) override;
   void step(int substeps, double substep_s, bool record_contacts, SubstepHook& hook) override;
+  const std::vector<std::size_t>& moved() const override;
   ContactGraph& contacts() override;
   const std::vector<std::size_t>& escaped() const override;
 

@@ -35,8 +35,11 @@ class RigidBodyEngine {
   virtual void velocity(std::size_t id, Eigen::Vector3d& velocity_mps, Eigen::Vector3d& angular_radps) const = 0;
   virtual void set_velocity(std::size_t id, const Eigen::Vector3d& velocity_mps,
                             const Eigen::Vector3d& angular_radps) = 0;
-  // A sleeping body must wake to move.
+  // A sleeping body must wake to move. Engines that let bodies sleep (scene physics.auto_disable) also wake a body
+  // that is given a force or a velocity, or that an awake body touches.
   virtual void wake(std::size_t id) = 0;
+  // Whether dynamic object `id` sleeps: at rest, its pose fixed and its velocity zero, costing nothing per step.
+  virtual bool asleep(std::size_t id) const = 0;
   // Held during the next substep only.
   virtual void add_force(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm) = 0;
   virtual void add_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m) = 0;
@@ -47,7 +50,11 @@ class RigidBodyEngine {
   // whatever other engines in the process do.
   virtual void step(int substeps, double substep_s, bool record_contacts, SubstepHook& hook) = 0;
 
-  // The contacts recorded by the last step that recorded them.
+  // The dynamic objects the last step simulated (awake at any time in it), ascending: the only ones whose state can
+  // have changed since the step before. Every dynamic object before the first step.
+  virtual const std::vector<std::size_t>& moved() const = 0;
+
+  // The contacts recorded by the last step that recorded them (a sleeping body keeps those it fell asleep with).
   virtual ContactGraph& contacts() = 0;
   // Objects taken out of the simulation because the solver threw them beyond kEscapeDistance_m (scene.h) or made their
   // state non-finite; they stay where they were taken out, at rest, and collide with nothing. In order of escape.

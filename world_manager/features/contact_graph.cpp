@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace impetus {
 namespace {
@@ -20,7 +21,9 @@ void ContactGraph::reset(std::size_t body_count) {
   body_count_ = body_count;
   pending_.clear();
   edges_.clear();
-  first_edge_.assign(body_count + 1, 0);
+  index_.clear();
+  for (const std::int32_t body : woken_) resting_.erase(body);
+  woken_.clear();
   if (visited_.size() != body_count) visited_.assign(body_count, 0);
 }
 
@@ -34,20 +37,44 @@ void ContactGraph::add(std::int32_t body, std::int32_t other, const Eigen::Vecto
 }
 
 void ContactGraph::finish() {
-  // Counting sort by body: edges_ grouped, first_edge_ the offsets.
-  std::fill(first_edge_.begin(), first_edge_.end(), 0);
-  for (const PendingEdge& p : pending_) ++first_edge_[static_cast<std::size_t>(p.body) + 1];
-  for (std::size_t b = 0; b < body_count_; ++b) first_edge_[b + 1] += first_edge_[b];
-  edges_.resize(pending_.size());
-  cursor_.assign(first_edge_.begin(), first_edge_.end() - 1);
-  for (const PendingEdge& p : pending_) edges_[cursor_[static_cast<std::size_t>(p.body)]++] = p.edge;
+  // Grouped by body; within a body the order of add() (stable), so a run is reproducible.
+  std::stable_sort(pending_.begin(), pending_.end(),
+                   [](const PendingEdge& a, const PendingEdge& b) { return a.body < b.body; });
+  edges_.clear();
+  index_.clear();
+  for (const PendingEdge& p : pending_) {
+    if (index_.empty() || index_.back().body != p.body) index_.push_back({p.body, edges_.size(), edges_.size()});
+    edges_.push_back(p.edge);
+    index_.back().end = edges_.size();
+  }
+}
+
+void ContactGraph::rest(std::int32_t body) {
+  woken_.erase(std::remove(woken_.begin(), woken_.end(), body), woken_.end());
+  const std::span<const Edge> edges = edges_of(body);
+  std::vector<Edge> kept(edges.begin(), edges.end());  // edges_of may point into resting_ itself
+  resting_[body] = std::move(kept);
+}
+
+void ContactGraph::wake(std::int32_t body) {
+  if (resting_.count(body) != 0) woken_.push_back(body);
+}
+
+std::span<const ContactGraph::Edge> ContactGraph::edges_of(std::int32_t body) const {
+  if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return {};
+  if (!resting_.empty()) {
+    const auto sleeping = resting_.find(body);
+    if (sleeping != resting_.end()) return sleeping->second;
+  }
+  const auto found = std::lower_bound(index_.begin(), index_.end(), body,
+                                      [](const BodyEdges& entry, std::int32_t b) { return entry.body < b; });
+  if (found == index_.end() || found->body != body) return {};
+  return std::span<const Edge>(edges_).subspan(found->begin, found->end - found->begin);
 }
 
 double ContactGraph::friction_capacity_N(std::int32_t body) const {
-  if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return 0.0;
-  const auto b = static_cast<std::size_t>(body);
   double capacity_N = 0.0;
-  for (std::size_t e = first_edge_[b]; e < first_edge_[b + 1]; ++e) capacity_N += edges_[e].friction * edges_[e].normal_force_N;
+  for (const Edge& edge : edges_of(body)) capacity_N += edge.friction * edge.normal_force_N;
   return capacity_N;
 }
 
@@ -61,10 +88,9 @@ bool ContactGraph::holds(std::int32_t body, const Eigen::Vector3d& direction) {
   stack_.push_back(body);
   visited_[static_cast<std::size_t>(body)] = generation_;
   while (!stack_.empty()) {
-    const auto b = static_cast<std::size_t>(stack_.back());
+    const std::int32_t b = stack_.back();
     stack_.pop_back();
-    for (std::size_t e = first_edge_[b]; e < first_edge_[b + 1]; ++e) {
-      const Edge& edge = edges_[e];
+    for (const Edge& edge : edges_of(b)) {
       // The contact takes a push along `direction` without sliding iff the push is within its friction cone about
       // −n: cos(angle) ≥ cos(atan μ) = 1/√(1 + μ²).
       const double opposing = -edge.normal.dot(direction);
@@ -81,11 +107,8 @@ bool ContactGraph::holds(std::int32_t body, const Eigen::Vector3d& direction) {
 
 std::uint32_t ContactGraph::local_contacts(std::int32_t body, std::span<const ObjectState> states,
                                           std::array<LocalContact, kMaxLocalContacts>& out) {
-  if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return 0;
-  const auto b = static_cast<std::size_t>(body);
   std::uint32_t count = 0;
-  for (std::size_t e = first_edge_[b]; e < first_edge_[b + 1]; ++e) {
-    const Edge& edge = edges_[e];
+  for (const Edge& edge : edges_of(body)) {
     // This body pushes the other side along −n.
     const bool held = edge.other == kStatic || holds(edge.other, -edge.normal);
     Vec3 other_velocity_mps{};

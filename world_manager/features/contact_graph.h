@@ -16,6 +16,11 @@
 // The chain test keeps the push direction fixed along the chain (a contact's friction cone is the tolerance): it
 // errs toward "does not hold", i.e. toward a model that gives way more than the world does, which is the passive
 // error (local_dynamics.h, frame boundaries).
+//
+// Sleeping bodies (the engine stops simulating a body at rest, ode_engine.h): a body put to sleep keeps the contacts it
+// had in its last simulated substep (`rest`) until it wakes (`wake`), so the local model sees a resting body on its
+// support whether or not the engine simulated it this step. The cost of a step's graph grows with the contacts of the
+// bodies simulated, not with the number of bodies.
 
 #include "common/contract/frames.h"
 #include "world_manager/object_state.h"
@@ -25,6 +30,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 namespace impetus {
@@ -33,7 +39,7 @@ class ContactGraph {
  public:
   static constexpr std::int32_t kStatic = -1;  // the other side is static geometry (floor, fixed objects)
 
-  // Forget the contacts; bodies are 0 … body_count − 1.
+  // Forget the contacts of the last substep (not those of sleeping bodies); bodies are 0 … body_count − 1.
   void reset(std::size_t body_count);
 
   // One contact point: `normal` (unit) pushes `body` out of `other` (a body id or kStatic); `friction` is the pair's μ;
@@ -41,8 +47,13 @@ class ContactGraph {
   void add(std::int32_t body, std::int32_t other, const Eigen::Vector3d& normal, double friction,
            double normal_force_N = 0.0);
 
-  // After the last add(): index the contacts by body.
+  // After the last add(): index the contacts by body. O(C log C) in the contacts added.
   void finish();
+
+  // `body` has gone to sleep: its contacts as of the last finish() stay its contacts until wake(body).
+  void rest(std::int32_t body);
+  // `body` is simulated again: the next reset() forgets its sleeping contacts, and finish() gives its new ones.
+  void wake(std::int32_t body);
 
   // `body`'s contacts for the local model: merged by direction (normals within kSameContactCosine are one constraint,
   // e.g. the four corners of a box on the floor), at most kMaxLocalContacts, kContactHolds set where the other side
@@ -53,10 +64,7 @@ class ContactGraph {
                                std::array<LocalContact, kMaxLocalContacts>& out);
 
   // Whether `body` had any contact (after finish()).
-  bool touching(std::int32_t body) const {
-    return body >= 0 && static_cast<std::size_t>(body) < body_count_ &&
-           first_edge_[static_cast<std::size_t>(body) + 1] > first_edge_[static_cast<std::size_t>(body)];
-  }
+  bool touching(std::int32_t body) const { return !edges_of(body).empty(); }
 
   // Σ μ·N over `body`'s contacts (N: each contact's normal force in the recorded substep): the most tangential force
   // its contacts' friction can hold (N). 0 for a body without contacts or with unknown forces.
@@ -76,12 +84,20 @@ class ContactGraph {
     std::int32_t body;
     Edge edge;
   };
+  struct BodyEdges {
+    std::int32_t body;
+    std::size_t begin, end;  // range in edges_
+  };
+
+  // `body`'s contacts: its sleeping ones if it sleeps, else those of the last finish().
+  std::span<const Edge> edges_of(std::int32_t body) const;
 
   std::size_t body_count_ = 0;
   std::vector<PendingEdge> pending_;
   std::vector<Edge> edges_;             // grouped by body after finish()
-  std::vector<std::size_t> first_edge_;  // body → index of its first edge in edges_; size body_count + 1
-  std::vector<std::size_t> cursor_;     // finish()'s fill position per body (kept to reuse its storage)
+  std::vector<BodyEdges> index_;        // the bodies with contacts, ascending
+  std::unordered_map<std::int32_t, std::vector<Edge>> resting_;  // sleeping bodies' contacts
+  std::vector<std::int32_t> woken_;     // bodies whose sleeping contacts the next reset() forgets
   std::vector<std::uint32_t> visited_;   // per body: the query generation that last visited it
   std::uint32_t generation_ = 0;
   std::vector<std::int32_t> stack_;

@@ -44,18 +44,30 @@ bool nearer(const ReachCandidate& a, const ReachCandidate& b) {
 
 FeatureExtractor::FeatureExtractor(const Scene& scene) : scene_(scene), grid_(choose_cell_size_m(scene)) {}
 
+Eigen::AlignedBox3d FeatureExtractor::swept_bounds(std::size_t id, const ObjectState& state,
+                                                   double world_period_s) const {
+  Eigen::AlignedBox3d box = world_bounds(scene_.objects[id].shape, state.pose);
+  // Sweeping each box by its own motion in one period lets the query use only the finger's part of the reach.
+  const double sweep_m = state.velocity_mps.norm() * world_period_s;
+  box.min().array() -= sweep_m;
+  box.max().array() += sweep_m;
+  return box;
+}
+
 void FeatureExtractor::index(std::span<const ObjectState> states, double world_period_s) {
   swept_bounds_.resize(states.size());
-  for (std::size_t i = 0; i < states.size(); ++i) {
-    const ObjectState& state = states[i];
-    Eigen::AlignedBox3d box = world_bounds(scene_.objects[i].shape, state.pose);
-    // Sweeping each box by its own motion in one period lets the query use only the finger's part of the reach.
-    const double sweep_m = state.velocity_mps.norm() * world_period_s;
-    box.min().array() -= sweep_m;
-    box.max().array() += sweep_m;
-    swept_bounds_[i] = box;
-  }
+  for (std::size_t i = 0; i < states.size(); ++i) swept_bounds_[i] = swept_bounds(i, states[i], world_period_s);
   grid_.rebuild(swept_bounds_);
+}
+
+void FeatureExtractor::reindex(std::span<const ObjectState> states, double world_period_s,
+                               std::span<const std::size_t> moved) {
+  if (swept_bounds_.size() != states.size()) return index(states, world_period_s);
+  for (const std::size_t id : moved) {
+    if (id >= states.size()) continue;
+    swept_bounds_[id] = swept_bounds(id, states[id], world_period_s);
+    grid_.update(static_cast<std::int32_t>(id), swept_bounds_[id]);
+  }
 }
 
 void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const ObjectState> states,

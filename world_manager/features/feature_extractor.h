@@ -7,8 +7,9 @@
 // from the finger (inside counts: the signed distance is negative), so nothing either of them can reach before the next
 // world step is missed. The floor (object_id = scene.floor_object_id()) and static objects give planes too.
 //
-// The extractor keeps a SpatialGrid of every object's bounding box swept by its own speed·T_w; index() rebuilds it
-// once per world step and extract() then only tests the objects in the cells around the finger.
+// The extractor keeps a SpatialGrid of every object's bounding box swept by its own speed·T_w; index() builds it,
+// reindex() moves the objects that moved in a world step, and extract() then only tests the objects in the cells
+// around the finger.
 //
 // Touching boxes: a query on an edge or corner of a box (the proxy in a concave corner of boxes whose faces touch
 // exactly) is equally near two or three of its faces. The face given is one whose outside is free space: a face
@@ -52,8 +53,11 @@ class FeatureExtractor {
   // Keeps a reference to `scene`, which must outlive the extractor.
   explicit FeatureExtractor(const Scene& scene);
 
-  // Re-indexes the objects after the world moved; `states[i]` is scene object i. O(N log N).
+  // Indexes every object; `states[i]` is scene object i. O(N).
   void index(std::span<const ObjectState> states, double world_period_s);
+  // Re-indexes the objects in `moved` after a world step (the others have not moved since they were indexed).
+  // O(moved).
+  void reindex(std::span<const ObjectState> states, double world_period_s, std::span<const std::size_t> moved);
 
   // Every object (and the floor) within reach, nearest first (ties by id). `states` must be those last indexed.
   // With `memory` (feature_memory.h), a query inside an object that had a face in memory's previous step keeps that
@@ -70,6 +74,7 @@ class FeatureExtractor {
   std::size_t last_candidate_count() const { return candidate_ids_.size(); }
 
  private:
+  Eigen::AlignedBox3d swept_bounds(std::size_t id, const ObjectState& state, double world_period_s) const;
   Plane make_plane(const ReachCandidate& candidate, std::span<const ObjectState> states) const;
   // The face of a box for a query on its surface within rounding: the face's own plane (not the direction of a
   // rounding-sized offset), and on an edge or corner a face whose outside is free (header: touching boxes).

@@ -18,6 +18,13 @@ int cell_coordinate(double x_m, double cell_size_m) {
   return static_cast<int>(std::clamp(cell, double{-kCellCoordinateLimit}, double{kCellCoordinateLimit}));
 }
 
+void erase_id(std::vector<std::int32_t>& ids, std::int32_t id) {
+  const auto found = std::find(ids.begin(), ids.end(), id);
+  if (found == ids.end()) return;
+  *found = ids.back();  // order within a cell does not matter: queries sort
+  ids.pop_back();
+}
+
 }  // namespace
 
 SpatialGrid::SpatialGrid(double cell_size_m) : cell_size_m_(cell_size_m) {
@@ -38,6 +45,15 @@ SpatialGrid::CellKey SpatialGrid::key(int x, int y, int z) {
   return (pack(x) << (2 * kBits)) | (pack(y) << kBits) | pack(z);
 }
 
+template <typename Visit>
+void SpatialGrid::for_each_cell(const CellRange& range, Visit&& visit) {
+  for (int x = range.low.x(); x <= range.high.x(); ++x) {
+    for (int y = range.low.y(); y <= range.high.y(); ++y) {
+      for (int z = range.low.z(); z <= range.high.z(); ++z) visit(key(x, y, z));
+    }
+  }
+}
+
 SpatialGrid::CellRange SpatialGrid::cells_of(const Eigen::AlignedBox3d& box) const {
   CellRange range;
   for (int a = 0; a < 3; ++a) {
@@ -47,48 +63,65 @@ SpatialGrid::CellRange SpatialGrid::cells_of(const Eigen::AlignedBox3d& box) con
   return range;
 }
 
-void SpatialGrid::rebuild(const std::vector<Eigen::AlignedBox3d>& bounds) {
-  entries_.clear();
+void SpatialGrid::reset(std::size_t object_count) {
+  entries_.assign(object_count, Entry{});
+  cells_.clear();
   oversized_.clear();
-  object_count_ = static_cast<std::int32_t>(bounds.size());
-  for (std::int32_t id = 0; id < object_count_; ++id) {
-    const Eigen::AlignedBox3d& box = bounds[static_cast<std::size_t>(id)];
-    if (!box.min().allFinite() || !box.max().allFinite()) {
-      oversized_.push_back(id);
-      continue;
-    }
-    const CellRange range = cells_of(box);
-    if (range.count() > kMaxCellsPerObject) {
-      oversized_.push_back(id);
-      continue;
-    }
-    for (int x = range.low.x(); x <= range.high.x(); ++x) {
-      for (int y = range.low.y(); y <= range.high.y(); ++y) {
-        for (int z = range.low.z(); z <= range.high.z(); ++z) entries_.emplace_back(key(x, y, z), id);
-      }
-    }
+}
+
+void SpatialGrid::rebuild(const std::vector<Eigen::AlignedBox3d>& bounds) {
+  reset(bounds.size());
+  for (std::size_t id = 0; id < bounds.size(); ++id) update(static_cast<std::int32_t>(id), bounds[id]);
+}
+
+void SpatialGrid::remove(std::int32_t id) {
+  if (id < 0 || static_cast<std::size_t>(id) >= entries_.size()) return;
+  Entry& entry = entries_[static_cast<std::size_t>(id)];
+  if (entry.placement == Placement::oversized) erase_id(oversized_, id);
+  if (entry.placement == Placement::cells) {
+    for_each_cell(entry.range, [&](CellKey cell) {
+      const auto found = cells_.find(cell);
+      if (found == cells_.end()) return;
+      erase_id(found->second, id);
+      if (found->second.empty()) cells_.erase(found);
+    });
   }
-  std::sort(entries_.begin(), entries_.end());
+  entry.placement = Placement::absent;
+}
+
+void SpatialGrid::update(std::int32_t id, const Eigen::AlignedBox3d& box) {
+  if (id < 0) return;
+  if (static_cast<std::size_t>(id) >= entries_.size()) entries_.resize(static_cast<std::size_t>(id) + 1);
+  const bool finite = box.min().allFinite() && box.max().allFinite();
+  const CellRange range = finite ? cells_of(box) : CellRange{};
+  const Placement placement = finite && range.count() <= kMaxCellsPerObject ? Placement::cells : Placement::oversized;
+  Entry& entry = entries_[static_cast<std::size_t>(id)];
+  if (entry.placement == placement && (placement == Placement::oversized || entry.range == range)) return;
+  remove(id);
+  entry.placement = placement;
+  entry.range = range;
+  if (placement == Placement::oversized) {
+    oversized_.push_back(id);
+    return;
+  }
+  for_each_cell(range, [&](CellKey cell) { cells_[cell].push_back(id); });
 }
 
 void SpatialGrid::query(const Eigen::AlignedBox3d& query, std::vector<std::int32_t>& out) const {
   out.clear();
   const auto return_all = [&] {
-    for (std::int32_t id = 0; id < object_count_; ++id) out.push_back(id);
+    for (std::size_t id = 0; id < entries_.size(); ++id) {
+      if (entries_[id].placement != Placement::absent) out.push_back(static_cast<std::int32_t>(id));
+    }
   };
   if (!query.min().allFinite() || !query.max().allFinite()) return return_all();
   const CellRange range = cells_of(query);
   if (range.count() > kMaxCellsPerQuery) return return_all();
   out = oversized_;
-  for (int x = range.low.x(); x <= range.high.x(); ++x) {
-    for (int y = range.low.y(); y <= range.high.y(); ++y) {
-      for (int z = range.low.z(); z <= range.high.z(); ++z) {
-        const CellKey cell = key(x, y, z);
-        auto it = std::lower_bound(entries_.begin(), entries_.end(), std::pair<CellKey, std::int32_t>{cell, -1});
-        for (; it != entries_.end() && it->first == cell; ++it) out.push_back(it->second);
-      }
-    }
-  }
+  for_each_cell(range, [&](CellKey cell) {
+    const auto found = cells_.find(cell);
+    if (found != cells_.end()) out.insert(out.end(), found->second.begin(), found->second.end());
+  });
   // An object spanning several queried cells is listed once per cell.
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
