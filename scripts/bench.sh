@@ -5,7 +5,8 @@
 #   scripts/bench.sh [--short]       --short: 5 s instead of 30 s for the real-time loop benchmark
 #
 #   1. haptic tick cost vs number of planes            build/tests/bench_haptic_tick
-#   2. world step and feature query vs object count, physics in the 1 kHz loop vs the 20 Hz world   build/tests/bench_world
+#   2. world step and feature query vs object count, physics in the 1 kHz loop vs the 20 Hz world, a world of
+#      N resting bodies with sleeping on and off (--short: up to 10 k, else 100 k)   build/tests/bench_world
 #   3. channel latency between processes               build/tests/bench_channel
 #   4. 1 kHz real-time loop lateness (FIFO + mlock)    build/tests/bench_rt_loop SECONDS
 #   5. lockstep throughput of the tap trial (simulated s per wall s, target >= 50x) via scripts/run.sh
@@ -18,10 +19,11 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
 
 rt_seconds=30
+world_args=()
 while (($#)); do
   case "$1" in
-    --short) rt_seconds=5; shift ;;
-    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --short) rt_seconds=5; world_args=(--quick); shift ;;
+    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -45,8 +47,8 @@ bench() {
 section "1. Haptic tick cost vs number of planes (ns)"
 bench bench_haptic_tick
 
-section "2. World step and feature query vs number of objects; physics in the 1 kHz loop vs the 20 Hz world"
-bench bench_world
+section "2. World step and feature query vs number of objects; physics in the 1 kHz loop vs the 20 Hz world; sleeping"
+bench bench_world "${world_args[@]}"
 
 section "3. Channel latency between processes"
 bench bench_channel

@@ -46,9 +46,11 @@ Percentiles percentiles(std::vector<double> samples_us) {
 }
 
 // `count` spheres of 2 cm radius on a square grid with 5 cm spacing, resting 1 mm above the floor.
+// Sleeping off: sections 1-3 measure what simulating every body costs (section 4 measures sleeping).
 Scene sphere_field(int count, double spacing_m) {
   Scene scene;
   scene.source_name = "bench";
+  scene.physics.auto_disable = false;
   const int side = static_cast<int>(std::ceil(std::sqrt(count)));
   for (int i = 0; i < count; ++i) {
     SceneObject object;
@@ -95,8 +97,9 @@ void bench_step() {
 
 void bench_features() {
   std::printf("\nFeatureExtractor::extract at constant density (one object per 5 cm cell), finger at the centre\n");
-  std::printf("%8s %10s %14s %14s %16s\n", "objects", "in reach", "extract p50", "extract p99", "index() p50");
-  std::printf("%8s %10s %14s %14s %16s\n", "", "", "[us]", "[us]", "[us]");
+  std::printf("%8s %10s %14s %14s %16s %18s\n", "objects", "in reach", "extract p50", "extract p99", "index() p50",
+              "reindex(10) p50");
+  std::printf("%8s %10s %14s %14s %16s %18s\n", "", "", "[us]", "[us]", "[us]", "[us]");
   for (int count : {100, 1000, 10000, 100000}) {
     Scene scene = sphere_field(count, 0.05);
     std::vector<impetus::ObjectState> states(scene.objects.size());
@@ -111,6 +114,16 @@ void bench_features() {
       extractor.index(states, 0.05);
       index_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
     }
+    // What a world step re-indexes: the 10 objects that moved (each by 1 cm, so some change cells).
+    std::vector<std::size_t> moved;
+    for (std::size_t k = 0; k < 10; ++k) moved.push_back(k * states.size() / 10);
+    std::vector<double> reindex_us;
+    for (int i = 0; i < 20; ++i) {
+      for (const std::size_t id : moved) states[id].pose.position_m.x() += (i % 2 == 0 ? 0.01 : -0.01);
+      const auto start = Clock::now();
+      extractor.reindex(states, 0.05, moved);
+      reindex_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+    }
     std::array<impetus::Plane, impetus::kMaxPlanes> planes{};
     impetus::ReachQuery finger;
     finger.position_m = {0.01, 0.01, 0.05};
@@ -123,7 +136,8 @@ void bench_features() {
       samples_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
     }
     const Percentiles p = percentiles(samples_us);
-    std::printf("%8d %10u %14.2f %14.2f %16.1f\n", count, in_reach, p.p50_us, p.p99_us, percentiles(index_us).p50_us);
+    std::printf("%8d %10u %14.2f %14.2f %16.1f %18.2f\n", count, in_reach, p.p50_us, p.p99_us,
+                percentiles(index_us).p50_us, percentiles(reindex_us).p50_us);
   }
 }
 

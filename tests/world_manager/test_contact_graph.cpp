@@ -120,3 +120,35 @@ TEST_CASE("contact graph: a contact with a dynamic body carries its velocity and
   CHECK(graph.friction_capacity_N(0) == Approx(0.5 * 9.81 + 0.2 * 2.0));
   CHECK(graph.friction_capacity_N(1) == Approx(0.2 * 2.0));
 }
+
+TEST_CASE("contact graph: a sleeping body keeps the contacts it fell asleep with until it wakes") {
+  ContactGraph graph;
+  graph.reset(3);
+  for (int corner = 0; corner < 4; ++corner) graph.add(0, kStatic, Vector3d::UnitZ(), 0.4, 1.0);  // box 0 on the floor
+  touch(graph, 1, 0, Vector3d::UnitZ(), 0.4);  // box 1 on box 0
+  graph.finish();
+  graph.rest(0);  // box 0 sleeps: the engine no longer collides it
+  graph.rest(1);
+
+  // The next substep's graph has only the awake body 2, on the floor.
+  graph.reset(3);
+  graph.add(2, kStatic, Vector3d::UnitZ(), 0.4, 2.0);
+  graph.finish();
+  CHECK(graph.touching(0));
+  CHECK(graph.friction_capacity_N(0) == Approx(4 * 0.4 * 1.0));
+  CHECK(graph.holds(1, -Vector3d::UnitZ()));  // box 1, pressed down, is still held through sleeping box 0
+  std::array<LocalContact, impetus::kMaxLocalContacts> contacts{};
+  CHECK(graph.local_contacts(0, {}, contacts) == 2);  // the floor and box 1
+  CHECK(graph.friction_capacity_N(2) == Approx(0.4 * 2.0));
+
+  // Box 0 wakes: its sleeping contacts last until the next graph, which has its new ones (none here).
+  graph.wake(0);
+  CHECK(graph.touching(0));
+  graph.reset(3);
+  graph.finish();
+  CHECK_FALSE(graph.touching(0));
+  CHECK(graph.touching(1));  // still asleep
+  // Asleep again: what the graph had for it then (nothing) is what it keeps.
+  graph.rest(0);
+  CHECK_FALSE(graph.touching(0));
+}

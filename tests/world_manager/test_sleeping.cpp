@@ -114,6 +114,7 @@ TEST_CASE("sleeping: a push wakes a sleeping body where it slept, and the push m
   // A cube on a floor, asleep; an impulse of 0.5 N·s along +x then sets it sliding as in the tap task. The same run
   // with sleeping off: the cube rested at the same place (it had come to rest before it slept), so both slide alike.
   Scene scene = impetus::load_scene(impetus::test::scene_path("tap.json"));
+  scene.physics.auto_disable = false;
   Scene sleeping_scene = scene;
   sleeping_scene.physics.auto_disable = true;
   auto awake_world = make_world(scene);
