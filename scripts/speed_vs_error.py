@@ -19,6 +19,8 @@ Per cell (one row of OUT/speed_vs_error.csv and of the Markdown table OUT/speed_
     spread_mm phase spread: per object the norm of the per-axis range (max - min) over phases, RMS over objects
               (for the one-cube tap scene this is the paper's Fig. 5 spread of the stop position)
     worst_mm  the worst single phase's RMS-over-objects error
+  floor_penetration_mm  the deepest any object went into the floor at the end of a world step, worst phase
+            (summary world.floor_penetration_max_m): ODE's penetration, which grows with the substep length
   cost, averaged over the cell's phases (from each trial's summary.json):
     world CPU per step (mean and p99, us) and per simulated second (ms), haptic CPU per tick (mean and p99, ns),
     wall time of the lockstep trial (s) and simulated seconds per wall second.
@@ -143,6 +145,8 @@ def cell_stats(trials, reference, start, eval_tick):
     def summary_mean(section, key, scale=1.0):
         return scale * mean([getattr(t["summary"], section).get(key) for t in trials])
 
+    penetrations = [t["summary"].world.get("floor_penetration_max_m") for t in trials]
+    penetrations = [p for p in penetrations if p is not None]
     walls = [t["summary"].wall_time_s for t in trials]
     sims = [t["summary"].world.get("time_s") for t in trials]
     touched = [sum(1 for name in t["summary"].objects if norm(t["summary"].impulse_Ns(name)) > TOUCH_THRESHOLD_NS)
@@ -151,6 +155,7 @@ def cell_stats(trials, reference, start, eval_tick):
         "touched_objects": mean(touched),
         "rms_mm": 1e3 * rms, "bias_mm": 1e3 * bias_rms, "bias_along_travel_mm": 1e3 * mean(along),
         "spread_mm": 1e3 * spread, "worst_mm": 1e3 * max(per_phase_rms),
+        "floor_penetration_mm": 1e3 * max(penetrations) if penetrations else float("nan"),
         "world_cpu_step_mean_us": summary_mean("world", "cpu_per_step_mean_us"),
         "world_cpu_step_p99_us": summary_mean("world", "cpu_per_step_p99_us"),
         "world_cpu_ms_per_sim_s": summary_mean("world", "cpu_per_simulated_s", 1e3),
@@ -179,9 +184,10 @@ def markdown(rows, meta):
                   f"reference, {fmt(info['max_speed_at_eval_mps'], 3)} m/s over all trials.",
                   "",
                   "| experiment | coupling | world Hz | substeps | phases | touched | RMS err (mm) | bias (mm) | "
-                  "bias along travel (mm) | phase spread (mm) | worst (mm) | world CPU/step mean, p99 (µs) | "
+                  "bias along travel (mm) | phase spread (mm) | worst (mm) | floor penetration (mm) | "
+                  "world CPU/step mean, p99 (µs) | "
                   "world CPU per sim s (ms) | haptic CPU/tick mean, p99 (ns) | wall (s) | sim s / wall s |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in rows:
             if r["scene"] != scene:
                 continue
@@ -190,7 +196,8 @@ def markdown(rows, meta):
                 f"| {r['experiment']} | {r['coupling']} | {r['rate_hz']:g} | {r['substeps']} | {phases} | "
                 f"{fmt(r.get('touched_objects'), 1)} | {fmt(r.get('rms_mm'), 2)} | {fmt(r.get('bias_mm'), 2)} | "
                 f"{fmt(r.get('bias_along_travel_mm'), 2)} | {fmt(r.get('spread_mm'), 2)} | "
-                f"{fmt(r.get('worst_mm'), 2)} | {fmt(r.get('world_cpu_step_mean_us'), 0)}, "
+                f"{fmt(r.get('worst_mm'), 2)} | {fmt(r.get('floor_penetration_mm'), 2)} | "
+                f"{fmt(r.get('world_cpu_step_mean_us'), 0)}, "
                 f"{fmt(r.get('world_cpu_step_p99_us'), 0)} | {fmt(r.get('world_cpu_ms_per_sim_s'), 2)} | "
                 f"{fmt(r.get('haptic_cpu_tick_mean_ns'), 0)}, {fmt(r.get('haptic_cpu_tick_p99_ns'), 0)} | "
                 f"{fmt(r.get('wall_s'), 2)} | {fmt(r.get('sim_per_wall'), 1)} |")
@@ -339,7 +346,7 @@ def main():
     parser.add_argument("--phases", type=int, help="phases per rate (default 10, --quick 4)")
     parser.add_argument("--scenes", help="subset of tap,spheres (default both, --quick tap)")
     parser.add_argument("--spheres-trajectory", default=SPHERES_TRAJECTORY)
-    parser.add_argument("--substeps", help="substeps knob values (default 1,2,5,10; --quick 1,10; '' to skip)")
+    parser.add_argument("--substeps", help="substeps knob values (default 1,2,5,10,20,40; --quick 1,10; '' to skip)")
     parser.add_argument("--substeps-rates", help="world rates of the substeps knob, Hz (default 20,100; --quick 20)")
     parser.add_argument("--substeps-scenes", help="scenes of the substeps knob (default tap,spheres; --quick tap)")
     parser.add_argument("--substeps-coupling", default="impulse")
@@ -356,7 +363,7 @@ def main():
     rates = parse_list(args.rates, int) if args.rates else (QUICK_RATES if args.quick else FULL_RATES)
     phases_per_rate = args.phases or (4 if args.quick else 10)
     scenes = parse_list(args.scenes, str) if args.scenes else (["tap"] if args.quick else ["tap", "spheres"])
-    substeps_knob = parse_list(args.substeps if args.substeps is not None else ("1,10" if args.quick else "1,2,5,10"),
+    substeps_knob = parse_list(args.substeps if args.substeps is not None else ("1,10" if args.quick else "1,2,5,10,20,40"),
                                int)
     substeps_rates = parse_list(args.substeps_rates or ("20" if args.quick else "20,100"), int)
     substeps_scenes = parse_list(args.substeps_scenes or ("tap" if args.quick else "tap,spheres"), str)

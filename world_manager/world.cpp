@@ -109,6 +109,13 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   ++steps_taken_;
   time_s_ = static_cast<double>(steps_taken_) * period_s_;  // no drift from summing periods
   refresh_states(engine_->moved());
+  simulated_object_steps_ += engine_->moved().size();
+  if (scene_.floor.present) {
+    for (const std::size_t id : engine_->moved()) {
+      const double lowest_m = world_bounds(scene_.objects[id].shape, states_[id].pose).min().z();
+      floor_penetration_max_m_ = std::max(floor_penetration_max_m_, scene_.floor.height_m - lowest_m);
+    }
+  }
 
   // Step 4: planes and publication.
   features_.reindex(states_, period_s_, engine_->moved());

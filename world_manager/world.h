@@ -78,6 +78,13 @@ class World {
   // The dynamic objects the last step simulated, ascending: what the step cost grows with (RigidBodyEngine::moved).
   std::span<const std::size_t> simulated() const { return engine_->moved(); }
 
+  // Object-steps simulated since the start: Σ over steps of simulated().size().
+  std::uint64_t simulated_object_steps() const { return simulated_object_steps_; }
+  // The deepest any dynamic object has been into the floor at the end of a world step since the start (m; 0 without
+  // a floor or contact). What the haptic side and the logs see of ODE's penetration, which grows with the substep
+  // length: a body arriving at speed v sinks up to v·h before the substep that finds its contact.
+  double floor_penetration_max_m() const { return floor_penetration_max_m_; }
+
   // State of every scene object after the last step (static ones never change).
   std::span<const ObjectState> states() const { return states_; }
   // Impulse the world applied to object `id` in the last step, and since the start (N·s, N·m·s). In position coupling
@@ -142,6 +149,8 @@ class World {
   std::vector<PlaneFrame> frames_;    // per slot; kMaxEndpoints, allocated once (a frame is ~40 KB)
   std::array<FingerState, kMaxEndpoints> fingers_{};  // each slot's finger, as the coupling takes them
   std::size_t slots_used_ = 0;
+  std::uint64_t simulated_object_steps_ = 0;
+  double floor_penetration_max_m_ = 0.0;
   double time_s_ = 0.0;
   std::uint64_t steps_taken_ = 0;
 };

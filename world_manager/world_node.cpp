@@ -210,6 +210,14 @@ nlohmann::json WorldNode::escaped_names() const {
   return names;
 }
 
+std::size_t WorldNode::asleep_count() const {
+  std::size_t asleep = 0;
+  for (std::size_t id = 0; id < scene_.objects.size(); ++id) {
+    if (scene_.objects[id].dynamic && world_.asleep(id)) ++asleep;
+  }
+  return asleep;
+}
+
 nlohmann::json WorldNode::summary() const {
   nlohmann::json objects = nlohmann::json::object();
   const auto states = world_.states();
@@ -248,6 +256,12 @@ nlohmann::json WorldNode::summary() const {
             {"foreign_reports", world_.foreign_reports()},
             {"stale_finger_steps", stale_finger_steps_},
             {"escaped_objects", escaped_names()},
+            {"floor_penetration_max_m", world_.floor_penetration_max_m()},
+            {"asleep_objects", asleep_count()},
+            {"simulated_objects_per_step_mean",
+             world_.steps_taken() > 0 ? static_cast<double>(world_.simulated_object_steps()) /
+                                            static_cast<double>(world_.steps_taken())
+                                      : 0.0},
             {"lateness_p50_ns", stats_.lateness_p50_ns},
             {"lateness_p99_ns", stats_.lateness_p99_ns},
             {"lateness_max_ns", stats_.lateness_max_ns},

@@ -66,6 +66,7 @@ class WorldNode final : public WorldStepper {
 
  private:
   nlohmann::json escaped_names() const;
+  std::size_t asleep_count() const;  // dynamic objects asleep now
   void publish_stats(const class RealtimeClock* clock);
 
   WorldNodeOptions options_;
