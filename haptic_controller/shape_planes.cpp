@@ -10,6 +10,10 @@ namespace {
 // A proxy this close to a face's rim is still on the face: the god-object puts a proxy that slides up to an edge on
 // it only to rounding (~1e-17 m), and a point on the surface has no direction to take a normal from.
 constexpr double kOnSurface_m = 1e-9;
+// A plane within 1° of a face's normal is that face's, as the interpolation or the local model turned it (the local
+// model's blend toward a new frame turns a face by a fraction of what the body turned in one period); an edge's or a
+// corner's plane from the world is tilted by more unless the proxy was within 1/57 of its distance of the face plane.
+constexpr double kSameFaceCosine = 0.99984769515;  // cos 1°
 
 void retake_sphere(ContactPlane& plane, const Eigen::Vector3d& around_m) {
   const Eigen::Vector3d centre_m = plane.point_m - plane.extent_m * plane.normal;
@@ -49,7 +53,10 @@ void retake_cylinder(ContactPlane& plane, const Eigen::Vector3d& around_m) {
   const bool beside = radial_m > radius_m + kOnSurface_m;
   const bool beyond_cap = std::abs(local_m.z()) > half_length_m + kOnSurface_m;
   if (!beside && !beyond_cap) return;  // on the surface or inside
-  if (cap_plane && !beside && local_m.z() * normal_local.z() > 0.0) return;  // over its own cap
+  // Over its own cap a cap's plane stays; a rim's plane from the world (tilted off the axis) becomes the cap's there,
+  // as a box edge's plane becomes its face's (retake_box).
+  const bool cap_as_moved = cap_plane && std::abs(normal_local.z()) >= kSameFaceCosine;
+  if (cap_as_moved && !beside && local_m.z() * normal_local.z() > 0.0) return;
   Eigen::Vector3d nearest_local_m(local_m.x(), local_m.y(), std::clamp(local_m.z(), -half_length_m, half_length_m));
   if (beside) nearest_local_m.head<2>() *= radius_m / radial_m;
   const Eigen::Vector3d offset_local_m = local_m - nearest_local_m;
@@ -81,7 +88,10 @@ void retake_box(ContactPlane& plane, const Eigen::Vector3d& around_m) {
     // the interpolation or the local model made it; anywhere else the box's nearest edge, corner or face.
     const bool over_face = offset_local_m[face_axis] * face_side > 0.0 &&
                            offset_local_m.squaredNorm() == offset_local_m[face_axis] * offset_local_m[face_axis];
-    if (over_face) return;
+    // Over its face the face's plane stays. An edge's or a corner's plane (the world took it with its proxy past the
+    // rim) tilts away from the face it is counted to: kept over the face it hangs above the face, millimetres off the
+    // box a few millimetres in, and the proxy slides along it in free space. It becomes the face's plane there.
+    if (over_face && std::abs(normal_local[face_axis]) >= kSameFaceCosine) return;
     plane.normal = plane.box_axes * (offset_local_m / distance_m);
     plane.point_m = plane.com_m + plane.box_axes * nearest_local_m;
     return;

@@ -323,3 +323,40 @@ TEST_CASE("cylinder planes: a cap's plane stays over the cap and ends at its rim
     CHECK(planes.planes[0].normal == before.normal);
   }
 }
+
+TEST_CASE("box and cylinder planes: an edge's or a rim's plane from the world becomes the face's over the face, a "
+          "face turned by less than a degree stays") {
+  for (const Eigen::Quaterniond& turn :
+       {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()))}) {
+    const Eigen::Matrix3d axes = turn.toRotationMatrix();
+    const Vector3d centre(0.01, -0.02, 0.05);
+    const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
+    // The world took the box's plane with its proxy 3 mm past the +x edge of the top: the edge's plane, tilted 37°.
+    ContactPlane edge = to_contact_plane(box_top_plane(centre, turn, at(0.0, 0.0, 0.06)));
+    edge.point_m = at(0.05, 0.0, 0.05);
+    edge.normal = axes * Vector3d(0.6, 0.0, 0.8);
+    // The proxy is now back over the top face, 4 mm in from the edge and 1 mm above the face: the face's own plane,
+    // not the edge's, which hangs 3 mm above the face there and would hold a finger that touches nothing.
+    PlaneSet planes = make_set({edge});
+    retake_shape_planes(planes, at(0.046, 0.01, 0.051));
+    CHECK((planes.planes[0].normal - axes.col(2)).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(0.046, 0.01, 0.05)).norm() < 1e-12);
+
+    // A top face the local model turned by half a degree about y: over the face it stays as it is.
+    ContactPlane tilted = to_contact_plane(box_top_plane(centre, turn, at(0.0, 0.0, 0.06)));
+    tilted.normal = axes * Vector3d(std::sin(0.0087), 0.0, std::cos(0.0087));
+    planes = make_set({tilted});
+    retake_shape_planes(planes, at(0.02, 0.01, 0.052));
+    CHECK(planes.planes[0].normal == tilted.normal);
+    CHECK(planes.planes[0].point_m == tilted.point_m);
+
+    // A cylinder's rim plane from the world, the proxy now over the cap: the cap's plane.
+    ContactPlane rim = cylinder_top_plane(centre, turn);
+    rim.point_m = at(0.02, 0.0, 0.03);
+    rim.normal = axes * Vector3d(0.6, 0.0, 0.8);
+    planes = make_set({rim});
+    retake_shape_planes(planes, at(0.01, 0.005, 0.031));
+    CHECK((planes.planes[0].normal - axes.col(2)).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(0.01, 0.005, 0.03)).norm() < 1e-12);
+  }
+}

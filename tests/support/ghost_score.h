@@ -35,6 +35,7 @@ inline constexpr double kForce_N = 0.1;       // "some force": 0.05 mm of the 2 
 inline constexpr double kOutside_m = 1e-4;    // clearly outside or inside: the spring's 0.2 N
 inline constexpr double kDeep_m = 1e-3;       // a wall the exact god-object would push back from with 2 N
 inline constexpr double kPopThrough_m = 5e-4;
+inline constexpr double kPi = 3.14159265358979323846;
 
 struct Score {
   int ticks = 0;
@@ -80,7 +81,11 @@ inline Scene clutter(int count, unsigned seed) {
     }
     object.mass_kg = 0.1;
     object.position_m = {0.12 * (unit(random) - 0.5), 0.12 * (unit(random) - 0.5), 0.12 * (unit(random) - 0.5)};
-    const Eigen::Quaterniond turn = Eigen::Quaterniond::UnitRandom();
+    // A uniform random rotation from the seeded generator (Shoemake's three uniforms; Eigen's UnitRandom draws from
+    // std::rand, whose state depends on what ran before, so the same seed would not give the same clutter).
+    const double u1 = unit(random), u2 = 2.0 * kPi * unit(random), u3 = 2.0 * kPi * unit(random);
+    const Eigen::Quaterniond turn(std::sqrt(u1) * std::cos(u3), std::sqrt(1.0 - u1) * std::sin(u2),
+                                  std::sqrt(1.0 - u1) * std::cos(u2), std::sqrt(u1) * std::sin(u3));
     object.orientation_wxyz = {turn.w(), turn.x(), turn.y(), turn.z()};
     scene.objects.push_back(object);
   }
