@@ -21,6 +21,9 @@ cp out/figures/tap_task/tap_task.md docs/tap_task.md
 /usr/bin/python3 scripts/grasp_figure.py --out out/figures/grasp
 cp out/figures/grasp/grasp.png docs/grasp.png
 cp out/figures/grasp/grasp.md docs/grasp.md
+# A finger sliding off a box's edge between world frames: planes as sent against planes taken again every tick.
+/usr/bin/python3 scripts/edge_figure.py --out out/figures/edge
+cp out/figures/edge/edge_release.png docs/edge_release.png
 # One-way delay on the world link: the tap under each coupling and the grasp, in-process (docs/latency.md).
 /usr/bin/python3 scripts/latency_experiment.py --out out/figures/latency
 cp out/figures/latency/latency.png docs/latency.png
