@@ -15,6 +15,7 @@ using impetus::HapticReport;
 using impetus::ObjectState;
 using impetus::Scene;
 using impetus::test::add_entry;
+using impetus::test::state_bits;
 using impetus::test::make_report;
 using impetus::test::make_world;
 
@@ -39,20 +40,6 @@ Scene stack_and_ball(double ball_gap_m, double ball_speed_mps) {
   ball.angular_velocity_radps = {0.0, ball_speed_mps / radius_m, 0.0};
   scene.objects.push_back(ball);
   return scene;
-}
-
-std::vector<double> state_bits(const impetus::World& world) {
-  std::vector<double> record;
-  for (const ObjectState& state : world.states()) {
-    const auto& p = state.pose.position_m;
-    const auto& q = state.pose.orientation.coeffs();
-    const auto& v = state.velocity_mps;
-    const auto& w = state.angular_velocity_radps;
-    for (double x : {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w(), v.x(), v.y(), v.z(), w.x(), w.y(), w.z()}) {
-      record.push_back(x);
-    }
-  }
-  return record;
 }
 
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {

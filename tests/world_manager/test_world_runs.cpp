@@ -18,22 +18,12 @@ namespace {
 // Raw bytes of every state double after `steps` steps, with a tap on the first sphere so impulses are exercised too.
 std::vector<double> run_and_record(const impetus::Scene& scene, int steps) {
   auto world = make_world(scene);
-  std::vector<double> record;
   for (int i = 0; i < steps; ++i) {
     HapticReport report = make_report(9, static_cast<std::uint64_t>(50 * i), {0.0, 0.0, 0.05}, true);
     add_entry(report, 0, 1, {0.001 * i, 0.0, 0.0});
     world->step(&report);
   }
-  for (const ObjectState& state : world->states()) {
-    const auto& p = state.pose.position_m;
-    const auto& q = state.pose.orientation.coeffs();
-    const auto& v = state.velocity_mps;
-    const auto& w = state.angular_velocity_radps;
-    for (double x : {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w(), v.x(), v.y(), v.z(), w.x(), w.y(), w.z()}) {
-      record.push_back(x);
-    }
-  }
-  return record;
+  return impetus::test::state_bits(*world);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace impetus::test {
 
@@ -46,6 +47,22 @@ inline HapticReport make_report(std::uint64_t session, std::uint64_t tick, const
   report.finger_m = finger_m;
   report.finger_valid = finger_valid ? 1u : 0u;
   return report;
+}
+
+// Every dynamic state double of every object (position, orientation, velocity, angular velocity), for bitwise
+// comparisons of runs.
+inline std::vector<double> state_bits(const World& world) {
+  std::vector<double> record;
+  for (const ObjectState& state : world.states()) {
+    const auto& p = state.pose.position_m;
+    const auto& q = state.pose.orientation.coeffs();
+    const auto& v = state.velocity_mps;
+    const auto& w = state.angular_velocity_radps;
+    for (double x : {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w(), v.x(), v.y(), v.z(), w.x(), w.y(), w.z()}) {
+      record.push_back(x);
+    }
+  }
+  return record;
 }
 
 inline void add_entry(HapticReport& report, std::int32_t object_id, std::uint32_t epoch, const Vec3& impulse_Ns,
