@@ -47,7 +47,8 @@ python_trial "$prefix"
 
 # The installed viewer finds its page and three.js in the prefix (no source tree, no network).
 viewer_serves() {
-  "$1/bin/viewer" --shm "impetus_install_test_$$" --listen 127.0.0.1:0 --duration 3 > "$scratch/viewer.out" 2>&1 &
+  # Long enough to outlast a loaded machine's start-up and requests; stopped below once they are answered.
+  "$1/bin/viewer" --shm "impetus_install_test_$$" --listen 127.0.0.1:0 --duration 60 > "$scratch/viewer.out" 2>&1 &
   local pid=$! url=""
   for _ in $(seq 100); do
     url=$(sed -n 's/.*serving \(http[^ ]*\).*/\1/p' "$scratch/viewer.out")
@@ -59,7 +60,11 @@ viewer_serves() {
                 three/examples/jsm/controls/OrbitControls.js; do
     curl -sf -o /dev/null "$url$target" || { echo "install_test: the installed viewer does not serve /$target" >&2; exit 1; }
   done
-  wait "$pid"
+  kill -TERM "$pid"
+  local status=0
+  wait "$pid" || status=$?
+  # A stop request ends the viewer with 0 (143 if the signal arrived before its handler was installed).
+  [ "$status" -eq 0 ] || [ "$status" -eq 143 ] || { cat "$scratch/viewer.out" >&2; echo "install_test: the viewer exited $status" >&2; exit 1; }
 }
 viewer_serves "$prefix"
 
