@@ -197,9 +197,10 @@ TEST_CASE("lockstep: when the haptic controller dies mid-trial, the world and th
                                    "/scenes/tap.json", "--clock", "lockstep", "--shm", shm}, dir / "world.out");
   const pid_t haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm},
                                    dir / "haptic.out");
-  // A 60 s press: far longer than the half second before the kill, whatever the machine's speed.
+  // An hour's press: lockstep runs the tap scene at up to ~120x real time here (a 60 s press once ended within the
+  // half second before the kill), so the kill lands mid-trial on any machine short of ~7000x.
   const pid_t device = test::spawn({test::binary("spidar_sim"), "--clock", "lockstep", "--shm", shm,
-                                    "--attach-timeout", "5", "--trajectory", "press:hold=60"}, dir / "device.out");
+                                    "--attach-timeout", "5", "--trajectory", "press:hold=3600"}, dir / "device.out");
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   kill(haptic, SIGKILL);
   test::wait_for(haptic, 5);
@@ -229,8 +230,9 @@ TEST_CASE("lockstep: a device killed mid-session is reported by the haptic contr
                                    "/scenes/tap.json", "--clock", "lockstep", "--shm", shm}, dir / "world.out");
   const pid_t haptic = test::spawn({test::binary("haptic_controller"), "--clock", "lockstep", "--shm", shm},
                                    dir / "haptic.out");
+  // An hour's press, for the same reason as above: the kill must land mid-session.
   const pid_t device = test::spawn({test::binary("spidar_sim"), "--clock", "lockstep", "--shm", shm,
-                                    "--attach-timeout", "5", "--trajectory", "press:hold=60"}, dir / "device.out");
+                                    "--attach-timeout", "5", "--trajectory", "press:hold=3600"}, dir / "device.out");
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   kill(device, SIGKILL);
   test::wait_for(device, 5);
