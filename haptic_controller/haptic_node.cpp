@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/haptic_node.h"
 
+#include "common/runtime/lockstep.h"
 #include "common/runtime/csv_line.h"
 #include "common/runtime/lockstep_schedule.h"
 #include "common/runtime/process.h"
@@ -250,6 +251,15 @@ void HapticNode::run_realtime() {
 
 int HapticNode::run() {
   if (options_.clock == ClockMode::lockstep) {
+    // While the device or the world has the turn, this thread writes the endpoints' log rows.
+    const LockstepIdleWork idle(
+        [](void* node) {
+          for (auto& endpoint : static_cast<HapticNode*>(node)->endpoints_) {
+            if (endpoint->log && endpoint->log->drain_one()) return true;
+          }
+          return false;
+        },
+        this);
     run_lockstep();
   } else {
     run_realtime();

@@ -108,8 +108,8 @@ namespace impetus {
 
 void InterpolatedPlanes::on_frame(const PlaneFrame& previous, const PlaneFrame& frame, const PlaneSet*,
                                   const Eigen::Vector3d&) {
-  previous_ = previous;
-  current_ = frame;
+  copy_used(previous, previous_);
+  copy_used(frame, current_);
 }
 
 void InterpolatedPlanes::planes_for_tick(double w, double, bool, const Eigen::Vector3d& pivot_m, PlaneSet& out) {

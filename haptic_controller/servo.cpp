@@ -36,7 +36,7 @@ void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
     counters_.local_model_error_max_m = std::max(counters_.local_model_error_max_m, motion_->frame_disagreement_m());
   }
   frame_since_last_tick_ = true;
-  current_frame_ = frame;
+  copy_used(frame, current_frame_);
   have_frame_ = true;
   frame_arrival_s_ = now_s;
   accumulator_.on_plane_frame(frame);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "spidar_sim/device_node.h"
 
+#include "common/runtime/lockstep.h"
 #include "common/runtime/process.h"
 #include "common/runtime/realtime_clock.h"
 
@@ -64,6 +65,13 @@ void DeviceNode::publish_stats(const RealtimeClock* clock) {
 
 int DeviceNode::run() {
   if (port_.clock() == ClockMode::lockstep) {
+    // While the haptic controller has the turn, this thread writes the log's rows.
+    const LockstepIdleWork idle(
+        [](void* node) {
+          auto& log = static_cast<DeviceNode*>(node)->log_;
+          return log && log->drain_one();
+        },
+        this);
     for (;;) {
       const TurnResult result = port_.wait_turn();
       if (result == TurnResult::shutdown) {

@@ -27,11 +27,16 @@ const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& comma
   }
   const int substeps = finger_.substeps_for(dt_s);
   const double h_s = dt_s / substeps;
+  // Motors without lag reach the command at once and hold it (SpidarHardware::apply with a zero time constant): one
+  // application stands for the tick's every sub-step. With lag they approach it sub-step by sub-step.
+  const bool motor_lag = hardware_.params().motor_time_constant_s > 0.0;
+  if (!motor_lag) hardware_.apply(commanded_tension_N, h_s);
   for (int k = 0; k < substeps; ++k) {
     const double t_s = time_s_ + k * h_s;
-    hardware_.apply(commanded_tension_N, h_s);
+    if (motor_lag) hardware_.apply(commanded_tension_N, h_s);
     const Eigen::Vector3d force_N = hardware_.force_on_finger(finger_.position_m());
-    finger_.step(to_eigen(trajectory_.position_at(t_s)), to_eigen(trajectory_.velocity_at(t_s)), force_N, h_s);
+    const Trajectory::Sample target = trajectory_.sample_at(t_s, segment_hint_);
+    finger_.step(to_eigen(target.position_m), to_eigen(target.velocity_mps), force_N, h_s);
   }
   time_s_ += dt_s;
   ++state_.tick;

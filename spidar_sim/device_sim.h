@@ -68,6 +68,7 @@ class DeviceSim {
  private:
   SpidarHardware hardware_;
   Trajectory trajectory_;
+  std::size_t segment_hint_ = 0;  // the trajectory segment of the last sub-step (Trajectory::sample_at)
   Finger finger_;
   double time_s_ = 0.0;
   DeviceState state_{};

@@ -223,11 +223,16 @@ Trajectory Trajectory::from_waypoints(const std::vector<Waypoint>& waypoints, st
   return Trajectory(std::move(segments), std::move(description));
 }
 
-const TrajectorySegment& Trajectory::segment_at(double t_s) const {
-  // First segment still running at t_s; zero-length segments are never "running", so they are skipped.
+std::size_t Trajectory::segment_index_at(double t_s, std::size_t hint) const {
+  // First segment still running at t_s; zero-length segments are never "running", so they are skipped. Ends never
+  // decrease, so segment k is that one iff t_s < end_k and (k = 0 or t_s >= end_(k−1)): the hint and the segment
+  // after it are checked so, before a binary search.
+  for (std::size_t k = hint; k < segments_.size() && k <= hint + 1; ++k) {
+    if (t_s < segments_[k].end_s && (k == 0 || !(t_s < segments_[k - 1].end_s))) return k;
+  }
   const auto it = std::upper_bound(segments_.begin(), segments_.end(), t_s,
                                    [](double t, const TrajectorySegment& seg) { return t < seg.end_s; });
-  return it == segments_.end() ? segments_.back() : *it;
+  return it == segments_.end() ? segments_.size() - 1 : static_cast<std::size_t>(it - segments_.begin());
 }
 
 Trajectory Trajectory::held_until(double end_s) const {
@@ -242,21 +247,31 @@ Trajectory Trajectory::held_until(double end_s) const {
   return Trajectory(std::move(segments), description_);
 }
 
-Vec3 Trajectory::position_at(double t_s) const {
-  if (!(t_s > segments_.front().begin_s)) return to_vec3(point_on_path(segments_.front(), 0.0));
-  if (t_s >= segments_.back().end_s) return to_vec3(point_on_path(segments_.back(), 1.0));
-  const TrajectorySegment& seg = segment_at(t_s);
-  return to_vec3(point_on_path(seg, eased_fraction(seg.easing, segment_tau(seg, t_s))));
+Vec3 Trajectory::position_at(double t_s) const { return sample_at(t_s).position_m; }
+
+Vec3 Trajectory::velocity_at(double t_s) const { return sample_at(t_s).velocity_mps; }
+
+Trajectory::Sample Trajectory::sample_at(double t_s) const {
+  std::size_t hint = 0;
+  return sample_at(t_s, hint);
 }
 
-Vec3 Trajectory::velocity_at(double t_s) const {
-  if (!(t_s >= segments_.front().begin_s) || t_s >= segments_.back().end_s) return {0.0, 0.0, 0.0};
-  const TrajectorySegment& seg = segment_at(t_s);
-  const double span = seg.end_s - seg.begin_s;
-  if (span <= 0.0) return {0.0, 0.0, 0.0};
+Trajectory::Sample Trajectory::sample_at(double t_s, std::size_t& segment_hint) const {
+  // Before the start the first point holds (at exactly the start too, where the velocity is already the first
+  // segment's); after the end the last point holds, still.
+  if (t_s >= segments_.back().end_s) return {to_vec3(point_on_path(segments_.back(), 1.0)), {0.0, 0.0, 0.0}};
+  if (!(t_s >= segments_.front().begin_s)) return {to_vec3(point_on_path(segments_.front(), 0.0)), {0.0, 0.0, 0.0}};
+  segment_hint = segment_index_at(t_s, segment_hint);
+  const TrajectorySegment& seg = segments_[segment_hint];
   const double tau = segment_tau(seg, t_s);
+  const double s = eased_fraction(seg.easing, tau);
+  // At the very start the position is the first point exactly, whatever the first segment's easing gives at τ = 0.
+  const Vec3 position_m = t_s > segments_.front().begin_s ? to_vec3(point_on_path(seg, s))
+                                                          : to_vec3(point_on_path(segments_.front(), 0.0));
+  const double span = seg.end_s - seg.begin_s;
+  if (span <= 0.0) return {position_m, {0.0, 0.0, 0.0}};
   // dP/dt = dP/ds · ds/dτ · dτ/dt
-  return to_vec3(path_derivative(seg, eased_fraction(seg.easing, tau)) * (eased_rate(seg.easing, tau) / span));
+  return {position_m, to_vec3(path_derivative(seg, s) * (eased_rate(seg.easing, tau) / span))};
 }
 
 // ---------------------------------------------------------------------------------------------------------------

@@ -130,6 +130,15 @@ class Trajectory {
   Vec3 position_at(double t_s) const;
   // Target velocity (m/s), the time derivative of position_at; zero outside the trajectory.
   Vec3 velocity_at(double t_s) const;
+  // Both at once, with one segment look-up: exactly {position_at(t_s), velocity_at(t_s)}. `segment_hint` (in/out)
+  // is where the previous sample's segment was: a caller whose times mostly increase (a device's sub-steps) finds the
+  // segment in O(1) instead of a search. Any value is valid; the sample does not depend on it.
+  struct Sample {
+    Vec3 position_m;
+    Vec3 velocity_mps;
+  };
+  Sample sample_at(double t_s) const;
+  Sample sample_at(double t_s, std::size_t& segment_hint) const;
   // Time (s) of the last point; after it the target holds still.
   double duration_s() const { return segments_.back().end_s; }
   // The same path, then holding its last point until end_s (if later than its own end): the fingers of one device
@@ -139,7 +148,8 @@ class Trajectory {
   const std::string& description() const { return description_; }
 
  private:
-  const TrajectorySegment& segment_at(double t_s) const;
+  // Index of the first segment still running at t_s (t_s < its end), the last if none is; `hint` is tried first.
+  std::size_t segment_index_at(double t_s, std::size_t hint) const;
 
   std::vector<TrajectorySegment> segments_;
   std::string description_;

@@ -227,9 +227,11 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
   // not the far face of a memory that lapsed.
   const bool valid = endpoint.finger.valid;
   if (valid) endpoint.plane_faces.begin_step(states_.size());
+  const std::uint32_t used_before = std::min(frame.plane_count, kMaxPlanes);
   frame.plane_count =
       valid ? features_.extract(endpoint.plane_query, states_, period_s_, frame.planes, &endpoint.plane_faces) : 0;
-  if (!valid) frame.planes.fill(Plane{});
+  // Planes past the count stay value-initialised (frames.h copy_used): only those the last frame used need it.
+  for (std::uint32_t k = frame.plane_count; k < used_before; ++k) frame.planes[k] = Plane{};
   coupling_->annotate(frame);
 }
 

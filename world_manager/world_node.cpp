@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/world_node.h"
 
+#include "common/runtime/lockstep.h"
 #include "common/runtime/lockstep_schedule.h"
 #include "common/runtime/process.h"
 #include "common/runtime/realtime_clock.h"
@@ -55,13 +56,7 @@ WorldNode::WorldNode(const WorldNodeOptions& options)
       throw std::invalid_argument(message);
     }
   }
-  if (!options.log_path.empty()) {
-    log_file_.emplace(options.log_path);
-    if (!*log_file_) throw std::runtime_error("cannot open log file '" + options.log_path + "' for writing");
-    log_watch_.emplace("world_manager", options.log_path);
-    log_.emplace(world_);
-    log_->write_header(*log_file_);
-  }
+  if (!options.log_path.empty()) log_.emplace(world_, options.log_path);
 }
 
 WorldLinkInfo WorldNode::link_info() const {
@@ -147,12 +142,7 @@ void WorldNode::step_world() {
                  "finite); it is taken out of the simulation\n", world_.time_s(), scene_.objects[id].name.c_str(),
                  kEscapeDistance_m);
   }
-  if (log_) {
-    log_->write_row(*log_file_);
-    // The world steps at 10–50 Hz: flushing each row costs nothing and shows a full disk at once.
-    log_file_->flush();
-    log_watch_->check(*log_file_);
-  }
+  if (log_) log_->record();
 }
 
 void WorldNode::publish_stats(const RealtimeClock* clock) {
@@ -170,6 +160,13 @@ int WorldNode::run() {
           : std::numeric_limits<std::uint64_t>::max();
   bool cut_short = false;  // the lockstep master died mid-trial: the trial is incomplete
   if (options_.clock == ClockMode::lockstep) {
+    // Between its turns this thread writes the log's rows (a world step's row, object by object).
+    const LockstepIdleWork idle(
+        [](void* node) {
+          auto& log = static_cast<WorldNode*>(node)->log_;
+          return log && log->drain_one();
+        },
+        this);
     while (world_.steps_taken() < max_steps) {
       const TurnResult result = link_->wait_turn();
       if (result != TurnResult::ok) {
@@ -197,11 +194,8 @@ int WorldNode::run() {
       publish_stats(&clock);
     }
   }
-  if (log_file_) {
-    log_file_->flush();
-    log_watch_->check(*log_file_);
-  }
-  return cut_short || (log_watch_ && log_watch_->failed()) ? 1 : 0;  // each reported when it happened
+  if (log_) log_->close();
+  return cut_short || (log_ && log_->failed()) ? 1 : 0;  // each reported when it happened
 }
 
 nlohmann::json WorldNode::escaped_names() const {

@@ -6,7 +6,6 @@
 //
 // Owns its World, log and statistics; its summary is the world half of summary.json (DESIGN.md §4).
 
-#include "common/runtime/write_watch.h"
 #include "common/link/inproc/inproc_world_link.h"
 #include "common/contract/world_view.h"
 #include "common/link/world_link.h"
@@ -20,7 +19,6 @@
 #include <array>
 #include <cstdint>
 #include <vector>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -75,9 +73,7 @@ class WorldNode final : public WorldStepper {
   WorldLinkServer* link_ = nullptr;
   WorldViewPublisher* view_ = nullptr;
   std::unique_ptr<WorldSnapshot> snapshot_;  // ~120 KB at full capacity: allocated once, in connect_view
-  std::optional<std::ofstream> log_file_;
-  std::optional<WriteWatch> log_watch_;  // reports a failed log write when it happens
-  std::optional<WorldLog> log_;
+  std::optional<WorldLog> log_;  // written by its own thread; reports a failed write when it happens
   // Per endpoint slot of the link: its newest report, and when it last changed (staleness).
   struct SlotReport {
     HapticReport report{};

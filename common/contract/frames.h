@@ -191,6 +191,14 @@ struct DeviceState {
   std::array<std::int64_t, kStringCount> encoder_counts{};
 };
 
+// Copy a frame or report by its used part: the header, then the planes (entries) below its count, clamped to the
+// capacity. What `to` held beyond that count is reset to a value-initialised Plane (ObjectImpulse), so a destination
+// whose unused slots were value-initialised keeps them so, as the transports' decoders leave them. A whole frame is
+// ~56 KB and a report ~7 KB while a trial touches a few planes: this costs what is used, not the capacity. Never
+// allocates or throws (the 1 kHz path copies reports). `from` and `to` may be the same object.
+void copy_used(const PlaneFrame& from, PlaneFrame& to) noexcept;
+void copy_used(const HapticReport& from, HapticReport& to) noexcept;
+
 static_assert(std::is_trivially_copyable_v<Plane>);
 static_assert(std::is_trivially_copyable_v<PlaneFrame>);
 static_assert(std::is_trivially_copyable_v<ObjectImpulse>);

@@ -19,7 +19,13 @@ namespace impetus {
 
 class CsvLine {
  public:
-  explicit CsvLine(std::ostream& out) : out_(out) {}
+  // Which part of a row this line writes: a whole row (ended by a newline), or one piece of a row written in several
+  // (the first piece, a middle one after a comma, the last one after a comma and ended by the newline).
+  enum class Part { whole, first, middle, last };
+
+  explicit CsvLine(std::ostream& out, Part part = Part::whole)
+      : out_(out), first_(part == Part::whole || part == Part::first),
+        newline_(part == Part::whole || part == Part::last) {}
   CsvLine(const CsvLine&) = delete;
   CsvLine& operator=(const CsvLine&) = delete;
   ~CsvLine() { end(); }
@@ -42,10 +48,10 @@ class CsvLine {
     return number(v[0]).number(v[1]).number(v[2]);
   }
 
-  // Ends the row with a newline and writes out what is buffered. Idempotent.
+  // Ends the row (or this piece of it) and writes out what is buffered. Idempotent.
   void end() {
     if (ended_) return;
-    buffer_[size_++] = '\n';
+    if (newline_) buffer_[size_++] = '\n';
     flush();
     ended_ = true;
   }
@@ -68,6 +74,7 @@ class CsvLine {
   std::array<char, 4096> buffer_{};
   std::size_t size_ = 0;
   bool first_ = true;
+  bool newline_ = true;
   bool ended_ = false;
 };
 

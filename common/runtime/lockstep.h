@@ -21,9 +21,10 @@ enum class TurnResult { ok, shutdown, peer_gone, timed_out, corrupted };
 const char* to_string(TurnResult result);
 
 // Lives in a segment; every word is a process-shared atomic. A turn is handed over by a binary semaphore built on a
-// futex word (0: no turn pending, 1: one pending) rather than a POSIX sem_t: glibc aborts the whole process when a
-// scribbled sem_t makes the futex call fail, whereas here every word is checked before use and a value the protocol
-// never writes ends the wait with `corrupted`, so the caller can say so and stop cleanly.
+// futex word (idle, posted, or idle with the waiter asleep in the kernel: only then does a post make a system call)
+// rather than a POSIX sem_t: glibc aborts the whole process when a scribbled sem_t makes the futex call fail, whereas
+// here every word is checked before use and a value the protocol never writes ends the wait with `corrupted`, so the
+// caller can say so and stop cleanly.
 class LockstepTurn {
  public:
   LockstepTurn() = default;
@@ -51,16 +52,34 @@ class LockstepTurn {
 
  private:
   enum class Wait { posted, slice_over, corrupted };
+  // The states of a turn word. Idle: no turn pending, the waiter (if any) polls. Posted: a turn is pending. Asleep:
+  // no turn pending and the waiter blocks in the kernel, so the poster must wake it.
+  static constexpr std::uint32_t kIdle = 0;
+  static constexpr std::uint32_t kPosted = 1;
+  static constexpr std::uint32_t kAsleep = 2;
   static Wait wait_slice(std::atomic<std::uint32_t>& turn);
   static void post(std::atomic<std::uint32_t>& turn);
   bool shutdown_corrupted() const { return shutdown_.load(std::memory_order_acquire) > 1; }
 
-  std::atomic<std::uint32_t> go_{0};    // master → follower
-  std::atomic<std::uint32_t> done_{0};  // follower → master
+  std::atomic<std::uint32_t> go_{kIdle};    // master → follower
+  std::atomic<std::uint32_t> done_{kIdle};  // follower → master
   std::atomic<std::uint64_t> tick_{0};
   std::atomic<std::uint32_t> shutdown_{0};
 };
 static_assert(std::atomic<std::uint32_t>::is_always_lock_free);
+
+// Work a lockstep process does while it waits for a turn, instead of only polling: formatting its logs' rows
+// (rt_log.h drain_one), so they are written in time it would otherwise spend waiting. `work(context)` does a little
+// (microseconds: one row) and returns whether it did anything; the waiter polls its turn between calls, so the turn is
+// taken at most one call late. Installed for the calling thread while the guard lives (one at a time).
+class LockstepIdleWork {
+ public:
+  using Work = bool (*)(void* context);
+  LockstepIdleWork(Work work, void* context);
+  ~LockstepIdleWork();
+  LockstepIdleWork(const LockstepIdleWork&) = delete;
+  LockstepIdleWork& operator=(const LockstepIdleWork&) = delete;
+};
 
 template <class PeerAlive>
 TurnResult LockstepTurn::wait_done(PeerAlive&& peer_alive, double timeout_s) {

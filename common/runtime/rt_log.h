@@ -17,6 +17,7 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -61,6 +62,42 @@ class RtLog {
     head_.store(head + 1, std::memory_order_release);
   }
 
+  // Producer: several rows that the drain must see together or not at all (pieces of one CSV line), at most the
+  // capacity. Waits for room for all of them in lockstep; with LogOverflow::drop drops them all if there is none.
+  void push_all(std::span<const Row> rows) {
+    const std::uint64_t head = head_.load(std::memory_order_relaxed);
+    if (rows.size() > rows_.size()) {
+      dropped_.fetch_add(rows.size(), std::memory_order_relaxed);  // could never fit: a caller's sizing error
+      return;
+    }
+    while (head + rows.size() - tail_.load(std::memory_order_acquire) > rows_.size()) {
+      if (overflow_ == LogOverflow::drop) {
+        dropped_.fetch_add(rows.size(), std::memory_order_relaxed);
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(50));
+    }
+    for (std::size_t k = 0; k < rows.size(); ++k) rows_[(head + k) % rows_.size()] = rows[k];
+    head_.store(head + rows.size(), std::memory_order_release);
+  }
+
+  // Any thread: formats the oldest queued row, unless none is queued or another thread is draining, and says whether
+  // it did. A lockstep process calls it while it waits for its turn (lockstep.h LockstepIdleWork): the rows are then
+  // formatted in time the process would only spend polling, instead of by the drain thread, which on a machine of
+  // two cores must take one from a process in the turn. Never blocks; the drain thread flushes the file.
+  bool drain_one() {
+    if (draining_.test_and_set(std::memory_order_acquire)) return false;
+    const std::uint64_t tail = tail_.load(std::memory_order_relaxed);
+    const bool queued = tail != head_.load(std::memory_order_acquire);
+    if (queued) {
+      format_(file_, rows_[tail % rows_.size()]);
+      tail_.store(tail + 1, std::memory_order_release);
+      unflushed_.store(true, std::memory_order_relaxed);
+    }
+    draining_.clear(std::memory_order_release);
+    return queued;
+  }
+
   std::uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
   // Whether a write to the file failed (reported on stderr when it happened).
   bool failed() const { return watch_.failed(); }
@@ -78,16 +115,20 @@ class RtLog {
   void drain_loop() {
     for (;;) {
       const bool stopping = stopping_.load(std::memory_order_acquire);
-      std::uint64_t tail = tail_.load(std::memory_order_relaxed);
-      const std::uint64_t head = head_.load(std::memory_order_acquire);
-      const bool wrote = tail != head;
-      for (; tail != head; ++tail) format_(file_, rows_[tail % rows_.size()]);
-      tail_.store(tail, std::memory_order_release);
-      if (wrote && !watch_.failed()) {
-        file_.flush();  // so a full disk is noticed now, not at exit
-        watch_.check(file_);
+      // A thread in drain_one() has the file: this pass is skipped, the next one (or the last, below) catches up.
+      if (!draining_.test_and_set(std::memory_order_acquire)) {
+        std::uint64_t tail = tail_.load(std::memory_order_relaxed);
+        const std::uint64_t head = head_.load(std::memory_order_acquire);
+        const bool wrote = tail != head || unflushed_.exchange(false, std::memory_order_relaxed);
+        for (; tail != head; ++tail) format_(file_, rows_[tail % rows_.size()]);
+        tail_.store(tail, std::memory_order_release);
+        if (wrote && !watch_.failed()) {
+          file_.flush();  // so a full disk is noticed now, not at exit
+          watch_.check(file_);
+        }
+        draining_.clear(std::memory_order_release);
+        if (stopping && tail == head_.load(std::memory_order_acquire)) return;
       }
-      if (stopping && tail == head_.load(std::memory_order_acquire)) return;
       // 2 ms keeps the ring far from full at 1 kHz with any sane capacity while costing almost no CPU.
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
@@ -101,6 +142,8 @@ class RtLog {
   std::atomic<std::uint64_t> tail_{0};
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<bool> stopping_{false};
+  std::atomic_flag draining_;               // held by whichever thread is formatting rows into the file
+  std::atomic<bool> unflushed_{false};      // drain_one() wrote rows the drain thread has not flushed yet
   WriteWatch watch_;
   std::thread drainer_;
 };

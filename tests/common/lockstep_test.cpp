@@ -25,6 +25,7 @@ struct LockstepLayout {
   LockstepTurn world_turn;
   std::atomic<std::uint32_t> event_count{0};
   std::array<std::int64_t, kMaxEvents> events{};
+  std::atomic<std::uint32_t> idle_work_done{0};  // units of idle work a follower did while it waited
 };
 
 void record(LockstepLayout& layout, int who, std::uint64_t tick) {
@@ -86,6 +87,40 @@ TEST_CASE("lockstep with three processes runs device, haptic and world in a fixe
   }
   CHECK(first == expected);
   CHECK(second == first);
+}
+
+TEST_CASE("a follower does its idle work while it waits, every unit of it, and still takes every turn in order") {
+  constexpr std::uint32_t kUnits = 300;  // like rows of a log queued for writing
+  constexpr std::uint64_t kTicks = 400;
+  const std::string name = test::unique_segment_name("idle");
+  auto segment = Segment<LockstepLayout>::create(name);
+  const pid_t follower = test::fork_child([&] {
+    LockstepLayout& layout = *segment;
+    const LockstepIdleWork idle(
+        [](void* context) {
+          auto& done = static_cast<LockstepLayout*>(context)->idle_work_done;
+          if (done.load() >= kUnits) return false;
+          done.fetch_add(1);
+          return true;
+        },
+        &layout);
+    return follow(layout, layout.device_turn, 1);
+  });
+  const auto alive = [follower] { return kill(follower, 0) == 0; };
+  for (std::uint64_t tick = 0; tick < kTicks; ++tick) {
+    segment->device_turn.give(tick);
+    REQUIRE(segment->device_turn.wait_done(alive, 10.0) == TurnResult::ok);
+  }
+  // The follower waits for the next turn: long enough to finish its work, which it does before it would block.
+  for (int k = 0; k < 1000 && segment->idle_work_done.load() < kUnits; ++k) usleep(1000);
+  segment->device_turn.request_shutdown();
+  CHECK(test::wait_child(follower) == 0);
+  CHECK(segment->idle_work_done.load() == kUnits);
+  const std::uint32_t count = segment->event_count.load();
+  REQUIRE(count == kTicks);
+  int out_of_order = 0;
+  for (std::uint32_t k = 0; k < count; ++k) out_of_order += segment->events[k] == 1'000'000 + k ? 0 : 1;
+  CHECK(out_of_order == 0);
 }
 
 TEST_CASE("a lockstep master notices a dead follower instead of hanging") {

@@ -222,3 +222,29 @@ TEST_CASE("built-in parameter errors name the key and the value") {
   CHECK(error_of("bogus:speed=1") == "'bogus': unknown built-in trajectory; known: tap, press, slide, circle");
   CHECK_THROWS_AS(load_trajectory("tap:speed=abc"), TrajectoryError);
 }
+
+TEST_CASE("a sample with a segment hint is the sample without one, whatever the hint and the order of times") {
+  for (const char* spec : {"tap", "tap:rest=0.3", "press", "slide", "circle:turns=2"}) {
+    const Trajectory trajectory = load_trajectory(spec);
+    std::size_t forward_hint = 0;
+    std::size_t stale_hint = 7;  // a hint from nowhere: out of range for some, a wrong segment for others
+    int mismatches = 0;
+    // Forward in sub-step times, then backward, then jumping: the hint follows along or is wrong.
+    std::vector<double> times;
+    for (double t = -0.01; t <= trajectory.duration_s() + 0.01; t += 1e-4) times.push_back(t);
+    for (double t = trajectory.duration_s() + 0.01; t >= -0.01; t -= 3.7e-3) times.push_back(t);
+    for (int k = 0; k < 200; ++k) times.push_back(std::fmod(k * 0.618, trajectory.duration_s() + 0.02) - 0.01);
+    for (const double t : times) {
+      const Trajectory::Sample plain = trajectory.sample_at(t);
+      const Trajectory::Sample followed = trajectory.sample_at(t, forward_hint);
+      const Trajectory::Sample stale = trajectory.sample_at(t, stale_hint);
+      stale_hint = 7;
+      const bool same = plain.position_m == followed.position_m && plain.velocity_mps == followed.velocity_mps &&
+                        plain.position_m == stale.position_m && plain.velocity_mps == stale.velocity_mps &&
+                        plain.position_m == trajectory.position_at(t) && plain.velocity_mps == trajectory.velocity_at(t);
+      mismatches += same ? 0 : 1;
+    }
+    INFO(spec << ": " << times.size() << " times");
+    CHECK(mismatches == 0);
+  }
+}

@@ -232,7 +232,6 @@ std::uint32_t FeatureExtractor::extract(const ReachQuery& finger, std::span<cons
   // Sorted nearest first, so a crowded neighbourhood keeps the kMaxPlanes planes the finger can touch soonest.
   const std::size_t count = std::min<std::size_t>(reach_scratch_.size(), kMaxPlanes);
   for (std::size_t i = 0; i < count; ++i) planes[i] = make_plane(reach_scratch_[i], states);
-  for (std::size_t i = count; i < kMaxPlanes; ++i) planes[i] = Plane{};
   return static_cast<std::uint32_t>(count);
 }
 

@@ -65,8 +65,8 @@ class FeatureExtractor {
   void within_reach(const ReachQuery& finger, std::span<const ObjectState> states, double world_period_s,
                     std::vector<ReachCandidate>& out, FeatureMemory* memory = nullptr) const;
 
-  // Fills planes[0..count) with the nearest kMaxPlanes objects within reach and returns count (paper §3.1).
-  // `memory` as for within_reach.
+  // Fills planes[0..count) with the nearest kMaxPlanes objects within reach and returns count (paper §3.1); the
+  // planes from count on are left as they were (the caller resets those it used before). `memory` as for within_reach.
   std::uint32_t extract(const ReachQuery& finger, std::span<const ObjectState> states, double world_period_s,
                         std::array<Plane, kMaxPlanes>& planes, FeatureMemory* memory = nullptr) const;
 

@@ -48,7 +48,12 @@ class DelayLine {
     Entry& entry = entries_[(first_ + count_) % entries_.size()];
     entry.sent_tick = sent_tick;
     entry.sequence = ++pushed_;
-    entry.value = value;
+    // Frames and reports are copied by their used part (frames.h copy_used): a whole frame is ~56 KB.
+    if constexpr (requires { copy_used(value, entry.value); }) {
+      copy_used(value, entry.value);
+    } else {
+      entry.value = value;
+    }
     ++count_;
   }
 

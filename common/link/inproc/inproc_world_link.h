@@ -104,7 +104,7 @@ class InProcessWorldLink final : public WorldLinkServer {
     if (slot >= slots_used_) return false;
     const auto due = slots_[slot].reports.take_newest_due(now_ticks_);
     if (due.value == nullptr) return false;
-    out = *due.value;
+    copy_used(*due.value, out);
     return true;
   }
   // Sent at the world's tick: the newest tick any report carries.
@@ -146,7 +146,7 @@ class InProcessWorldLink final : public WorldLinkServer {
       Slot& slot = link_.slots_[first_slot_ + endpoint];
       const auto due = slot.frames.take_newest_due(now_ticks_);
       if (due.value == nullptr || due.sequence == slot.frame_taken) return false;
-      out = *due.value;
+      copy_used(*due.value, out);
       slot.frame_taken = due.sequence;
       return true;
     }

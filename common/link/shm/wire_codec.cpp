@@ -219,35 +219,31 @@ void encode(const DeviceState& state, wire::DeviceState& out) {
   seal(out);
 }
 
-// Decoding copies the counted slots only; the rest of the contract frame is reset, so nothing unvalidated reaches it.
+// Decoding copies the counted slots only; the slots `out` used beyond the new count are reset, so nothing unvalidated
+// reaches the contract frame and, as with copy_used (frames.h), a value-initialised frame's unused slots stay so. The
+// cost follows the counts, not the capacity.
 FrameError decode(const wire::PlaneFrame& in, PlaneFrame& out) {
   const FrameError error = validate(in);
   if (error != FrameError::ok) return error;
+  const std::uint32_t used_before = std::min(out.plane_count, kMaxPlanes);
   fields::visit_frame_header(in, out, CopyInto{});
-  for (std::size_t k = 0; k < kMaxPlanes; ++k) {
-    if (k < in.plane_count) {
-      fields::visit_plane(in.planes[k], out.planes[k], CopyInto{});
-      for (std::size_t c = in.planes[k].local_contact_count; c < kMaxLocalContacts; ++c) {
-        out.planes[k].local_contacts[c] = LocalContact{};
-      }
-    } else {
-      out.planes[k] = Plane{};
+  for (std::size_t k = 0; k < in.plane_count; ++k) {
+    fields::visit_plane(in.planes[k], out.planes[k], CopyInto{});
+    for (std::size_t c = in.planes[k].local_contact_count; c < kMaxLocalContacts; ++c) {
+      out.planes[k].local_contacts[c] = LocalContact{};
     }
   }
+  for (std::size_t k = in.plane_count; k < used_before; ++k) out.planes[k] = Plane{};
   return FrameError::ok;
 }
 
 FrameError decode(const wire::HapticReport& in, HapticReport& out) {
   const FrameError error = validate(in);
   if (error != FrameError::ok) return error;
+  const std::uint32_t used_before = std::min(out.entry_count, kMaxImpulseEntries);
   fields::visit_report_header(in, out, CopyInto{});
-  for (std::size_t k = 0; k < kMaxImpulseEntries; ++k) {
-    if (k < in.entry_count) {
-      fields::visit_entry(in.entries[k], out.entries[k], CopyInto{});
-    } else {
-      out.entries[k] = ObjectImpulse{};
-    }
-  }
+  for (std::size_t k = 0; k < in.entry_count; ++k) fields::visit_entry(in.entries[k], out.entries[k], CopyInto{});
+  for (std::size_t k = in.entry_count; k < used_before; ++k) out.entries[k] = ObjectImpulse{};
   return FrameError::ok;
 }
 
