@@ -74,8 +74,12 @@ void check_scene(const impetus::Scene& scene) {
   FUZZ_CHECK(physics.world_rate_hz > 0.0 && std::isfinite(physics.world_rate_hz));
   FUZZ_CHECK(std::isfinite(physics.world_period_s()));
   FUZZ_CHECK(physics.substeps > 0 && physics.solver_iterations > 0);
-  FUZZ_CHECK(physics.erp >= 0.0 && physics.erp <= 1.0);
-  FUZZ_CHECK(physics.cfm >= 0.0 && std::isfinite(physics.cfm));
+  // ODE's ERP in [0, 1] and a finite CFM >= 0 at any substep a world can take.
+  for (const double substep_s : {physics.world_period_s() / physics.substeps, 1e-7, 1.0}) {
+    const double erp = physics.erp_at(substep_s), cfm = physics.cfm_at(substep_s);
+    FUZZ_CHECK(erp >= 0.0 && erp <= 1.0);
+    FUZZ_CHECK(cfm >= 0.0 && std::isfinite(cfm));
+  }
   const impetus::HapticParams& haptic = scene.haptic;
   FUZZ_CHECK(haptic.reach_radius_m > 0.0 && std::isfinite(haptic.reach_radius_m));
   FUZZ_CHECK(haptic.stiffness_Npm > 0.0 && std::isfinite(haptic.stiffness_Npm));

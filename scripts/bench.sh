@@ -9,7 +9,9 @@
 #      N resting bodies with sleeping on and off (--short: up to 10 k, else 100 k)   build/tests/bench_world
 #   3. channel latency between processes               build/tests/bench_channel
 #   4. 1 kHz real-time loop lateness (FIFO + mlock)    build/tests/bench_rt_loop SECONDS
-#   5. lockstep throughput of the tap trial (simulated s per wall s, target >= 50x) via scripts/run.sh
+#   5. lockstep throughput of the tap trial (simulated s per wall s, target >= 50x) via scripts/run.sh, against the
+#      floor of three-process turn-taking with no work (build/tests/bench_lockstep_ring), and the in-process loop
+#      without logs (build/tests/bench_in_process)
 #   6. peak RSS of each process during a tap trial
 #   7. the world view: snapshot size and cost per world step, a viewer's read and encode   build/tests/bench_world_view
 #   8. world link one-way latency, shared memory and DDS, and DDS across a veth   build/tests/bench_dds_link
@@ -57,6 +59,10 @@ section "4. Real-time loop lateness at 1 kHz, ${rt_seconds} s per mode (ordinary
 bench bench_rt_loop "$rt_seconds"
 
 section "5. Lockstep throughput: tap trial (world 20 Hz, impulse coupling), 5 runs one after another"
+echo "The floor: the same three-process turns with no work in them (ticks/s; a 1 kHz tick is 1/1000 of a simulated s):"
+bench bench_lockstep_ring
+echo "The in-process loop (one thread, no processes, no logs):"
+bench bench_in_process
 # Simulated seconds are the world's (summary world.time_s); wall time is run.sh's, from launching the three processes
 # to their clean exit, so start-up and shared-memory set-up count against the throughput. The same trial with a 20 s
 # final hold separates that fixed cost from the steady-state rate (the marginal simulated s per wall s).

@@ -206,8 +206,8 @@ Floor parse_floor(const Node& node) {
 
 PhysicsParams parse_physics(const Node& node) {
   node.expect_keys(
-      {"world_rate_hz", "substeps", "solver", "solver_iterations", "erp", "cfm", "max_correcting_velocity_mps",
-       "auto_disable", "seed"});
+      {"world_rate_hz", "substeps", "solver", "solver_iterations", "contact_stiffness_Npm", "contact_damping_Nspm",
+       "erp", "cfm", "max_correcting_velocity_mps", "auto_disable", "seed"});
   PhysicsParams physics;
   if (node.has("world_rate_hz")) {
     physics.world_rate_hz = node.child("world_rate_hz").in_range(limits::kMinWorldRate_Hz, limits::kMaxWorldRate_Hz, " Hz");
@@ -226,6 +226,23 @@ PhysicsParams parse_physics(const Node& node) {
   }
   if (node.has("solver_iterations")) {
     physics.solver_iterations = node.child("solver_iterations").positive_int(limits::kMaxSolverIterations);
+  }
+  // ODE's per-substep numbers as they are, or the contact as a spring and a damper: one model or the other.
+  const bool spring = node.has("contact_stiffness_Npm") || node.has("contact_damping_Nspm");
+  for (const char* key : {"erp", "cfm"}) {
+    if (node.has(key) && spring) {
+      node.child(key).fail("give either \"erp\"/\"cfm\" (ODE's numbers per substep) or \"contact_stiffness_Npm\"/"
+                           "\"contact_damping_Nspm\" (a spring and damper at any substep), not both");
+    }
+  }
+  if (node.has("contact_stiffness_Npm")) {
+    physics.contact_stiffness_Npm =
+        node.child("contact_stiffness_Npm")
+            .in_range(SceneLimits::kMinContactStiffness_Npm, SceneLimits::kMaxContactStiffness_Npm, " N/m");
+  }
+  if (node.has("contact_damping_Nspm")) {
+    physics.contact_damping_Nspm =
+        node.child("contact_damping_Nspm").in_range(0.0, SceneLimits::kMaxContactDamping_Nspm, " N·s/m");
   }
   if (node.has("erp")) physics.erp = node.child("erp").in_unit_interval();
   if (node.has("cfm")) physics.cfm = node.child("cfm").in_range(0.0, SceneLimits::kMaxCfm, "");
@@ -373,6 +390,29 @@ SceneObject parse_object(const Node& node) {
 }
 
 }  // namespace
+
+namespace {
+
+double stiffness_or_default(double stiffness_Npm) {
+  return std::isnan(stiffness_Npm) ? PhysicsParams::kDefaultContactStiffness_Npm : stiffness_Npm;
+}
+
+double damping_or_default(double damping_Nspm) {
+  return std::isnan(damping_Nspm) ? PhysicsParams::kDefaultContactDamping_Nspm : damping_Nspm;
+}
+
+}  // namespace
+
+double PhysicsParams::erp_at(double substep_s) const {
+  if (!contact_spring()) return erp;
+  const double hk = substep_s * stiffness_or_default(contact_stiffness_Npm);
+  return hk / (hk + damping_or_default(contact_damping_Nspm));
+}
+
+double PhysicsParams::cfm_at(double substep_s) const {
+  if (!contact_spring()) return cfm;
+  return 1.0 / (substep_s * stiffness_or_default(contact_stiffness_Npm) + damping_or_default(contact_damping_Nspm));
+}
 
 double combine_friction(double a, double b) { return std::sqrt(a * b); }
 double combine_restitution(double a, double b) { return std::max(a, b); }

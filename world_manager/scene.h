@@ -17,7 +17,10 @@
 //       "solver": "quickstep",                  quickstep (iterative, O(n)) | direct (ODE's dWorldStep: exact
 //                                               LCP, O(n³), for stacks with large mass ratios QuickStep cannot hold)
 //       "solver_iterations": 20,                QuickStep iterations
-//       "erp": 0.2, "cfm": 1e-5,                ODE error reduction / constraint force mixing
+//       "erp": 0.2, "cfm": 1e-5,                ODE's error reduction / constraint force mixing per substep
+//       "contact_stiffness_Npm": 4e6,           or every contact as a spring and a damper, the same whatever the
+//       "contact_damping_Nspm": 8e4,            substep (ODE's ERP and CFM then follow from them per substep; not
+//                                               with "erp"/"cfm"); see PhysicsParams
 //       "max_correcting_velocity_mps": 0.005,   cap on the speed at which ODE pushes penetrating bodies apart
 //                                               (default: none, ODE's own); see PhysicsParams
 //       "auto_disable": true,                   resting bodies sleep: out of the simulation until pushed or touched,
@@ -60,6 +63,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -88,6 +92,11 @@ struct SceneLimits {
   static constexpr double kMaxGravity_mps2 = 1e3;  // 100 g
   static constexpr double kMaxFriction = 100.0;    // real pairs stay below ~2; 100 already holds like glue
   static constexpr double kMaxCfm = 1.0;           // ODE: CFM above 1 makes every contact softer than the body it holds
+  // Bounds against typing errors, each 10^4–10^6 times off the default contact's (PhysicsParams); at the lowest
+  // stiffness a 1 g body rests 1 cm deep: no contact at all.
+  static constexpr double kMinContactStiffness_Npm = 1.0;
+  static constexpr double kMaxContactStiffness_Npm = 1e12;
+  static constexpr double kMaxContactDamping_Nspm = 1e9;
   static constexpr double kMaxReachRadius_m = 10.0;  // 30× a desktop device's workspace
   // A world step costs O(objects) in ODE's broadphase and our feature grid; 10^4 static spheres step in ~35 ms on
   // this class of machine (within a 20 Hz period) and 10^5 in tens of seconds (docs/reliability.md).
@@ -163,9 +172,26 @@ struct PhysicsParams {
   enum class Solver { quickstep, direct };
   Solver solver = Solver::quickstep;
   int solver_iterations = 20;  // ODE's own default for QuickStep; enough for stacks of a few boxes
-  double erp = 0.2;            // ODE's default: corrects 20 % of a penetration per step
-  // A little compliance (ODE default is 1e-10 in double) lets QuickStep settle stacks without jitter.
+  // ODE's error reduction and constraint force mixing, used as they are at every substep (ODE's own semantics): a
+  // contact then acts as a spring k = ERP/(h·CFM) and a damper c = (1 − ERP)/CFM, so it stiffens as the substep h
+  // shortens. ERP 0.2 is ODE's default; a CFM of 1e-5 (ODE's is 1e-10 in double) lets QuickStep settle stacks
+  // without jitter.
+  double erp = 0.2;
   double cfm = 1e-5;
+  // Or every contact as a spring and a damper that stay the same at any world rate and substep count, which ODE is
+  // given per substep (ODE manual, "Joint error and the ERP" and "Soft constraint and CFM"):
+  //   ERP = h·k / (h·k + c),   CFM = 1 / (h·k + c).
+  // NaN: not given (then ERP and CFM above). A scene that gives one of the two gets the other from kDefaultContact*:
+  // ERP 0.2 and CFM 1e-5 at 5 ms substeps (20 Hz × 10), where the two models agree exactly. A 1 kg body rests m·g/k
+  // = 2.5 µm deep on one such contact (a box on four, 0.6 µm); a contact's correction time constant c/k is 20 ms.
+  static constexpr double kDefaultContactStiffness_Npm = 4e6;  // 0.2 / (0.005 s · 1e-5)
+  static constexpr double kDefaultContactDamping_Nspm = 8e4;   // 0.8 / 1e-5
+  double contact_stiffness_Npm = std::numeric_limits<double>::quiet_NaN();
+  double contact_damping_Nspm = std::numeric_limits<double>::quiet_NaN();
+  bool contact_spring() const { return !std::isnan(contact_stiffness_Npm) || !std::isnan(contact_damping_Nspm); }
+  // What ODE is given for substeps of `substep_s`: ERP and CFM as they are, or from the spring and damper.
+  double erp_at(double substep_s) const;
+  double cfm_at(double substep_s) const;
   // ERP removes a fraction of each contact's penetration per substep, as a separating speed erp·depth/h. An impact
   // penetrates about v·h, so at coarse substeps that speed is a bounce nobody asked for: a 1 kg cube sliding at
   // 0.4 m/s into a 0.5 kg one with restitution 0 should push it along, not kick it (5 ms substeps give the second

@@ -142,8 +142,8 @@ class RtLog {
   std::atomic<std::uint64_t> tail_{0};
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<bool> stopping_{false};
-  std::atomic_flag draining_;               // held by whichever thread is formatting rows into the file
-  std::atomic<bool> unflushed_{false};      // drain_one() wrote rows the drain thread has not flushed yet
+  std::atomic_flag draining_;           // held by whichever thread is formatting rows into the file
+  std::atomic<bool> unflushed_{false};  // drain_one() wrote rows the drain thread has not flushed yet
   WriteWatch watch_;
   std::thread drainer_;
 };

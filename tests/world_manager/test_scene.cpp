@@ -206,6 +206,48 @@ TEST_CASE("the penetration correction is uncapped unless the scene caps it") {
   CHECK(impetus::parse_scene(document, "test.json").physics.max_correcting_velocity_mps == 0.005);
 }
 
+TEST_CASE("a contact takes ODE's ERP and CFM as they are, or a spring and damper that agree with them at 5 ms") {
+  const impetus::PhysicsParams defaults = impetus::parse_scene(json{{"objects", json::array()}}, "t.json").physics;
+  CHECK_FALSE(defaults.contact_spring());
+  for (const double h_s : {1e-4, 5e-3, 0.01}) {
+    CHECK(defaults.erp_at(h_s) == 0.2);
+    CHECK(defaults.cfm_at(h_s) == 1e-5);
+  }
+  // Either field makes every contact a spring and a damper; the other is the one that agrees with ODE's numbers at
+  // 20 Hz × 10 substeps, exactly.
+  const json stiffness_only{{"objects", json::array()}, {"physics", {{"contact_stiffness_Npm", 4e6}}}};
+  const impetus::PhysicsParams spring = impetus::parse_scene(stiffness_only, "t.json").physics;
+  REQUIRE(spring.contact_spring());
+  CHECK(spring.erp_at(0.05 / 10) == 0.2);
+  CHECK(spring.cfm_at(0.05 / 10) == 1e-5);
+  // The same spring at any substep: ERP/(h·CFM) = k and (1 − ERP)/CFM = c.
+  for (const double h_s : {1e-4, 1.25e-3, 2e-3, 0.01}) {
+    INFO("substep " << h_s << " s");
+    CHECK(spring.erp_at(h_s) / (h_s * spring.cfm_at(h_s)) == Approx(4e6).epsilon(1e-12));
+    CHECK((1.0 - spring.erp_at(h_s)) / spring.cfm_at(h_s) == Approx(8e4).epsilon(1e-9));
+  }
+  const json undamped{{"objects", json::array()},
+                      {"physics", {{"contact_stiffness_Npm", 1e5}, {"contact_damping_Nspm", 0}}}};
+  const impetus::PhysicsParams rigid = impetus::parse_scene(undamped, "t.json").physics;
+  CHECK(rigid.erp_at(1e-3) == 1.0);  // no damper: the whole penetration is corrected in one substep
+  CHECK(rigid.cfm_at(1e-3) == Approx(1e-2));
+  const json own{{"objects", json::array()}, {"physics", {{"erp", 0.5}, {"cfm", 0.0}}}};
+  const impetus::PhysicsParams ode = impetus::parse_scene(own, "t.json").physics;
+  CHECK(ode.erp_at(1e-2) == 0.5);
+  CHECK(ode.cfm_at(1e-3) == 0.0);
+}
+
+TEST_CASE("scene error: both contact models at once, or a contact softer than 1 N/m") {
+  require_error(json{{"objects", json::array()}, {"physics", {{"erp", 0.2}, {"contact_stiffness_Npm", 1e6}}}},
+                "/physics/erp", "not both");
+  require_error(json{{"objects", json::array()}, {"physics", {{"cfm", 1e-5}, {"contact_damping_Nspm", 1e4}}}},
+                "/physics/cfm", "not both");
+  require_error(json{{"objects", json::array()}, {"physics", {{"contact_stiffness_Npm", 0.5}}}},
+                "/physics/contact_stiffness_Npm", "N/m");
+  require_error(json{{"objects", json::array()}, {"physics", {{"contact_damping_Nspm", -1}}}},
+                "/physics/contact_damping_Nspm", "N·s/m");
+}
+
 TEST_CASE("the direct solver is chosen by the scene and QuickStep is the default") {
   const json document{{"objects", json::array()}, {"physics", {{"solver", "direct"}}}};
   CHECK(impetus::parse_scene(document, "test.json").physics.solver == impetus::PhysicsParams::Solver::direct);

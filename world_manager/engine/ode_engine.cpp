@@ -318,8 +318,6 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   if (ode.sleeping) ode.resting_space = dSimpleSpaceCreate(nullptr);  // never collided as a whole: it only owns
   ode.contacts = dJointGroupCreate(0);
   dWorldSetGravity(ode.world, scene.gravity_mps2[0], scene.gravity_mps2[1], scene.gravity_mps2[2]);
-  dWorldSetERP(ode.world, scene.physics.erp);
-  dWorldSetCFM(ode.world, scene.physics.cfm);
   if (std::isfinite(scene.physics.max_correcting_velocity_mps)) {
     dWorldSetContactMaxCorrectingVel(ode.world, scene.physics.max_correcting_velocity_mps);
   }
@@ -488,6 +486,9 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
   Handles& ode = *ode_;
   const Scene& scene = *ode.scene;
   dRandSetSeed(ode.random_state);
+  // The contact's spring and damper as ODE's numbers for this substep (scene.h PhysicsParams).
+  dWorldSetERP(ode.world, scene.physics.erp_at(substep_s));
+  dWorldSetCFM(ode.world, scene.physics.cfm_at(substep_s));
   if (ode.sleeping) {
     ode.moved.assign(ode.awake.begin(), ode.awake.end());
     std::sort(ode.moved.begin(), ode.moved.end());
