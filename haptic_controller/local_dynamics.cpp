@@ -72,7 +72,7 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
     return std::find(touched_ids.begin(), touched_ids.begin() + touched_count, id) != touched_ids.begin() + touched_count;
   };
 
-  frame_ = frame;
+  copy_used(frame, frame_);
   plane_count_ = std::min(frame.plane_count, kMaxPlanes);
   gravity_mps2_ = to_eigen(frame.gravity_mps2);
   substep_s_ = frame.world_substep_s > 0.0 && frame.world_substep_s <= frame.world_period_s ? frame.world_substep_s
