@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cmath>
 #include <limits>
 
 namespace impetus {
@@ -32,6 +33,17 @@ struct ContactPlane {
   // the interpolation and the local model (shape_planes.h).
   Eigen::Matrix3d box_axes = Eigen::Matrix3d::Identity();
   Eigen::Vector3d box_half_m = Eigen::Vector3d::Zero();
+
+  // How far from point_m the plane still describes its object (0: unbounded), for telling a plane whose object is
+  // beside the finger from one it is in (proxy_projection.h). A sphere's and a box's is extent_m (its radius, its
+  // diagonal). A capsule's and a cylinder's extent_m is their radius, which their planes are retaken with, but a
+  // finger inside either may lie farther than that from the plane's point along the axis: theirs is the diagonal of
+  // the cylinder that bounds them, as generous as a box's.
+  double describes_within_m() const {
+    if (capsule()) return std::hypot(2.0 * extent_m, 2.0 * (box_half_m.z() + extent_m));
+    if (cylinder()) return std::hypot(2.0 * extent_m, 2.0 * box_half_m.z());
+    return extent_m;
+  }
 
   // Velocity of the object's material point at `x` (rigid body: v + ω × (x − com)).
   Eigen::Vector3d surface_velocity_mps(const Eigen::Vector3d& x_m) const {

@@ -73,11 +73,23 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, d
         (plane.box() || plane.capsule() || plane.cylinder()) && (before.flags & kPlaneCarriesShape) != 0;
 
     if (normals_flip(to_eigen(before.normal), to_eigen(now.normal))) {
-      if (!flip_switched(w)) {
+      const Plane& face = flip_switched(w) ? now : before;
+      if (box_both) {
+        // A body that carries its shape moves between the frames whichever face is shown: the face is carried
+        // rigidly from its frame's pose to the interpolated one (a face held where frame i−1 left it would let a body
+        // that comes at the finger close over the proxy for half a period).
+        plane.com_m = lerp(before.com_m, now.com_m, w);
+        interpolate_box_axes(before, now, w, plane);  // frame i's axes when the turn is too large to interpolate
+        const Eigen::Vector3d face_x = to_eigen(face.box_axis_x), face_y = to_eigen(face.box_axis_y);
+        Eigen::Matrix3d face_axes;
+        face_axes << face_x, face_y, face_x.cross(face_y);
+        const Eigen::Matrix3d turn = plane.box_axes * face_axes.transpose();
+        plane.point_m = plane.com_m + turn * (to_eigen(face.point_m) - to_eigen(face.com_m));
+        plane.normal = (turn * to_eigen(face.normal)).normalized();
+      } else if (&face == &before) {
         plane.point_m = to_eigen(before.point_m);
         plane.normal = to_eigen(before.normal);
         plane.com_m = to_eigen(before.com_m);
-        if (box_both) interpolate_box_axes(before, before, 0.0, plane);
       }
       continue;
     }

@@ -12,6 +12,9 @@
 //    over an edge or through a thin object and the nearest point jumped to another face), linear blending would pass
 //    through a vanishing normal and sweep the plane through the object; instead the whole plane switches from frame
 //    i−1's to frame i's at the midpoint, w ≥ ½. For dot ≥ 0 the blended normal has length ≥ 1/√2, never near zero.
+//    A plane that carries its body (box, capsule, cylinder) shows the same face, but carried rigidly with the body's
+//    interpolated pose (centre lerped, axes turned part of the way): a face held where frame i−1 left it would let a
+//    body that comes at the finger close over the proxy for half a period.
 //  * The centre of mass is interpolated like the point; velocities, friction and flags are frame i's (the newest
 //    state the world has sent, §6.2).
 //  * Where the normal turns, the plane turns about the pivot (the last proxy), not about its point: its signed

@@ -55,9 +55,10 @@ void drop(ProxySolution& s, int j) {
 // within the plane's extent (none: unbounded). Beyond it the object is not there at all (no point of a sphere of
 // radius R lies more than R from its tangent point along the tangent plane), and the finger passes beside it.
 bool beside_or_on(const ContactPlane& plane, const Eigen::Vector3d& goal) {
-  if (!(plane.extent_m > 0.0)) return true;
+  const double within_m = plane.describes_within_m();
+  if (!(within_m > 0.0)) return true;
   const Eigen::Vector3d offset = goal - plane.point_m;
-  return (offset - offset.dot(plane.normal) * plane.normal).norm() <= plane.extent_m;
+  return (offset - offset.dot(plane.normal) * plane.normal).norm() <= within_m;
 }
 
 // Whether `x` is where the planes in play (the active ones and p) still describe their objects: within each plane's
@@ -67,7 +68,8 @@ bool within_validity(const PlaneSet& planes, const ProxySolution& s, int p, cons
   if ((x - goal).norm() > planes.valid_within_m) return false;
   auto covers = [&](int k) {
     const ContactPlane& plane = planes.planes[static_cast<std::size_t>(k)];
-    return !(plane.extent_m > 0.0) || (x - plane.point_m).norm() <= plane.extent_m;
+    const double within_m = plane.describes_within_m();
+    return !(within_m > 0.0) || (x - plane.point_m).norm() <= within_m;
   };
   for (int j = 0; j < s.active_count; ++j) {
     if (!covers(s.active[j].plane)) return false;

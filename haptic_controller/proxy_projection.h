@@ -23,18 +23,18 @@
 //    two overlapping opposite planes). `infeasible` is set; the conflicting plane is listed as a fourth (or further)
 //    active constraint, and multipliers become the depth of the goal behind each listed plane, so the reaction still
 //    goes to the objects that pinch. Always finite for finite input.
-//  * Planes that do not reach the goal: a plane whose extent_m (> 0) is less than the goal's offset along it from the
-//    plane's point describes an object that is not there (the finger is beside a ball, not over its tangent plane's
-//    far reaches) and does not constrain the proxy. Without this a ball 3 cm above the finger pressed it through its
-//    infinite tangent plane, at a lever that spun the 3 g ball to 1200 rad/s.
+//  * Planes that do not reach the goal: a plane whose extent (describes_within_m, > 0) is less than the goal's offset
+//    along it from the plane's point describes an object that is not there (the finger is beside a ball, not over its
+//    tangent plane's far reaches) and does not constrain the proxy. Without this a ball 3 cm above the finger pressed
+//    it through its infinite tangent plane, at a lever that spun the 3 g ball to 1200 rad/s.
 //  * Locally infeasible sets: nearly opposed planes that overlap do meet, but δ/sin θ along their wedge, and tangent
 //    planes of balls packed around the finger close a pocket whose corners lie beside the balls. A plane is §3.1's
-//    first-order picture of its object near its point: it holds within its extent_m (a sphere's radius, a box's
-//    diagonal), and the plane set as a whole within planes.valid_within_m of the goal (the world's reach: it sent
-//    nothing beyond). Once the proxy has left the finger's spot (an edge or corner is being built), a step that takes
-//    it beyond either treats the plane being added as conflicting with the active ones, exactly as an opposite
-//    parallel plane: same compromise, same flag. A single plane is never bounded: however deep the finger, its
-//    proxy is the projection onto that face.
+//    first-order picture of its object near its point: it holds within its extent (a sphere's radius, a box's diagonal,
+//    a cylinder's or capsule's bounding diagonal), and the plane set as a whole within planes.valid_within_m of the
+//    goal (the world's reach: it sent nothing beyond). Once the proxy has left the finger's spot (an edge or corner is
+//    being built), a step that takes it beyond either treats the plane being added as conflicting with the active ones,
+//    exactly as an opposite parallel plane: same compromise, same flag. A single plane is never bounded: however deep
+//    the finger, its proxy is the projection onto that face.
 
 #include "haptic_controller/contact_plane.h"
 

@@ -42,7 +42,13 @@ void retake_capsule(ContactPlane& plane, const Eigen::Vector3d& around_m) {
 // normal nearer the axis). Beside the side a side plane is the tangent plane under the proxy; over its cap a cap plane
 // stays as the interpolation or the local model made it, as a box face's does; past the plane's own part (round a
 // rim, or onto the other part) the cylinder's nearest point, its normal from there to the proxy. A proxy on the
-// surface or inside keeps the plane (the world chose it).
+// surface gets the plane of the part it is on: its own cap's plane as it came, the side's tangent plane there, a cap's
+// plane on a cap. Inside it gets the part the world chose (the one the plane faces), on the true surface.
+//
+// On the surface the plane must be the part's own even when it came tilted: a plane blended between a rim's and the
+// side's (the proxy went round the rim between two frames) kept under a proxy on the side would carry the proxy off
+// the surface onto the tilt, the next tick would bring it back to the side's tangent plane, and so on, a tick-by-tick
+// hop of millimetres.
 void retake_cylinder(ContactPlane& plane, const Eigen::Vector3d& around_m) {
   const Eigen::Vector3d local_m = plane.box_axes.transpose() * (around_m - plane.com_m);  // body frame, axis z
   const double radius_m = plane.extent_m;
@@ -52,10 +58,46 @@ void retake_cylinder(ContactPlane& plane, const Eigen::Vector3d& around_m) {
   const double radial_m = std::hypot(local_m.x(), local_m.y());
   const bool beside = radial_m > radius_m + kOnSurface_m;
   const bool beyond_cap = std::abs(local_m.z()) > half_length_m + kOnSurface_m;
-  if (!beside && !beyond_cap) return;  // on the surface or inside
   // Over its own cap a cap's plane stays; a rim's plane from the world (tilted off the axis) becomes the cap's there,
   // as a box edge's plane becomes its face's (retake_box).
   const bool cap_as_moved = cap_plane && std::abs(normal_local.z()) >= kSameFaceCosine;
+  if (!beside && !beyond_cap) {
+    const bool on_side = radial_m >= radius_m - kOnSurface_m && radial_m > 0.0;
+    const bool on_cap = std::abs(local_m.z()) >= half_length_m - kOnSurface_m;
+    if (!on_side && !on_cap) {
+      // Inside (the body moved onto the proxy): the part the world chose, but its own plane there, not a blend that
+      // cuts into the body (between a rim's plane and a part's it passes inside the rim).
+      if (cap_plane) {
+        if (cap_as_moved) return;
+        const double side = normal_local.z() > 0.0 ? 1.0 : -1.0;
+        plane.normal = side * plane.box_axes.col(2);
+        plane.point_m = plane.com_m + plane.box_axes * Eigen::Vector3d(local_m.x(), local_m.y(), side * half_length_m);
+        return;
+      }
+      // The side at the azimuth the plane faces: exact even for a plane blended between two frames' tangent planes,
+      // which lies on their chord, inside the side (r·(1 − cos(Δθ/2)): 0.5 mm for 36° on a 1 cm radius).
+      const double out_m = std::hypot(normal_local.x(), normal_local.y());
+      if (!(out_m > 0.0)) return;
+      const Eigen::Vector3d out_local(normal_local.x() / out_m, normal_local.y() / out_m, 0.0);
+      plane.normal = plane.box_axes * out_local;
+      plane.point_m = plane.com_m + plane.box_axes * Eigen::Vector3d(radius_m * out_local.x(),
+                                                                     radius_m * out_local.y(), local_m.z());
+      return;
+    }
+    const double cap_side = local_m.z() >= 0.0 ? 1.0 : -1.0;
+    if (on_cap && (!on_side || cap_plane)) {
+      if (cap_as_moved && cap_side * normal_local.z() > 0.0) return;
+      plane.normal = cap_side * plane.box_axes.col(2);
+      plane.point_m =
+          plane.com_m + plane.box_axes * Eigen::Vector3d(local_m.x(), local_m.y(), cap_side * half_length_m);
+      return;
+    }
+    const Eigen::Vector3d out_local(local_m.x() / radial_m, local_m.y() / radial_m, 0.0);
+    plane.normal = plane.box_axes * out_local;
+    plane.point_m = plane.com_m + plane.box_axes * Eigen::Vector3d(radius_m * out_local.x(), radius_m * out_local.y(),
+                                                                   local_m.z());
+    return;
+  }
   if (cap_as_moved && !beside && local_m.z() * normal_local.z() > 0.0) return;
   Eigen::Vector3d nearest_local_m(local_m.x(), local_m.y(), std::clamp(local_m.z(), -half_length_m, half_length_m));
   if (beside) nearest_local_m.head<2>() *= radius_m / radial_m;
@@ -96,15 +138,25 @@ void retake_box(ContactPlane& plane, const Eigen::Vector3d& around_m) {
     plane.point_m = plane.com_m + plane.box_axes * nearest_local_m;
     return;
   }
-  // On the surface (where the god-object leaves a proxy) or inside (the box moved onto it). A proxy on the plane's
-  // own face, or deep inside (the world chose the face: feature_memory.h), keeps the plane; a proxy on another face
-  // (it went round an edge) gets that face: of the faces it is on, the one nearest the plane's normal.
+  // On the surface (where the god-object leaves a proxy) or inside (the box moved onto it). A proxy deep inside keeps
+  // the plane (the world chose the face: feature_memory.h; a plane blending from a face's toward the edge's the finger
+  // slid past sinks into the box, and lets the finger go, as it should). A proxy on the plane's own face keeps the
+  // plane only within 1° of the face, and otherwise gets the face's own plane: a blend between an edge's plane and a
+  // face's kept under a proxy on the face would carry the proxy off the face, the next tick would bring it back, and
+  // so on, a hop every tick. A proxy on another face (it went round an edge) gets that face: of the faces it is on,
+  // the one nearest the plane's normal.
+  const bool as_moved = std::abs(normal_local[face_axis]) >= kSameFaceCosine;
   int best_axis = -1;
   double best_side = 0.0, best_alignment = -2.0;
   for (int axis = 0; axis < 3; ++axis) {
     if (std::abs(local_m[axis]) < half_m[axis] - kOnSurface_m) continue;
     const double side = local_m[axis] >= 0.0 ? 1.0 : -1.0;
-    if (axis == face_axis && side == face_side) return;
+    if (axis == face_axis && side == face_side) {
+      if (as_moved) return;
+      best_axis = axis;
+      best_side = side;
+      break;
+    }
     const double alignment = side * normal_local[axis];
     if (alignment > best_alignment) {
       best_axis = axis;

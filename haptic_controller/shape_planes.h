@@ -37,11 +37,13 @@ namespace impetus {
 //
 // Cylinders. Flat caps and a curved side (kPlaneCylinder: axes, half length and radius travel with it): a cap's plane
 // ends at its rim as a box face's does, a side's plane is taken again under the proxy every tick, and past either
-// the plane is the cylinder's nearest rim or part.
+// the plane is the cylinder's nearest rim or part. On the surface the plane is the part's the proxy is on; inside,
+// the part's the plane faces, on the true surface (a plane blended between two frames may cut into the body).
 //
 // Replaces each sphere plane of `planes` by the tangent plane at the sphere's point nearest `around_m` (the last
-// proxy), each capsule plane likewise about the axis point nearest it, and each box plane whose face `around_m` has passed the rim of by the box's plane at its nearest point.
-// A point at a sphere's centre, or on the box's surface, keeps the plane as it is.
+// proxy), each capsule plane likewise about the axis point nearest it, each box plane by the rules for boxes above,
+// and each cylinder plane by the rules for cylinders. A point at a sphere's or a capsule's centre keeps the plane as
+// it is.
 void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m);
 
 }  // namespace impetus

@@ -15,7 +15,7 @@
 #   6. peak RSS of each process during a tap trial
 #   7. the world view: snapshot size and cost per world step, a viewer's read and encode   build/tests/bench_world_view
 #   8. world link one-way latency, shared memory and DDS, and DDS across a veth   build/tests/bench_dds_link
-#   9. ghost force, release, lost walls and pop-through in clutter   build/tests/bench_ghost_force
+#   9. ghost force, release, lost walls and pop-through in clutter and streams   build/tests/bench_ghost_force
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -153,5 +153,5 @@ else
   echo "(DDS across a veth skipped: network namespaces need root and iproute2)"
 fi
 
-section "9. Ghost force between world frames in static clutter, scored against the true geometry (docs/ghost_force.md)"
+section "9. Ghost force between world frames in static clutter and in streams past the finger, scored against the true geometry (docs/ghost_force.md)"
 bench bench_ghost_force

@@ -119,3 +119,33 @@ TEST_CASE("a plane that turns at a box's edge turns about the proxy: no drop at 
     last = distance;
   }
 }
+
+TEST_CASE("a box whose face flips between frames moves with its body whichever face is shown") {
+  // A 2 cm box moving 5 mm along +x in a period toward a proxy beside its +x face; in frame i the proxy is past the
+  // top's rim and the world sent the top. Frame i−1's face is shown until the midpoint, but carried with the box:
+  // held where frame i−1 left it, the box would close over the proxy for half a period.
+  auto box_plane = [](double x_m, const Vector3d& point, const Vector3d& normal) {
+    Plane plane = wire_plane(5, point, normal);
+    plane.flags |= kPlaneFlat | kPlaneBox;
+    plane.com_m = {x_m, 0.0, 0.0};
+    plane.box_axis_x = {1.0, 0.0, 0.0};
+    plane.box_axis_y = {0.0, 1.0, 0.0};
+    plane.box_half_m = {0.01, 0.01, 0.01};
+    return plane;
+  };
+  const PlaneFrame previous = make_frame({box_plane(0.0, {0.01, 0.0, 0.0}, {1, 0, 0})}, 0);
+  const PlaneFrame current = make_frame({box_plane(0.005, {0.012, 0.0, 0.01}, {-0.2, 0, 1})}, 1);
+  PlaneSet out;
+  for (const double w : {0.0, 0.25, 0.49, 0.5, 0.75, 1.0}) {
+    interpolate_planes(previous, current, w, kPivot, out);
+    const ContactPlane& plane = out.planes[0];
+    CHECK(plane.com_m.x() == Approx(0.005 * w).margin(1e-15));
+    if (w < 0.5) {
+      CHECK(plane.normal.isApprox(Vector3d(1, 0, 0)));
+      CHECK(plane.point_m.isApprox(Vector3d(0.01 + 0.005 * w, 0.0, 0.0)));
+    } else {
+      CHECK(plane.normal.isApprox(Vector3d(-0.2, 0, 1).normalized()));
+      CHECK(plane.point_m.isApprox(Vector3d(0.012 - 0.005 * (1.0 - w), 0.0, 0.01)));
+    }
+  }
+}

@@ -4,6 +4,7 @@
 
 #include "haptic_controller/impulse_accumulator.h"
 #include "haptic_controller/plane_interpolator.h"
+#include "haptic_controller/proxy_projection.h"
 #include "haptic_controller/servo.h"
 #include "haptic_controller/shape_planes.h"
 #include "test_support.h"
@@ -317,10 +318,11 @@ TEST_CASE("cylinder planes: a cap's plane stays over the cap and ends at its rim
     retake_shape_planes(planes, at(-0.03, 0.0, -0.02));
     CHECK((planes.planes[0].normal + axes.col(0)).norm() < 1e-12);
     CHECK((planes.planes[0].point_m - at(-0.02, 0.0, -0.02)).norm() < 1e-12);
-    // On the surface or inside: as it was.
+    // Inside: the side the plane faces, its point on the side at the proxy's height.
     const ContactPlane before = planes.planes[0];
-    retake_shape_planes(planes, at(0.0, 0.0, 0.0));
-    CHECK(planes.planes[0].normal == before.normal);
+    retake_shape_planes(planes, at(0.0, 0.0, 0.005));
+    CHECK((planes.planes[0].normal - before.normal).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(-0.02, 0.0, 0.005)).norm() < 1e-12);
   }
 }
 
@@ -358,5 +360,100 @@ TEST_CASE("box and cylinder planes: an edge's or a rim's plane from the world be
     retake_shape_planes(planes, at(0.01, 0.005, 0.031));
     CHECK((planes.planes[0].normal - axes.col(2)).norm() < 1e-12);
     CHECK((planes.planes[0].point_m - at(0.01, 0.005, 0.03)).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("cylinder planes: on the surface the plane of the part the proxy is on, inside a plane that cuts into the "
+          "rim becomes its part's own") {
+  for (const Eigen::Quaterniond& turn :
+       {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(1.1, Vector3d(3, -1, 2).normalized()))}) {
+    const Eigen::Matrix3d axes = turn.toRotationMatrix();
+    const Vector3d centre(-0.01, 0.02, 0.05);
+    const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
+    // Between a frame with the rim's plane and one with the side's, the interpolation blends them: a plane tilted 30°
+    // off the side's normal toward the axis, through the rim.
+    ContactPlane blended = cylinder_top_plane(centre, turn);
+    blended.normal = axes * Vector3d(std::cos(0.52), 0.0, std::sin(0.52));
+    blended.point_m = at(0.02, 0.0, 0.03);
+    // A proxy on the side, 1 cm below the rim: the side's tangent plane there, not the tilt, which leans off the side
+    // and would carry the proxy off the surface (a hop each tick as the next one brought it back).
+    PlaneSet planes = make_set({blended});
+    retake_shape_planes(planes, at(0.02, 0.0, 0.02));
+    CHECK((planes.planes[0].normal - axes.col(0)).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(0.02, 0.0, 0.02)).norm() < 1e-12);
+    // A proxy inside, under the tilt (the cylinder came at it): pushed out through the side the plane faces.
+    // Likewise under a side's plane blended between two frames' tangent planes 36° apart, which lies on their chord,
+    // 0.98 mm inside the side here: the side's own plane at the azimuth it faces.
+    ContactPlane chord = cylinder_top_plane(centre, turn);
+    chord.normal = axes * Vector3d(1, 0, 0);
+    chord.point_m = at(0.02 * std::cos(0.314), 0.0, 0.0);
+    planes = make_set({chord});
+    retake_shape_planes(planes, at(0.015, 0.002, -0.01));
+    CHECK((planes.planes[0].normal - chord.normal).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(0.02, 0.0, -0.01)).norm() < 1e-12);
+    planes = make_set({blended});
+    retake_shape_planes(planes, at(0.015, 0.005, 0.025));
+    const Vector3d side = axes * Vector3d(1, 0, 0);
+    CHECK((planes.planes[0].normal - side).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(0.02, 0.0, 0.025)).norm() < 1e-12);
+    // A cap-leaning blend (60° off the side's normal) over a proxy inside: the cap's own plane above it.
+    blended.normal = axes * Vector3d(std::cos(1.05), 0.0, std::sin(1.05));
+    planes = make_set({blended});
+    retake_shape_planes(planes, at(0.015, 0.005, 0.025));
+    CHECK((planes.planes[0].normal - axes.col(2)).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(0.015, 0.005, 0.03)).norm() < 1e-12);
+    // The same blend under a proxy on the cap: the cap's plane; on the cap with the cap's own plane: as it came.
+    planes = make_set({blended});
+    retake_shape_planes(planes, at(0.01, -0.004, 0.03));
+    CHECK((planes.planes[0].normal - axes.col(2)).norm() < 1e-12);
+    const ContactPlane top = cylinder_top_plane(centre, turn);
+    planes = make_set({top});
+    retake_shape_planes(planes, at(0.01, -0.004, 0.03));
+    CHECK(planes.planes[0].normal == top.normal);
+    CHECK(planes.planes[0].point_m == top.point_m);
+  }
+}
+
+TEST_CASE("box planes: a tilted plane under a proxy on its face becomes the face's, under a proxy inside it stays") {
+  for (const Eigen::Quaterniond& turn :
+       {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()))}) {
+    const Eigen::Matrix3d axes = turn.toRotationMatrix();
+    const Vector3d centre(0.01, -0.02, 0.05);
+    const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
+    // The top face's plane blended 20° toward an edge's, through the edge.
+    ContactPlane blended = to_contact_plane(box_top_plane(centre, turn, at(0.0, 0.0, 0.06)));
+    blended.normal = axes * Vector3d(std::sin(0.35), 0.0, std::cos(0.35));
+    blended.point_m = at(0.05, 0.0, 0.05);
+    PlaneSet planes = make_set({blended});
+    retake_shape_planes(planes, at(0.03, 0.01, 0.05));  // on the top face
+    CHECK((planes.planes[0].normal - axes.col(2)).norm() < 1e-12);
+    CHECK((planes.planes[0].point_m - at(0.03, 0.01, 0.05)).norm() < 1e-12);
+    // Inside, under the blend: it stays, and sinking toward the edge's plane it lets a finger that slid off the edge
+    // go (hard case 6).
+    planes = make_set({blended});
+    retake_shape_planes(planes, at(0.03, 0.01, 0.045));
+    CHECK(planes.planes[0].normal == blended.normal);
+    CHECK(planes.planes[0].point_m == blended.point_m);
+  }
+}
+
+TEST_CASE("a finger inside a long cylinder or capsule is held by its plane however far along the axis from the "
+          "plane's point") {
+  // A cylinder and a capsule of radius 1 cm, 8 cm long, lying along x; the plane is the side's top at x = −3 cm, where
+  // the world saw the proxy. The finger is 5 mm into the side at x = +2 cm, 5 cm from the plane's point along it: more
+  // than the radius, within the body.
+  for (const std::uint32_t kind : {kPlaneCylinder, kPlaneCapsule}) {
+    Plane wire = test::wire_plane(7, {-0.03, 0.0, 0.01}, {0, 0, 1}, false);
+    wire.flags |= kind;
+    wire.extent_m = 0.01;
+    wire.com_m = {0.0, 0.0, 0.0};
+    wire.box_axis_x = {0.0, 1.0, 0.0};
+    wire.box_axis_y = {0.0, 0.0, 1.0};  // body z = x × y along world x
+    wire.box_half_m = {0.01, 0.01, kind == kPlaneCylinder ? 0.04 : 0.03};
+    const ContactPlane plane = to_contact_plane(wire);
+    REQUIRE((plane.cylinder() || plane.capsule()));
+    const ProxySolution solution = project_outside_planes(make_set({plane}), Vector3d(0.02, 0.0, 0.005));
+    CHECK(solution.active_count == 1);
+    CHECK(solution.proxy_m.z() == Approx(0.01).margin(1e-12));
   }
 }

@@ -1,37 +1,71 @@
 // SPDX-License-Identifier: Apache-2.0
 // What the finger feels between world frames, scored against the true geometry (tests/support/ghost_score.h): the
-// goals are no ghost force beyond 1 % of the contact ticks, release within 2 ms, no lost wall and no pop-through.
-// Sparse clutter meets them all and is asserted here; denser clutter meets the ghost goal, asserted too, and its
-// releases, lost walls and pop-through are printed by build/tests/bench_ghost_force (docs/ghost_force.md).
+// goals are no ghost force beyond 1 % of the contact ticks, release within 2 ms, no lost wall and no pop-through, in
+// static clutter and among objects that slide past the finger. build/tests/bench_ghost_force prints the same cells
+// (docs/ghost_force.md).
 
 #include "tests/support/ghost_score.h"
 
 #include <catch2/catch.hpp>
 
 namespace impetus {
+namespace {
 
-TEST_CASE("between world frames the finger feels sparse clutter as it is: no ghost force, release within 2 ms, no lost "
-          "wall, no pop-through") {
-  for (const double rate_hz : {20.0, 10.0}) {
-    INFO(rate_hz << " Hz world");
-    const test::Score s = test::score(test::clutter(4, 7), rate_hz, 20.0);
-    CHECK(s.contact_ticks > 100);  // the finger really went through the objects
-    CHECK(s.ghost_fraction() <= 0.01);
-    CHECK(s.worst_release_ms <= 2.0);
-    CHECK(s.lost_wall_ticks == 0);
-    CHECK(s.pop_through_ticks == 0);
+void check_goals(const test::Score& s, int least_contact_ticks) {
+  CHECK(s.contact_ticks > least_contact_ticks);  // the finger really went through the objects
+  CHECK(s.ghost_fraction() <= 0.01);
+  CHECK(s.worst_release_ms <= 2.0);
+  CHECK(s.lost_wall_ticks == 0);
+  CHECK(s.pop_through_ticks == 0);
+}
+
+const char* name(Coupling coupling) {
+  return coupling == Coupling::impulse ? "impulse" : coupling == Coupling::position ? "position" : "local";
+}
+
+// The stream of the tests: 0.1 m/s, 17° off the x axis, boxes spinning at 1 rad/s, for 20 s.
+Scene test_stream(int per_cube) { return test::stream(per_cube, 7, Eigen::Vector3d(0.1, 0.03, 0.0), 1.0, 20.0); }
+
+}  // namespace
+
+TEST_CASE("between world frames the finger feels static clutter of 4 to 64 objects as it is, at 20 and 10 Hz") {
+  // Before the shape planes an edge's or a rim's plane from the world, kept over its face, hung in free space above
+  // the face: 1.8-6.8 % ghost ticks and releases of 17-56 ms in 64 objects (docs/ghost_force.md).
+  for (const int count : {4, 16, 64}) {
+    for (const double rate_hz : {20.0, 10.0}) {
+      INFO(count << " objects, " << rate_hz << " Hz world");
+      check_goals(test::score(test::clutter(count, 7), rate_hz, 20.0), count == 4 ? 100 : 500);
+    }
   }
 }
 
-TEST_CASE("between world frames no ghost force lingers in clutter of 16 and 64 objects at 20 and 10 Hz") {
-  // An edge's or a rim's plane from the world, kept over its face, hung in free space above the face: 1.8-6.8 % ghost
-  // ticks and releases of 17-56 ms in 64 objects before it became the face's plane there (docs/ghost_force.md).
-  for (const int count : {16, 64}) {
+TEST_CASE("objects that slide past the finger are felt where they are, under every coupling, at 20 and 10 Hz") {
+  for (const Coupling coupling : {Coupling::impulse, Coupling::position, Coupling::local}) {
     for (const double rate_hz : {20.0, 10.0}) {
-      INFO(count << " objects, " << rate_hz << " Hz world");
-      const test::Score s = test::score(test::clutter(count, 7), rate_hz, 20.0);
-      CHECK(s.contact_ticks > 500);
+      INFO(name(coupling) << " coupling, " << rate_hz << " Hz world, 4 objects per finger's cube");
+      check_goals(test::score(test_stream(4), rate_hz, 20.0, coupling), 300);
+    }
+  }
+}
+
+TEST_CASE("a dense stream of objects past the finger: every goal at 20 Hz, and at 10 Hz but for the local model's "
+          "hold") {
+  for (const Coupling coupling : {Coupling::impulse, Coupling::position, Coupling::local}) {
+    for (const double rate_hz : {20.0, 10.0}) {
+      INFO(name(coupling) << " coupling, " << rate_hz << " Hz world, 16 objects per finger's cube");
+      const test::Score s = test::score(test_stream(16), rate_hz, 20.0, coupling);
+      if (coupling != Coupling::local || rate_hz == 20.0) {
+        check_goals(s, 800);
+        continue;
+      }
+      // Local coupling at 10 Hz: where the world's new frame puts a face nearer the finger than the model had it, the
+      // plane is held where the finger felt it until the finger withdraws (local_dynamics.h, passivity), so the
+      // finger ends up to the model's error (half a millimetre here) inside and its proxy may leave that deep.
+      CHECK(s.contact_ticks > 800);
       CHECK(s.ghost_fraction() <= 0.01);
+      CHECK(s.lost_wall_ticks == 0);
+      CHECK(s.worst_release_ms <= 5.0);
+      CHECK(s.pop_through_ticks <= 5);
     }
   }
 }
