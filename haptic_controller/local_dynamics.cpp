@@ -105,6 +105,7 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
       body.contact_count = std::min(plane.local_contact_count, kMaxLocalContacts);
       body.sphere_radius_m = (plane.flags & kPlaneSphere) != 0 && plane.extent_m > 0.0 ? plane.extent_m : 0.0;
       body.turns = (plane.flags & kPlaneFlat) != 0;
+      body.turns_shape = (plane.flags & (kPlaneCapsule | kPlaneCylinder)) != 0;
       for (std::uint32_t c = 0; c < body.contact_count; ++c) {
         body.contact_normal[c] = to_eigen(plane.local_contacts[c].normal);
         body.contact_friction[c] = plane.local_contacts[c].friction;
@@ -225,7 +226,7 @@ void LocalDynamics::advance(double dt_s) {
     LocalBody& body = bodies_[b];
     body.displacement_m += body.velocity_mps * dt_s;
     const double angle = body.angular_velocity_radps.norm() * dt_s;
-    if (body.turns && angle > 0.0 && std::isfinite(angle)) {
+    if ((body.turns || body.turns_shape) && angle > 0.0 && std::isfinite(angle)) {
       body.turn = (Eigen::Quaterniond(Eigen::AngleAxisd(angle, body.angular_velocity_radps.normalized())) * body.turn)
                       .normalized();
     }
@@ -288,8 +289,8 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
       plane.point_m = body->carry_point(point);
       plane.normal = body->carry_normal(normal);  // turned for a flat face only: see the header
       plane.com_m = body->com_m();
-      // A box travels with its plane: its centre is the CoM, its axes turn with the body (shape_planes.h).
-      for (int axis = 0; axis < 3; ++axis) plane.box_axes.col(axis) = body->carry_normal(plane.box_axes.col(axis));
+      // A shape travels with its plane: its centre is the CoM, its axes turn with the body (shape_planes.h).
+      for (int axis = 0; axis < 3; ++axis) plane.box_axes.col(axis) = body->carry_axis(plane.box_axes.col(axis));
       plane.velocity_mps = body->velocity_mps;
       plane.angular_velocity_radps = body->angular_velocity_radps;
     } else {

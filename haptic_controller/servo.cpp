@@ -141,8 +141,9 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   }
   result_.interpolation_weight = w;
 
-  // Spheres' and boxes' planes taken again at the last proxy (shape_planes.h).
-  retake_shape_planes(planes_, to_eigen(result_.proxy_m));
+  // Planes that carry their shape taken again at the last proxy, or at the finger past a body the way to it does not
+  // enter (shape_planes.h).
+  retake_shape_planes(planes_, to_eigen(result_.proxy_m), finger_m);
 
   // 3. Proxy D_j (god-object with friction).
   planes_.valid_within_m =

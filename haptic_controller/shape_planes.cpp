@@ -2,7 +2,9 @@
 #include "haptic_controller/shape_planes.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 
 namespace impetus {
 namespace {
@@ -171,20 +173,169 @@ void retake_box(ContactPlane& plane, const Eigen::Vector3d& around_m) {
   plane.point_m = plane.com_m + plane.box_axes * on_face_m;
 }
 
+// Segment tests against a body shrunk by kOnSurface_m, so that a segment that starts on the surface (the proxy) and
+// leaves it does not count as entering. `from_m` + t·(to_m − from_m), t in [0, 1].
+
+// The parameter interval [t0, t1] the segment spends within |coordinate| ≤ half along one body axis; false if none.
+bool clip_slab(double from, double delta, double half, double& t0, double& t1) {
+  if (std::abs(delta) < 1e-300) return std::abs(from) < half;
+  double ta = (-half - from) / delta, tb = (half - from) / delta;
+  if (ta > tb) std::swap(ta, tb);
+  t0 = std::max(t0, ta);
+  t1 = std::min(t1, tb);
+  return t0 < t1;
+}
+
+// Squared distance from the origin to the segment a + t·d, t in [t0, t1] (2-D or 3-D).
+template <typename Vector>
+double min_squared_norm(const Vector& a, const Vector& d, double t0, double t1) {
+  const double dd = d.squaredNorm();
+  const double t = dd > 0.0 ? std::clamp(-a.dot(d) / dd, t0, t1) : t0;
+  return (a + t * d).squaredNorm();
+}
+
+bool segment_enters(const ContactPlane& plane, const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m) {
+  if (plane.sphere()) {
+    const Eigen::Vector3d centre_m = plane.point_m - plane.extent_m * plane.normal;
+    const double inner_m = plane.extent_m - kOnSurface_m;
+    return min_squared_norm(Eigen::Vector3d(from_m - centre_m), Eigen::Vector3d(to_m - from_m), 0.0, 1.0) <
+           inner_m * inner_m;
+  }
+  const Eigen::Vector3d a = plane.box_axes.transpose() * (from_m - plane.com_m);  // body frame
+  const Eigen::Vector3d d = plane.box_axes.transpose() * (to_m - from_m);
+  double t0 = 0.0, t1 = 1.0;
+  if (plane.box()) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!clip_slab(a[axis], d[axis], plane.box_half_m[axis] - kOnSurface_m, t0, t1)) return false;
+    }
+    return true;
+  }
+  const double inner_m = plane.extent_m - kOnSurface_m;
+  if (plane.cylinder()) {
+    if (!clip_slab(a.z(), d.z(), plane.box_half_m.z() - kOnSurface_m, t0, t1)) return false;
+    return min_squared_norm(Eigen::Vector2d(a.head<2>()), Eigen::Vector2d(d.head<2>()), t0, t1) < inner_m * inner_m;
+  }
+  // A capsule: the segment comes within the radius of its axis segment, z in [−half, half]. Along the segment the
+  // squared distance to it is a quadratic on each stretch where z is below, within or above that range: the least of
+  // their minima.
+  const double half_m = plane.box_half_m.z();
+  std::array<double, 4> cuts{0.0, 1.0, 1.0, 1.0};  // 0, the crossings of z = ±half inside (0, 1) in order, 1
+  std::size_t stretches = 1;
+  if (std::abs(d.z()) > 1e-300) {
+    double first = (-half_m - a.z()) / d.z(), second = (half_m - a.z()) / d.z();
+    if (first > second) std::swap(first, second);
+    for (const double t : {first, second}) {
+      if (t > 0.0 && t < 1.0) cuts[stretches++] = t;
+    }
+  }
+  cuts[stretches] = 1.0;
+  double least = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < stretches; ++k) {
+    const double u = cuts[k], v = cuts[k + 1];
+    const double z_mid = a.z() + 0.5 * (u + v) * d.z();
+    if (std::abs(z_mid) <= half_m) {
+      least = std::min(least, min_squared_norm(Eigen::Vector2d(a.head<2>()), Eigen::Vector2d(d.head<2>()), u, v));
+    } else {
+      const Eigen::Vector3d end_m(0.0, 0.0, z_mid > 0.0 ? half_m : -half_m);
+      least = std::min(least, min_squared_norm(Eigen::Vector3d(a - end_m), d, u, v));
+    }
+  }
+  return least < inner_m * inner_m;
+}
+
+void retake(ContactPlane& plane, const Eigen::Vector3d& around_m) {
+  if (plane.sphere()) {
+    retake_sphere(plane, around_m);
+  } else if (plane.box()) {
+    retake_box(plane, around_m);
+  } else if (plane.capsule()) {
+    retake_capsule(plane, around_m);
+  } else if (plane.cylinder()) {
+    retake_cylinder(plane, around_m);
+  }
+}
+
+bool in_front(const ContactPlane& plane, const Eigen::Vector3d& x_m) {
+  return plane.normal.dot(x_m - plane.point_m) >= -kOnSurface_m;
+}
+
+// The body's plane at its point nearest the way from `from_m` to `to_m`, which passes the body: the supporting plane
+// there separates the two (they are convex), so both ends are in front of it. The body's distance is convex along the
+// way; a golden-section search finds its least to 1e-10 of the way (48 steps), each a retake about a point of the way.
+ContactPlane nearest_to_way(const ContactPlane& as_sent, const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m) {
+  auto at = [&](double t, ContactPlane& plane) {
+    plane = as_sent;
+    const Eigen::Vector3d x_m = from_m + t * (to_m - from_m);
+    retake(plane, x_m);
+    return plane.normal.dot(x_m - plane.point_m);
+  };
+  constexpr double kGolden = 0.6180339887498949;  // (√5 − 1)/2
+  ContactPlane plane1, plane2;
+  double lo = 0.0, hi = 1.0;
+  double t1 = hi - kGolden * (hi - lo), t2 = lo + kGolden * (hi - lo);
+  double d1 = at(t1, plane1), d2 = at(t2, plane2);
+  for (int step = 0; step < 48; ++step) {
+    if (d1 < d2) {
+      hi = t2, t2 = t1, d2 = d1, plane2 = plane1;
+      t1 = hi - kGolden * (hi - lo);
+      d1 = at(t1, plane1);
+    } else {
+      lo = t1, t1 = t2, d1 = d2, plane1 = plane2;
+      t2 = lo + kGolden * (hi - lo);
+      d2 = at(t2, plane2);
+    }
+  }
+  return d1 < d2 ? plane1 : plane2;
+}
+
+bool carries_shape(const ContactPlane& plane) {
+  return plane.sphere() || plane.box() || plane.capsule() || plane.cylinder();
+}
+
 }  // namespace
 
 void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m) {
+  for (std::uint32_t k = 0; k < planes.count; ++k) retake(planes.planes[k], around_m);
+}
+
+void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& finger_m) {
+  // About the proxy, as always. A retake moves only the plane, not the body, so the plane as it came is its point and
+  // normal, kept here (uninitialised storage: nothing is built per tick).
+  std::array<Eigen::Vector3d, kMaxPlanes> sent_point_m, sent_normal;
+  auto as_sent = [&](std::uint32_t k) {
+    ContactPlane plane = planes.planes[k];
+    plane.point_m = sent_point_m[k];
+    plane.normal = sent_normal[k];
+    return plane;
+  };
+  bool finger_held = false;
   for (std::uint32_t k = 0; k < planes.count; ++k) {
     ContactPlane& plane = planes.planes[k];
-    if (plane.sphere()) {
-      retake_sphere(plane, around_m);
-    } else if (plane.box()) {
-      retake_box(plane, around_m);
-    } else if (plane.capsule()) {
-      retake_capsule(plane, around_m);
-    } else if (plane.cylinder()) {
-      retake_cylinder(plane, around_m);
-    }
+    if (!carries_shape(plane)) continue;
+    sent_point_m[k] = plane.point_m;
+    sent_normal[k] = plane.normal;
+    retake(plane, proxy_m);
+    finger_held = finger_held || !in_front(plane, finger_m);
+  }
+  if (!finger_held) return;
+  // Is the straight way from the proxy to the finger clear of every body? Any one it enters holds the proxy back,
+  // and the proxy then slides along that body, where the others may meet it: only a way clear of all lets it go.
+  for (std::uint32_t k = 0; k < planes.count; ++k) {
+    const ContactPlane& plane = planes.planes[k];
+    const bool enters = carries_shape(plane) ? segment_enters(plane, proxy_m, finger_m)
+                                             : !in_front(plane, proxy_m) || !in_front(plane, finger_m);
+    if (enters) return;
+  }
+  // Clear: every body behind a plane with both ends of the way in front. The one about the proxy if the finger is in
+  // front of it; else the finger's supporting plane, if the proxy is in front of that; else the plane at the body's
+  // point nearest the way.
+  for (std::uint32_t k = 0; k < planes.count; ++k) {
+    ContactPlane& plane = planes.planes[k];
+    if (!carries_shape(plane) || in_front(plane, finger_m)) continue;
+    const ContactPlane sent = as_sent(k);
+    ContactPlane at_finger = sent;
+    retake(at_finger, finger_m);
+    plane = in_front(at_finger, proxy_m) ? at_finger : nearest_to_way(sent, proxy_m, finger_m);
   }
 }
 

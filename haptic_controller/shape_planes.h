@@ -46,4 +46,12 @@ namespace impetus {
 // it is.
 void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m);
 
+// The servo's form: as above about the last proxy, except for a body the straight way from the proxy to the finger
+// does not enter. The god-object then goes straight to the finger past that body, which holds it back nowhere, so
+// the body's plane is taken about the finger instead: its supporting plane at the point nearest the finger, with the
+// body behind it and the finger in front. Taken about the proxy, the plane past an edge or a rim is the edge's
+// tangent plane there; a finger that has left the body over the edge can still be behind it, and the proxy slides
+// along it, off the body, holding the finger for a few more ticks.
+void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& finger_m);
+
 }  // namespace impetus

@@ -30,7 +30,8 @@ def main():
     rows = list(csv.DictReader(io.StringIO(text)))
     past_mm = [1e3 * float(r["finger_from_edge_m"]) for r in rows]
     series = {"planes as the world sent them (a face's plane lasts until the next frame)": "force_as_sent_N",
-              "planes taken again at the proxy every tick": "force_retaken_N",
+              "planes taken again every tick (at the proxy; at the finger once the way is clear)":
+                  "force_retaken_N",
               "exact god-object on the true box": "force_exact_N"}
     held_mm = max((p for p, r in zip(past_mm, rows) if float(r["force_as_sent_N"]) > 0.1), default=0.0)
     retaken_mm = max((p for p, r in zip(past_mm, rows) if float(r["force_retaken_N"]) > 0.1), default=0.0)

@@ -356,3 +356,31 @@ TEST_CASE("local dynamics: a ball rolling on the floor keeps its speed, a slidin
     CHECK(model.find(5)->angular_velocity_radps.y() * 0.01 == Approx(v).epsilon(1e-9));
   }
 }
+
+TEST_CASE("local dynamics: a spinning cylinder's and capsule's axes turn with the model, their plane does not") {
+  // A cylinder and a capsule lying along x, spinning end over end about z at 1 rad/s; the plane is the side's top. In
+  // 100 ticks the axis turns 0.1 rad, as the world's will; the plane itself is only carried with the centre (the
+  // servo takes it again from the turned shape, shape_planes.h).
+  for (const std::uint32_t kind : {kPlaneCylinder, kPlaneCapsule}) {
+    Plane plane = wire_plane(3, {0.0, 0.0, 0.01}, {0, 0, 1});
+    plane.flags |= kind;
+    plane.extent_m = 0.01;
+    plane.com_m = {0.0, 0.0, 0.0};
+    plane.box_axis_x = {0.0, 1.0, 0.0};
+    plane.box_axis_y = {0.0, 0.0, 1.0};  // body z along world x
+    plane.box_half_m = {0.01, 0.01, 0.02};
+    plane.inverse_mass_per_kg = 1.0;
+    plane.inverse_inertia_world = {1e4, 0, 0, 0, 1e4, 0, 0, 0, 1e4};
+    plane.angular_velocity_radps = {0.0, 0.0, 1.0};
+    LocalDynamics model;
+    model.on_plane_frame(local_frame({plane}), nullptr, Vector3d(0.0, 0.0, 0.02));
+    PlaneSet planes;
+    for (int tick = 1; tick <= 100; ++tick) {
+      model.advance(kTick_s);
+      model.render(tick / 50.0, Vector3d(0.0, 0.0, 0.02), planes);
+    }
+    const Vector3d axis = planes.planes[0].box_axes.col(2);
+    CHECK((axis - Vector3d(std::cos(0.1), std::sin(0.1), 0.0)).norm() < 1e-9);
+    CHECK((planes.planes[0].normal - Vector3d::UnitZ()).norm() < 1e-12);
+  }
+}

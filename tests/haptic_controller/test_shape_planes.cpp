@@ -457,3 +457,85 @@ TEST_CASE("a finger inside a long cylinder or capsule is held by its plane howev
     CHECK(solution.proxy_m.z() == Approx(0.01).margin(1e-12));
   }
 }
+
+TEST_CASE("a body the straight way from the proxy to the finger passes gets a plane with both in front: the force "
+          "ends as the finger leaves it over an edge") {
+  for (const Eigen::Quaterniond& turn :
+       {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()))}) {
+    const Eigen::Matrix3d axes = turn.toRotationMatrix();
+    const Vector3d centre(0.01, -0.02, 0.05);
+    const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
+    const ContactPlane top = to_contact_plane(box_top_plane(centre, turn, at(0.0, 0.0, 0.06)));  // 10 cm cube
+    const auto in_front = [](const ContactPlane& plane, const Vector3d& x) {
+      return plane.normal.dot(x - plane.point_m) >= -1e-12;
+    };
+
+    // The finger inside, pressing the top: the plane about the proxy, as before.
+    PlaneSet planes = make_set({top});
+    retake_shape_planes(planes, at(0.01, 0.0, 0.05), at(0.01, 0.0, 0.047));
+    CHECK(planes.planes[0].normal == top.normal);
+
+    // The proxy has slid past the +x rim, on the edge's plane; the finger has left the cube beside the +x face,
+    // behind that plane. The way passes the edge: the +x face's plane under the finger, the proxy in front of it.
+    planes = make_set({top});
+    retake_shape_planes(planes, at(0.051, 0.0, 0.0505), at(0.0505, 0.0, 0.046));
+    CHECK((planes.planes[0].normal - axes.col(0)).norm() < 1e-12);
+    CHECK(in_front(planes.planes[0], at(0.051, 0.0, 0.0505)));
+    CHECK(in_front(planes.planes[0], at(0.0505, 0.0, 0.046)));
+    // Taken about the proxy, as before, the edge's plane would still hold the finger.
+    planes = make_set({top});
+    retake_shape_planes(planes, at(0.051, 0.0, 0.0505));
+    CHECK_FALSE(in_front(planes.planes[0], at(0.0505, 0.0, 0.046)));
+
+    // The proxy over the top inside its rim, the finger beside the +x face: each is behind the other's plane, and
+    // the way passes 0.35 mm outside the edge. The edge's plane at its point nearest the way, normal (1, 0, 1)/√2.
+    planes = make_set({top});
+    retake_shape_planes(planes, at(0.0495, 0.0, 0.051), at(0.051, 0.0, 0.0495));
+    CHECK((planes.planes[0].normal - axes * Vector3d(1, 0, 1).normalized()).norm() < 1e-6);
+    CHECK((planes.planes[0].point_m - at(0.05, 0.0, 0.05)).norm() < 1e-6);
+    CHECK(in_front(planes.planes[0], at(0.0495, 0.0, 0.051)));
+    CHECK(in_front(planes.planes[0], at(0.051, 0.0, 0.0495)));
+
+    // A way that cuts the edge (the finger went through the cube's corner region): held about the proxy.
+    planes = make_set({top});
+    retake_shape_planes(planes, at(0.045, 0.0, 0.05), at(0.051, 0.0, 0.044));
+    CHECK(planes.planes[0].normal == top.normal);
+  }
+}
+
+TEST_CASE("the way past a sphere, a capsule and a cylinder is told from a way through them") {
+  // Each body lies along world x through the origin, radius 1 cm (the capsule and the cylinder 6 cm long); the
+  // plane came with the proxy above it. A way passing 0.8 mm outside the body leaves the finger free, one dipping
+  // 0.1 mm into it keeps the plane about the proxy.
+  Plane sphere_wire = test::wire_plane(8, {0.0, 0.0, 0.01}, {0, 0, 1}, false);
+  sphere_wire.flags |= kPlaneSphere;
+  sphere_wire.extent_m = 0.01;
+  sphere_wire.com_m = {0.0, 0.0, 0.0};
+  std::vector<ContactPlane> bodies{to_contact_plane(sphere_wire)};
+  for (const std::uint32_t kind : {kPlaneCapsule, kPlaneCylinder}) {
+    Plane wire = test::wire_plane(7, {0.0, 0.0, 0.01}, {0, 0, 1}, false);
+    wire.flags |= kind;
+    wire.extent_m = 0.01;
+    wire.com_m = {0.0, 0.0, 0.0};
+    wire.box_axis_x = {0.0, 1.0, 0.0};
+    wire.box_axis_y = {0.0, 0.0, 1.0};
+    wire.box_half_m = {0.01, 0.01, kind == kPlaneCylinder ? 0.03 : 0.02};
+    bodies.push_back(to_contact_plane(wire));
+  }
+  for (const ContactPlane& body : bodies) {
+    INFO("flags " << body.flags);
+    // Across the body, from 64° up its side to 26° (at x = 0 for the sphere, 1 cm along the others), on the line
+    // y + z = 15.3 mm, 10.8 mm from the axis. The finger is behind the plane the proxy had.
+    const double x = body.sphere() ? 0.0 : 0.01;
+    const Vector3d proxy(x, 0.005, 0.0103), clear_finger(x, 0.0103, 0.005);
+    PlaneSet planes = make_set({body});
+    retake_shape_planes(planes, proxy, clear_finger);
+    CHECK(planes.planes[0].normal.dot(clear_finger - planes.planes[0].point_m) >= 0.0);
+    CHECK(planes.planes[0].normal.dot(proxy - planes.planes[0].point_m) >= 0.0);
+    // Ends a little nearer (y + z = 14 mm, 9.9 mm from the axis): the way enters, and the finger stays behind.
+    const Vector3d through_finger(x, 0.0095, 0.0045);
+    planes = make_set({body});
+    retake_shape_planes(planes, Vector3d(x, 0.0045, 0.0095), through_finger);
+    CHECK(planes.planes[0].normal.dot(through_finger - planes.planes[0].point_m) < 0.0);
+  }
+}
