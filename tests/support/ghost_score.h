@@ -183,9 +183,11 @@ inline Scene stream(int count, unsigned seed, const Eigen::Vector3d& velocity_mp
 //   impulse, position  a step taken at tick k·n simulates to (k+1)·n, and the servo interpolates from frame k−1
 //                      to frame k over the period after it arrives (§3.2): the world's state at s is the truth at
 //                      tick s;
-//   local              a step taken at tick k·n replays the period the finger just rendered, placing each impulse
-//                      when it was rendered (world_manager/couplings/local_coupling.h), and its frame is the state
-//                      *now*, which the servo's model carries on: the truth at tick s is the world's state at s + T.
+//   local              a step taken at tick k·n replays the ticks the finger rendered since the last one, up to
+//                      tick k·n − 1, placing each impulse when it was rendered (world_manager/couplings/
+//                      local_coupling.h); its frame is the state at that last tick, which the servo's model carries on
+//                      tick by tick: the world's state at (k+1)·n is the truth at tick k·n − 1, and at s + T + 1 tick
+//                      the truth at tick s.
 // So the ticks are rendered first and scored once the world has simulated the times they need.
 inline Score score(Scene scene, double world_rate_hz, double duration_s, Coupling coupling = Coupling::impulse) {
   init_ode_once();
@@ -203,7 +205,7 @@ inline Score score(Scene scene, double world_rate_hz, double duration_s, Couplin
   World world(scene, options);
   HapticServo servo(ServoOptions{}, 1);
   const int ticks_per_step = static_cast<int>(std::lround(1000.0 / world_rate_hz));
-  const int steps_ahead = coupling == Coupling::local ? 1 : 0;
+  const int lead_ticks = coupling == Coupling::local ? ticks_per_step + 1 : 0;  // world time − tick time, in ticks
   const int ticks = static_cast<int>(duration_s * 1000.0);
 
   // Rendering: the world's states after each step (history[m] at m periods), and per tick the finger, proxy, force.
@@ -214,7 +216,7 @@ inline Score score(Scene scene, double world_rate_hz, double duration_s, Couplin
   };
   std::vector<Rendered> rendered;
   rendered.reserve(static_cast<std::size_t>(ticks));
-  for (int j = 0; j < ticks + (steps_ahead + 1) * ticks_per_step; ++j) {
+  for (int j = 0; j < ticks + lead_ticks + ticks_per_step; ++j) {
     const double t_s = 1e-3 * j;
     if (j % ticks_per_step == 0) {
       HapticReport report = servo.report();
@@ -235,8 +237,8 @@ inline Score score(Scene scene, double world_rate_hz, double duration_s, Couplin
   Score result;
   int left_at = -1;  // the tick the finger last left every object, while the force has not yet let go
   for (int j = ticks_per_step; j < ticks; ++j) {  // from the first frame's arrival
-    const std::size_t step = static_cast<std::size_t>(j / ticks_per_step + steps_ahead);
-    const double w = double(j % ticks_per_step) / ticks_per_step;
+    const std::size_t step = static_cast<std::size_t>((j + lead_ticks) / ticks_per_step);
+    const double w = double((j + lead_ticks) % ticks_per_step) / ticks_per_step;
     for (std::size_t k = 0; k < scene.objects.size(); ++k) {
       if (!scene.objects[k].dynamic) continue;
       const BodyPose& before = history[step][k];
