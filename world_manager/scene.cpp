@@ -207,7 +207,7 @@ Floor parse_floor(const Node& node) {
 PhysicsParams parse_physics(const Node& node) {
   node.expect_keys(
       {"world_rate_hz", "substeps", "solver", "solver_iterations", "contact_stiffness_Npm", "contact_damping_Nspm",
-       "erp", "cfm", "max_correcting_velocity_mps", "auto_disable", "seed"});
+       "erp", "cfm", "max_correcting_velocity_mps", "speculative_contacts", "auto_disable", "seed"});
   PhysicsParams physics;
   if (node.has("world_rate_hz")) {
     physics.world_rate_hz = node.child("world_rate_hz").in_range(limits::kMinWorldRate_Hz, limits::kMaxWorldRate_Hz, " Hz");
@@ -249,6 +249,9 @@ PhysicsParams parse_physics(const Node& node) {
   if (node.has("max_correcting_velocity_mps")) {
     physics.max_correcting_velocity_mps =
         node.child("max_correcting_velocity_mps").positive_up_to(SceneLimits::kMaxSpeed_mps, " m/s");
+  }
+  if (node.has("speculative_contacts")) {
+    physics.speculative_contacts = node.child("speculative_contacts").boolean();
   }
   if (node.has("auto_disable")) physics.auto_disable = node.child("auto_disable").boolean();
   if (node.has("seed")) {

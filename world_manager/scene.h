@@ -23,6 +23,8 @@
 //                                               with "erp"/"cfm"); see PhysicsParams
 //       "max_correcting_velocity_mps": 0.005,   cap on the speed at which ODE pushes penetrating bodies apart
 //                                               (default: none, ODE's own); see PhysicsParams
+//       "speculative_contacts": true,           contacts one substep before bodies meet, so an impact neither sinks
+//                                               into the other body nor bounces off ERP's push-out
 //       "auto_disable": true,                   resting bodies sleep: out of the simulation until pushed or touched,
 //                                               so a step costs what moves, not what exists (docs/sleeping.md)
 //       "seed": 1                               dRandSetSeed, so QuickStep runs are bitwise reproducible
@@ -198,6 +200,10 @@ struct PhysicsParams {
   // cube 19 % more travel than 0.1 ms ones; capped at 5 mm/s, 0.5 %). The cap slows the removal of penetration
   // (2 mm takes 0.4 s at 5 mm/s), so it is off unless a scene asks for it. Infinity: no cap (ODE's default).
   double max_correcting_velocity_mps = std::numeric_limits<double>::infinity();
+  // Contacts made one substep before a pair meets, which let it close the gap and no more
+  // (engine/speculative_contact.h): an impact then neither sinks v·h into the other body nor gets ERP's push-out
+  // back as a bounce. Off: ODE's contacts only once bodies overlap.
+  bool speculative_contacts = true;
   // A body resting for half a second leaves the simulation until something pushes or touches it
   // (engine/ode_engine.h): "model only what a scene needs". The tap trial's cube ends within 60 nm of where it ends
   // with it off (docs/sleeping.md); off keeps every body in ODE.

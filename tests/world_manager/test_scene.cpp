@@ -197,6 +197,14 @@ TEST_CASE("scene error: bad physics settings") {
                 "\"quickstep\" or \"direct\"");
   require_error(json{{"objects", json::array()}, {"physics", {{"max_correcting_velocity_mps", 0}}}},
                 "/physics/max_correcting_velocity_mps", "positive");
+  require_error(json{{"objects", json::array()}, {"physics", {{"speculative_contacts", 1}}}},
+                "/physics/speculative_contacts", "true or false");
+}
+
+TEST_CASE("speculative contacts are on unless the scene turns them off") {
+  CHECK(impetus::parse_scene(json{{"objects", json::array()}}, "test.json").physics.speculative_contacts);
+  const json document{{"objects", json::array()}, {"physics", {{"speculative_contacts", false}}}};
+  CHECK_FALSE(impetus::parse_scene(document, "test.json").physics.speculative_contacts);
 }
 
 TEST_CASE("the penetration correction is uncapped unless the scene caps it") {

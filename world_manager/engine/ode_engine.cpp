@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/engine/ode_engine.h"
 
+#include "world_manager/engine/speculative_contact.h"
 #include "world_manager/features/spatial_grid.h"
 
 #include <ode/ode.h>
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace impetus {
@@ -53,6 +55,11 @@ double grid_cell_size_m(const Scene& scene) {
   return *middle;
 }
 
+// A geom pair as one key, the lower id first (the floor's id is the object count).
+std::uint64_t pair_key(std::size_t a, std::size_t b) {
+  return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint64_t>(std::max(a, b));
+}
+
 void* id_to_data(std::size_t id) { return reinterpret_cast<void*>(static_cast<std::uintptr_t>(id)); }
 std::size_t data_to_id(void* data) { return static_cast<std::size_t>(reinterpret_cast<std::uintptr_t>(data)); }
 
@@ -85,12 +92,23 @@ struct OdeEngine::Handles {
     std::int32_t id_a, id_b;  // kStatic for a side without a body
     Eigen::Vector3d normal;   // pushes a out of b
     double friction;
+    bool speculative;         // a pair not touching yet: in the graph only if the step pressed it
   };
   std::vector<RecordedContact> recorded;
   std::vector<dJointFeedback> feedback;  // one per recorded contact; sized before the step so the addresses hold
   std::vector<std::size_t> escaped;      // objects taken out of the simulation (park_escaped)
   std::vector<bool> is_escaped;          // per object
   std::vector<std::size_t> moved;        // RigidBodyEngine::moved()
+
+  // Speculative contacts (speculative_contact.h, scene physics.speculative_contacts).
+  bool speculative = false;
+  dGeomID probe = nullptr;                     // a box in no space: the swept bounds of one body, for the broadphase
+  std::vector<Eigen::Vector3d> displacement;   // per object: its free displacement in this substep (awake bodies)
+  double max_displacement_m = 0.0;             // the largest of them
+  double substep_s = 0.0;                      // the substep being made
+  std::vector<std::uint64_t> touching;         // pair_key of every pair with ordinary contacts in this substep
+  std::vector<dGeomID> candidates;             // scratch
+  std::vector<std::pair<dGeomID, dGeomID>> closing;  // touching pairs still closing fast (near_callback)
 
   // Sleeping (ode_engine.h). The awake list is in the order bodies woke; `moved` is sorted at the end of each step.
   bool sleeping = false;
@@ -152,19 +170,30 @@ struct OdeEngine::Handles {
     contact_graph.wake(static_cast<std::int32_t>(id));
   }
 
-  // Wakes every sleeping body an awake one touches, and those they touch in turn (ODE's islands would).
-  void wake_touched() {
+  // Wakes every sleeping body an awake one touches, and those they touch in turn (ODE's islands would). With
+  // speculative contacts also those an awake body would reach within the substep of h, so that they meet as bodies.
+  void wake_touched(double h) {
     wake_queue.assign(awake.begin(), awake.end());
     for (std::size_t i = 0; i < wake_queue.size(); ++i) {
-      if (is_escaped[wake_queue[i]]) continue;
-      dGeomID geom = geoms[wake_queue[i]];
-      const Eigen::AlignedBox3d bounds = geom_bounds(geom);
+      const std::size_t id = wake_queue[i];
+      if (is_escaped[id]) continue;
+      dGeomID geom = geoms[id];
+      Eigen::AlignedBox3d bounds = geom_bounds(geom);
+      if (speculative) {
+        displacement[id] = free_displacement(id, h);
+        Eigen::AlignedBox3d moved_bounds = bounds;
+        bounds.extend(moved_bounds.translate(displacement[id]));
+      }
       grid->query(bounds, nearby);
       for (const std::int32_t other : nearby) {
         const auto o = static_cast<std::size_t>(other);
         if (kind[o] != Kind::asleep || !bounds.intersects(resting_bounds[o])) continue;
-        dContactGeom touch;
-        if (dCollide(geom, geoms[o], 1, &touch, sizeof(dContactGeom)) == 0) continue;
+        dContact touch[kMaxContactsPerPair];
+        if (dCollide(geom, geoms[o], 1, &touch[0].geom, sizeof(dContact)) == 0 &&
+            !(speculative && speculative_contacts(geom, bodies[id], geoms[o], displacement[id], touch,
+                                                  kMaxContactsPerPair) > 0)) {
+          continue;
+        }
         wake_up(o);
         wake_queue.push_back(o);
       }
@@ -243,6 +272,7 @@ struct OdeEngine::Handles {
 
   ~Handles() {
     if (contacts != nullptr) dJointGroupDestroy(contacts);
+    if (probe != nullptr) dGeomDestroy(probe);
     if (resting_space != nullptr) dSpaceDestroy(resting_space);
     if (space != nullptr) dSpaceDestroy(space);  // destroys the geoms it holds (cleanup mode on)
     if (world != nullptr) dWorldDestroy(world);  // destroys the bodies
@@ -256,6 +286,7 @@ struct OdeEngine::Handles {
       const RecordedContact& contact = recorded[c];
       const dReal* f = feedback[c].f1;
       const double normal_force_N = std::abs(contact.normal.dot(Eigen::Vector3d(f[0], f[1], f[2])));
+      if (contact.speculative && !(normal_force_N > 0.0)) continue;  // the pair did not meet in the substep
       if (contact.id_a != ContactGraph::kStatic) {
         contact_graph.add(contact.id_a, contact.id_b, contact.normal, contact.friction, normal_force_N);
       }
@@ -266,42 +297,225 @@ struct OdeEngine::Handles {
     contact_graph.finish();
   }
 
-  // ODE's near callback: contact joints with the two materials combined (scene.h combine_*).
-  static void near_callback(void* data, dGeomID a, dGeomID b) {
-    auto* self = static_cast<Handles*>(data);
+  // The two materials combined (scene.h combine_*) on a contact's surface.
+  void set_surface(dSurfaceParameters& surface, const Material& ma, const Material& mb) const {
+    // Approx1: the friction bound is mu times the normal force (a Coulomb pyramid). ODE has a single coefficient;
+    // it gets the dynamic one because sliding (how far a tapped cube goes, paper §4.2.2) is governed by it. The
+    // static coefficient matters for the finger, and the planes carry it to the haptic side.
+    surface.mode = dContactApprox1;
+    surface.mu = combine_friction(ma.dynamic_friction, mb.dynamic_friction);
+    const double restitution = combine_restitution(ma.restitution, mb.restitution);
+    if (restitution > 0.0) {
+      surface.mode |= dContactBounce;
+      surface.bounce = restitution;
+      surface.bounce_vel = kBounceThreshold_mps;
+    }
+  }
+
+  // A contact joint between the geoms' bodies, recorded for the contact graph in the recording substep.
+  void add_contact(const dContact& contact, dGeomID a, dGeomID b, bool speculative_contact) {
     dBodyID body_a = dGeomGetBody(a);
     dBodyID body_b = dGeomGetBody(b);
-    if (body_a == nullptr && body_b == nullptr) return;  // static against static never moves
+    dJointID joint = dJointCreateContact(world, contacts, &contact);
+    dJointAttach(joint, body_a, body_b);
+    if (!record_contacts) return;
+    // ODE's normal points into geom 1 (contact.h): the contact pushes body a along +n and body b along −n.
+    const dReal* n = contact.geom.normal;
+    const Eigen::Vector3d normal(n[0], n[1], n[2]);
+    if (!(normal.squaredNorm() > 0.0) || !normal.allFinite()) return;
+    const auto id_a = body_a != nullptr ? static_cast<std::int32_t>(data_to_id(dGeomGetData(a))) : ContactGraph::kStatic;
+    const auto id_b = body_b != nullptr ? static_cast<std::int32_t>(data_to_id(dGeomGetData(b))) : ContactGraph::kStatic;
+    recorded.push_back({joint, id_a, id_b, normal, contact.surface.mu, speculative_contact});
+  }
+
+  // ODE's near callback: contact joints with the two materials combined. With speculative contacts a pair that is
+  // still closing fast is given the contacts of where it will be (add_swept_contacts): it has only just met, and
+  // ODE's contacts of a pair touching by a hair are any subset of its corners (two bottom corners of a face: a torque
+  // that pitches both boxes).
+  static void near_callback(void* data, dGeomID a, dGeomID b) {
+    auto* self = static_cast<Handles*>(data);
+    if (dGeomGetBody(a) == nullptr && dGeomGetBody(b) == nullptr) return;  // static against static never moves
     dContact contacts[kMaxContactsPerPair];
     const int count = dCollide(a, b, kMaxContactsPerPair, &contacts[0].geom, sizeof(dContact));
     if (count == 0) return;
-    const Material& ma = self->materials[data_to_id(dGeomGetData(a))];
-    const Material& mb = self->materials[data_to_id(dGeomGetData(b))];
-    const double restitution = combine_restitution(ma.restitution, mb.restitution);
-    for (int i = 0; i < count; ++i) {
-      dSurfaceParameters& surface = contacts[i].surface;
-      // Approx1: the friction bound is mu times the normal force (a Coulomb pyramid). ODE has a single coefficient;
-      // it gets the dynamic one because sliding (how far a tapped cube goes, paper §4.2.2) is governed by it. The
-      // static coefficient matters for the finger, and the planes carry it to the haptic side.
-      surface.mode = dContactApprox1;
-      surface.mu = combine_friction(ma.dynamic_friction, mb.dynamic_friction);
-      if (restitution > 0.0) {
-        surface.mode |= dContactBounce;
-        surface.bounce = restitution;
-        surface.bounce_vel = kBounceThreshold_mps;
-      }
-      dJointID joint = dJointCreateContact(self->world, self->contacts, &contacts[i]);
-      dJointAttach(joint, body_a, body_b);
-      if (self->record_contacts) {
-        // ODE's normal points into geom 1 (contact.h): the contact pushes body a along +n and body b along −n.
-        const dReal* n = contacts[i].geom.normal;
-        const Eigen::Vector3d normal(n[0], n[1], n[2]);
-        if (!(normal.squaredNorm() > 0.0) || !normal.allFinite()) continue;
-        const auto id_a = body_a != nullptr ? static_cast<std::int32_t>(data_to_id(dGeomGetData(a))) : ContactGraph::kStatic;
-        const auto id_b = body_b != nullptr ? static_cast<std::int32_t>(data_to_id(dGeomGetData(b))) : ContactGraph::kStatic;
-        self->recorded.push_back({joint, id_a, id_b, normal, surface.mu});
+    const std::size_t id_a = data_to_id(dGeomGetData(a));
+    const std::size_t id_b = data_to_id(dGeomGetData(b));
+    if (self->speculative) {
+      self->touching.push_back(pair_key(id_a, id_b));
+      if (self->closing_fast(id_a, id_b, contacts[0].geom)) {
+        self->closing.push_back({a, b});  // the body is moved for the test, which the locked space forbids here
+        return;
       }
     }
+    self->add_contacts(contacts, count, a, b);
+  }
+
+  void add_contacts(dContact* contacts, int count, dGeomID a, dGeomID b) {
+    const std::size_t id_a = data_to_id(dGeomGetData(a));
+    const std::size_t id_b = data_to_id(dGeomGetData(b));
+    for (int i = 0; i < count; ++i) {
+      set_surface(contacts[i].surface, materials[id_a], materials[id_b]);
+      add_contact(contacts[i], a, b, false);
+    }
+  }
+
+  // The pairs the near callback found closing fast, once the space is unlocked: the contacts of where they will be,
+  // or their ordinary ones if the displacements part them.
+  void add_closing_contacts() {
+    for (const auto& [a, b] : closing) {
+      if (add_swept_contacts(a, b)) continue;
+      dContact contacts[kMaxContactsPerPair];
+      add_contacts(contacts, dCollide(a, b, kMaxContactsPerPair, &contacts[0].geom, sizeof(dContact)), a, b);
+    }
+    closing.clear();
+  }
+
+  // Whether the pair's contact `touch` closes faster than a resting contact ever does (kBounceThreshold_mps, with the
+  // velocities as they are, before this substep's gravity and forces).
+  bool closing_fast(std::size_t id_a, std::size_t id_b, const dContactGeom& touch) const {
+    const Eigen::Vector3d at(touch.pos[0], touch.pos[1], touch.pos[2]);
+    const Eigen::Vector3d normal(touch.normal[0], touch.normal[1], touch.normal[2]);
+    return -normal.dot(point_velocity(id_a, at) - point_velocity(id_b, at)) > kBounceThreshold_mps;
+  }
+
+  // The velocity of the point `at` on what carries geom `id` (zero for fixed geometry and the floor).
+  Eigen::Vector3d point_velocity(std::size_t id, const Eigen::Vector3d& at) const {
+    if (id >= bodies.size() || bodies[id] == nullptr) return Eigen::Vector3d::Zero();
+    const dReal* p = dBodyGetPosition(bodies[id]);
+    const dReal* v = dBodyGetLinearVel(bodies[id]);
+    const dReal* w = dBodyGetAngularVel(bodies[id]);
+    return Eigen::Vector3d(v[0], v[1], v[2]) +
+           Eigen::Vector3d(w[0], w[1], w[2]).cross(at - Eigen::Vector3d(p[0], p[1], p[2]));
+  }
+
+  // The contacts the pair makes within this substep (speculative_contact.h), moving the one with a body (the lower id
+  // if both have) by their relative free displacement; false if they do not meet. Where the pair is still apart by
+  // gap the row lets it close the gap and no more (relative normal speed ≥ −gap/h; ERP adds nothing at zero depth);
+  // a bouncing pair (restitution e, closing faster than the bounce threshold) leaves at e times its closing speed
+  // from there, as ODE's bounce would one substep later from inside. Where it already overlaps, an ordinary contact.
+  bool add_swept_contacts(dGeomID a, dGeomID b) {
+    std::size_t id_a = data_to_id(dGeomGetData(a));
+    std::size_t id_b = data_to_id(dGeomGetData(b));
+    if (dGeomGetBody(a) == nullptr || (dGeomGetBody(b) != nullptr && id_b < id_a)) {
+      std::swap(a, b);
+      std::swap(id_a, id_b);
+    }
+    const Eigen::Vector3d relative_m = displacement_of(id_a) - displacement_of(id_b);
+    if (!(relative_m.squaredNorm() > 0.0)) return false;
+    dContact found[kMaxContactsPerPair];
+    const int count = speculative_contacts(a, bodies[id_a], b, relative_m, found, kMaxContactsPerPair);
+    for (int i = 0; i < count; ++i) {
+      dContact& contact = found[i];
+      set_surface(contact.surface, materials[id_a], materials[id_b]);
+      const double gap_m = -contact.geom.depth;
+      const bool apart = gap_m > 0.0;
+      if (apart) {
+        contact.geom.depth = 0.0;
+        contact.surface.mode |= dContactMotionN;
+        contact.surface.motionN = -gap_m / substep_s;
+        if ((contact.surface.mode & dContactBounce) != 0) {
+          contact.surface.mode &= ~dContactBounce;
+          const Eigen::Vector3d at(contact.geom.pos[0], contact.geom.pos[1], contact.geom.pos[2]);
+          const Eigen::Vector3d normal(contact.geom.normal[0], contact.geom.normal[1], contact.geom.normal[2]);
+          const double closing_mps = -normal.dot(point_velocity(id_a, at) - point_velocity(id_b, at));
+          if (closing_mps > contact.surface.bounce_vel) contact.surface.motionN = contact.surface.bounce * closing_mps;
+        }
+      }
+      add_contact(contact, a, b, apart);
+    }
+    return count > 0;
+  }
+
+  // The displacement body `id` makes in a substep of h if nothing touches it: semi-implicit Euler, as ODE steps,
+  // with gravity and the forces applied so far (the couplings add theirs before the substep).
+  Eigen::Vector3d free_displacement(std::size_t id, double h) const {
+    dBodyID body = bodies[id];
+    dMass mass;
+    dBodyGetMass(body, &mass);
+    const dReal* v = dBodyGetLinearVel(body);
+    const dReal* f = dBodyGetForce(body);
+    Eigen::Vector3d acceleration = Eigen::Vector3d(f[0], f[1], f[2]) / mass.mass;
+    if (dBodyGetGravityMode(body) != 0) acceleration += Eigen::Vector3d(scene->gravity_mps2.data());
+    return h * (Eigen::Vector3d(v[0], v[1], v[2]) + h * acceleration);
+  }
+
+  // Every moving body's free displacement for the coming substep, and the largest.
+  void predict_displacements(double h) {
+    max_displacement_m = 0.0;
+    auto predict = [&](std::size_t id) {
+      if (bodies[id] == nullptr || is_escaped[id] || dBodyIsEnabled(bodies[id]) == 0) return;
+      displacement[id] = free_displacement(id, h);
+      max_displacement_m = std::max(max_displacement_m, displacement[id].norm());
+    };
+    if (sleeping) {
+      for (const std::size_t id : awake) predict(id);
+    } else {
+      for (std::size_t id = 0; id < bodies.size(); ++id) predict(id);
+    }
+  }
+
+  // The displacement of whatever carries geom `id` this substep: zero for fixed geometry, the floor and sleepers.
+  Eigen::Vector3d displacement_of(std::size_t id) const {
+    if (id >= bodies.size() || bodies[id] == nullptr || is_escaped[id] || dBodyIsEnabled(bodies[id]) == 0) {
+      return Eigen::Vector3d::Zero();
+    }
+    return displacement[id];
+  }
+
+  // The bounds `id`'s geom sweeps in the substep, grown by the most any other body moves (so a pair closing from
+  // both sides is found from either).
+  Eigen::AlignedBox3d swept_bounds(std::size_t id) const {
+    Eigen::AlignedBox3d bounds = geom_bounds(geoms[id]);
+    Eigen::AlignedBox3d moved_bounds = bounds;
+    moved_bounds.translate(displacement[id]);
+    bounds.extend(moved_bounds);
+    const Eigen::Vector3d margin = Eigen::Vector3d::Constant(max_displacement_m);
+    return Eigen::AlignedBox3d(bounds.min() - margin, bounds.max() + margin);
+  }
+
+  static void collect_candidate(void* data, dGeomID a, dGeomID b) {
+    auto* self = static_cast<Handles*>(data);
+    self->candidates.push_back(a == self->probe ? b : a);
+  }
+
+  // Speculative contacts (speculative_contact.h) of every moving body with what it would reach in this substep and
+  // does not touch yet. Each pair once: two moving bodies from the lower id, with their relative displacement.
+  void speculate() {
+    std::sort(touching.begin(), touching.end());
+    auto one_body = [&](std::size_t id) {
+      if (bodies[id] == nullptr || is_escaped[id] || dBodyIsEnabled(bodies[id]) == 0) return;
+      if (!(displacement[id].squaredNorm() > 0.0) && max_displacement_m == 0.0) return;
+      const Eigen::AlignedBox3d bounds = swept_bounds(id);
+      const Eigen::Vector3d size = bounds.sizes();
+      const Eigen::Vector3d centre = bounds.center();
+      dGeomBoxSetLengths(probe, size.x(), size.y(), size.z());
+      dGeomSetPosition(probe, centre.x(), centre.y(), centre.z());
+      candidates.clear();
+      dSpaceCollide2(probe, reinterpret_cast<dGeomID>(space), this, &Handles::collect_candidate);
+      if (sleeping) {
+        if (floor != nullptr) candidates.push_back(floor);
+        grid->query(bounds, nearby);
+        for (const std::int32_t other : nearby) {
+          const auto o = static_cast<std::size_t>(other);
+          if (kind[o] == Kind::fixed && bounds.intersects(resting_bounds[o])) candidates.push_back(geoms[o]);
+        }
+      }
+      for (dGeomID other : candidates) speculate_pair(id, other);
+    };
+    if (sleeping) {
+      for (const std::size_t id : awake) one_body(id);
+    } else {
+      for (std::size_t id = 0; id < bodies.size(); ++id) one_body(id);
+    }
+  }
+
+  void speculate_pair(std::size_t id, dGeomID other) {
+    dGeomID geom = geoms[id];
+    if (other == geom || dGeomIsEnabled(other) == 0) return;
+    const std::size_t other_id = data_to_id(dGeomGetData(other));
+    if (dGeomGetBody(other) != nullptr && other_id < id) return;  // the lower id's pass has it
+    if (std::binary_search(touching.begin(), touching.end(), pair_key(id, other_id))) return;
+    add_swept_contacts(geom, other);
   }
 };
 
@@ -317,6 +531,11 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   ode.space = ode.sleeping ? dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ) : dHashSpaceCreate(nullptr);
   if (ode.sleeping) ode.resting_space = dSimpleSpaceCreate(nullptr);  // never collided as a whole: it only owns
   ode.contacts = dJointGroupCreate(0);
+  ode.speculative = scene.physics.speculative_contacts;
+  if (ode.speculative) {
+    ode.probe = dCreateBox(nullptr, 1.0, 1.0, 1.0);
+    ode.displacement.assign(scene.objects.size(), Eigen::Vector3d::Zero());
+  }
   dWorldSetGravity(ode.world, scene.gravity_mps2[0], scene.gravity_mps2[1], scene.gravity_mps2[2]);
   if (std::isfinite(scene.physics.max_correcting_velocity_mps)) {
     dWorldSetContactMaxCorrectingVel(ode.world, scene.physics.max_correcting_velocity_mps);
@@ -499,11 +718,18 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
     const bool recording = ode.record_contacts;
     if (recording) ode.recorded.clear();
     ode.park_escaped();
+    ode.touching.clear();
+    ode.substep_s = substep_s;
+    if (ode.sleeping) ode.wake_touched(substep_s);
+    if (ode.speculative) ode.predict_displacements(substep_s);
     if (ode.sleeping) {
-      ode.wake_touched();
       ode.collide_awake();
     } else {
       dSpaceCollide(ode.space, &ode, &Handles::near_callback);
+    }
+    if (ode.speculative) {
+      ode.add_closing_contacts();
+      ode.speculate();
     }
     ode.record_contacts = false;
     if (recording) {
