@@ -102,18 +102,21 @@ struct OdeEngine::Handles {
 
   // Speculative contacts (speculative_contact.h, scene physics.speculative_contacts).
   bool speculative = false;
-  dGeomID probe = nullptr;                     // a box in no space: the swept bounds of one body, for the broadphase
   std::vector<Eigen::Vector3d> displacement;   // per object: its free displacement in this substep (awake bodies)
-  double max_displacement_m = 0.0;             // the largest of them
   double substep_s = 0.0;                      // the substep being made
   std::vector<std::uint64_t> touching;         // pair_key of every pair with ordinary contacts in this substep
-  std::vector<dGeomID> candidates;             // scratch
+  struct Sweep {
+    std::size_t id;
+    Eigen::AlignedBox3d bounds;
+  };
+  std::vector<Sweep> sweeps;                   // scratch: the moving bodies' swept bounds
+  std::vector<std::pair<std::size_t, Eigen::AlignedBox3d>> fixed_bounds;  // without sleeping: fixed objects' geoms
   std::vector<std::pair<dGeomID, dGeomID>> closing;  // touching pairs still closing fast (near_callback)
 
   // Sleeping (ode_engine.h). The awake list is in the order bodies woke; `moved` is sorted at the end of each step.
   bool sleeping = false;
   dSpaceID resting_space = nullptr;  // owns the geoms of static objects, sleeping bodies and the floor
-  dGeomID floor = nullptr;
+  dGeomID floor = nullptr;                    // in resting_space with sleeping, else in space
   enum class Kind : std::uint8_t { fixed, awake, asleep };
   std::vector<Kind> kind;                     // per object
   std::vector<std::size_t> awake;             // ids of the awake dynamic bodies (not escaped)
@@ -272,7 +275,6 @@ struct OdeEngine::Handles {
 
   ~Handles() {
     if (contacts != nullptr) dJointGroupDestroy(contacts);
-    if (probe != nullptr) dGeomDestroy(probe);
     if (resting_space != nullptr) dSpaceDestroy(resting_space);
     if (space != nullptr) dSpaceDestroy(space);  // destroys the geoms it holds (cleanup mode on)
     if (world != nullptr) dWorldDestroy(world);  // destroys the bodies
@@ -439,13 +441,11 @@ struct OdeEngine::Handles {
     return h * (Eigen::Vector3d(v[0], v[1], v[2]) + h * acceleration);
   }
 
-  // Every moving body's free displacement for the coming substep, and the largest.
+  // Every moving body's free displacement for the coming substep.
   void predict_displacements(double h) {
-    max_displacement_m = 0.0;
     auto predict = [&](std::size_t id) {
       if (bodies[id] == nullptr || is_escaped[id] || dBodyIsEnabled(bodies[id]) == 0) return;
       displacement[id] = free_displacement(id, h);
-      max_displacement_m = std::max(max_displacement_m, displacement[id].norm());
     };
     if (sleeping) {
       for (const std::size_t id : awake) predict(id);
@@ -462,60 +462,58 @@ struct OdeEngine::Handles {
     return displacement[id];
   }
 
-  // The bounds `id`'s geom sweeps in the substep, grown by the most any other body moves (so a pair closing from
-  // both sides is found from either).
+  // The bounds `id`'s geom sweeps in the substep.
   Eigen::AlignedBox3d swept_bounds(std::size_t id) const {
     Eigen::AlignedBox3d bounds = geom_bounds(geoms[id]);
     Eigen::AlignedBox3d moved_bounds = bounds;
-    moved_bounds.translate(displacement[id]);
-    bounds.extend(moved_bounds);
-    const Eigen::Vector3d margin = Eigen::Vector3d::Constant(max_displacement_m);
-    return Eigen::AlignedBox3d(bounds.min() - margin, bounds.max() + margin);
-  }
-
-  static void collect_candidate(void* data, dGeomID a, dGeomID b) {
-    auto* self = static_cast<Handles*>(data);
-    self->candidates.push_back(a == self->probe ? b : a);
+    return bounds.extend(moved_bounds.translate(displacement[id]));
   }
 
   // Speculative contacts (speculative_contact.h) of every moving body with what it would reach in this substep and
-  // does not touch yet. Each pair once: two moving bodies from the lower id, with their relative displacement.
+  // does not touch yet. Moving pairs by sweep and prune over their swept bounds along x (O(n log n) in the bodies
+  // that move); fixed geometry from the grid (with sleeping) or the list of it, and the floor.
   void speculate() {
     std::sort(touching.begin(), touching.end());
-    auto one_body = [&](std::size_t id) {
+    sweeps.clear();
+    auto add_sweep = [&](std::size_t id) {
       if (bodies[id] == nullptr || is_escaped[id] || dBodyIsEnabled(bodies[id]) == 0) return;
-      if (!(displacement[id].squaredNorm() > 0.0) && max_displacement_m == 0.0) return;
-      const Eigen::AlignedBox3d bounds = swept_bounds(id);
-      const Eigen::Vector3d size = bounds.sizes();
-      const Eigen::Vector3d centre = bounds.center();
-      dGeomBoxSetLengths(probe, size.x(), size.y(), size.z());
-      dGeomSetPosition(probe, centre.x(), centre.y(), centre.z());
-      candidates.clear();
-      dSpaceCollide2(probe, reinterpret_cast<dGeomID>(space), this, &Handles::collect_candidate);
-      if (sleeping) {
-        if (floor != nullptr) candidates.push_back(floor);
-        grid->query(bounds, nearby);
-        for (const std::int32_t other : nearby) {
-          const auto o = static_cast<std::size_t>(other);
-          if (kind[o] == Kind::fixed && bounds.intersects(resting_bounds[o])) candidates.push_back(geoms[o]);
-        }
-      }
-      for (dGeomID other : candidates) speculate_pair(id, other);
+      sweeps.push_back({id, swept_bounds(id)});
     };
     if (sleeping) {
-      for (const std::size_t id : awake) one_body(id);
+      for (const std::size_t id : awake) add_sweep(id);
     } else {
-      for (std::size_t id = 0; id < bodies.size(); ++id) one_body(id);
+      for (std::size_t id = 0; id < bodies.size(); ++id) add_sweep(id);
+    }
+    std::sort(sweeps.begin(), sweeps.end(),
+              [](const Sweep& a, const Sweep& b) { return a.bounds.min().x() < b.bounds.min().x(); });
+    for (std::size_t i = 0; i < sweeps.size(); ++i) {
+      const Sweep& a = sweeps[i];
+      for (std::size_t j = i + 1; j < sweeps.size() && sweeps[j].bounds.min().x() <= a.bounds.max().x(); ++j) {
+        if (!a.bounds.intersects(sweeps[j].bounds)) continue;
+        const std::size_t low = std::min(a.id, sweeps[j].id), high = std::max(a.id, sweeps[j].id);
+        speculate_pair(low, geoms[high]);
+      }
+      if (floor != nullptr) speculate_pair(a.id, floor);
+      if (sleeping) {
+        grid->query(a.bounds, nearby);
+        for (const std::int32_t other : nearby) {
+          const auto o = static_cast<std::size_t>(other);
+          if (kind[o] == Kind::fixed && a.bounds.intersects(resting_bounds[o])) speculate_pair(a.id, geoms[o]);
+        }
+      } else {
+        for (const auto& [o, bounds] : fixed_bounds) {
+          if (a.bounds.intersects(bounds)) speculate_pair(a.id, geoms[o]);
+        }
+      }
     }
   }
 
+  // Body `id` against `other` (fixed, the floor, or a body of higher id), unless they touch already.
   void speculate_pair(std::size_t id, dGeomID other) {
-    dGeomID geom = geoms[id];
-    if (other == geom || dGeomIsEnabled(other) == 0) return;
+    if (dGeomIsEnabled(other) == 0) return;
     const std::size_t other_id = data_to_id(dGeomGetData(other));
-    if (dGeomGetBody(other) != nullptr && other_id < id) return;  // the lower id's pass has it
     if (std::binary_search(touching.begin(), touching.end(), pair_key(id, other_id))) return;
-    add_swept_contacts(geom, other);
+    add_swept_contacts(geoms[id], other);
   }
 };
 
@@ -533,7 +531,6 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   ode.contacts = dJointGroupCreate(0);
   ode.speculative = scene.physics.speculative_contacts;
   if (ode.speculative) {
-    ode.probe = dCreateBox(nullptr, 1.0, 1.0, 1.0);
     ode.displacement.assign(scene.objects.size(), Eigen::Vector3d::Zero());
   }
   dWorldSetGravity(ode.world, scene.gravity_mps2[0], scene.gravity_mps2[1], scene.gravity_mps2[2]);
@@ -620,6 +617,8 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
       if (ode.sleeping) {
         ode.resting_bounds[id] = geom_bounds(geom);
         ode.grid->update(static_cast<std::int32_t>(id), ode.resting_bounds[id]);
+      } else if (ode.speculative) {
+        ode.fixed_bounds.emplace_back(id, geom_bounds(geom));
       }
     }
     ode.materials.push_back(object.material);
@@ -628,7 +627,7 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   if (scene.floor.present) {
     dGeomID floor = dCreatePlane(ode.sleeping ? ode.resting_space : ode.space, 0.0, 0.0, 1.0, scene.floor.height_m);
     dGeomSetData(floor, id_to_data(scene.objects.size()));
-    if (ode.sleeping) ode.floor = floor;
+    ode.floor = floor;
   }
 
   dRandSetSeed(static_cast<unsigned long>(scene.physics.seed));
