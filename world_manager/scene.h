@@ -194,11 +194,10 @@ struct PhysicsParams {
   // What ODE is given for substeps of `substep_s`: ERP and CFM as they are, or from the spring and damper.
   double erp_at(double substep_s) const;
   double cfm_at(double substep_s) const;
-  // ERP removes a fraction of each contact's penetration per substep, as a separating speed erp·depth/h. An impact
-  // penetrates about v·h, so at coarse substeps that speed is a bounce nobody asked for: a 1 kg cube sliding at
-  // 0.4 m/s into a 0.5 kg one with restitution 0 should push it along, not kick it (5 ms substeps give the second
-  // cube 19 % more travel than 0.1 ms ones; capped at 5 mm/s, 0.5 %). The cap slows the removal of penetration
-  // (2 mm takes 0.4 s at 5 mm/s), so it is off unless a scene asks for it. Infinity: no cap (ODE's default).
+  // ERP removes a fraction of each contact's penetration per substep, as a separating speed erp·depth/h; this caps
+  // that speed. An impact that penetrates (speculative contacts off) turns the correction into a bounce nobody asked
+  // for, which a low cap suppresses; the cap also slows the removal of any penetration (2 mm takes 0.4 s at
+  // 5 mm/s), so it is off unless a scene asks for it. Infinity: no cap (ODE's default).
   double max_correcting_velocity_mps = std::numeric_limits<double>::infinity();
   // Contacts made one substep before a pair meets, which let it close the gap and no more
   // (engine/speculative_contact.h): an impact then neither sinks v·h into the other body nor gets ERP's push-out
