@@ -12,6 +12,19 @@ namespace {
 
 // Gauss–Seidel passes over the contacts: enough for a corner of three supports to settle.
 constexpr int kContactPasses = 3;
+
+// The two friction directions ODE gives a contact of normal n that names none (its dPlaneSpace), so the model's
+// friction pyramid is the world's.
+std::array<Eigen::Vector3d, 2> ode_tangents(const Eigen::Vector3d& n) {
+  if (std::fabs(n.z()) > std::sqrt(0.5)) {
+    const double k = 1.0 / std::sqrt(n.y() * n.y() + n.z() * n.z());
+    const Eigen::Vector3d p(0.0, -n.z() * k, n.y() * k);
+    return {p, Eigen::Vector3d((n.y() * n.y() + n.z() * n.z()) * k, -n.x() * p.z(), n.x() * p.y())};
+  }
+  const double k = 1.0 / std::sqrt(n.x() * n.x() + n.y() * n.y());
+  const Eigen::Vector3d p(-n.y() * k, n.x() * k, 0.0);
+  return {p, Eigen::Vector3d(-n.z() * p.y(), n.z() * p.x(), (n.x() * n.x() + n.y() * n.y()) * k)};
+}
 // Bound on drift substeps applied in one tick (a tick longer than the world's substep, e.g. after a stall).
 constexpr int kMaxDriftChunksPerTick = 8;
 
@@ -106,6 +119,11 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
       body.sphere_radius_m = (plane.flags & kPlaneSphere) != 0 && plane.extent_m > 0.0 ? plane.extent_m : 0.0;
       body.turns = (plane.flags & kPlaneFlat) != 0;
       body.turns_shape = (plane.flags & (kPlaneCapsule | kPlaneCylinder)) != 0;
+      if ((plane.flags & kPlaneBox) != 0) {
+        const Eigen::Vector3d x = to_eigen(plane.box_axis_x), y = to_eigen(plane.box_axis_y);
+        body.box_axes << x, y, x.cross(y);
+        body.box_half_m = to_eigen(plane.box_half_m);
+      }
       for (std::uint32_t c = 0; c < body.contact_count; ++c) {
         body.contact_normal[c] = to_eigen(plane.local_contacts[c].normal);
         body.contact_friction[c] = plane.local_contacts[c].friction;
@@ -181,6 +199,10 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
       w += spin_per_impulse * lever.cross(j);
       continue;
     }
+    if (body.box_half_m.minCoeff() > 0.0 && body.inverse_mass_per_kg > 0.0) {
+      apply_box_friction(body, n, limit);
+      continue;
+    }
     const Eigen::Vector3d slip = v - v.dot(n) * n;
     const double slip_mps = slip.norm();
     if (slip_mps > 0.0) v -= std::min(slip_mps, limit) / slip_mps * slip;
@@ -189,6 +211,53 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
   // Rotation is otherwise left free: supports do not stop a ball rolling, and where they would stop a box tipping the model
   // over-predicts the surface's motion, the passive error. Stopping it would let the finger's friction spin a ball
   // in the world far past rolling with the finger, since the model would see its surface still.
+}
+
+void LocalDynamics::apply_box_friction(LocalBody& body, const Eigen::Vector3d& n, double limit) {
+  // The face that looks along −n (the support's side), from the box's axes as the model has turned them.
+  const Eigen::Matrix3d axes = body.turn.toRotationMatrix() * body.box_axes;
+  int down = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (std::fabs(axes.col(k).dot(n)) > std::fabs(axes.col(down).dot(n))) down = k;
+  }
+  const double side = axes.col(down).dot(n) > 0.0 ? -1.0 : 1.0;
+  const int a = (down + 1) % 3, b = (down + 2) % 3;
+  std::array<Eigen::Vector3d, 4> corners;
+  for (int c = 0; c < 4; ++c) {
+    corners[static_cast<std::size_t>(c)] = side * body.box_half_m[down] * axes.col(down) +
+                                           ((c & 1) != 0 ? 1.0 : -1.0) * body.box_half_m[a] * axes.col(a) +
+                                           ((c & 2) != 0 ? 1.0 : -1.0) * body.box_half_m[b] * axes.col(b);
+  }
+  // Spin about n per unit of angular impulse about n, per unit mass: m·(n·I⁻¹·n).
+  const double spin_per_impulse = n.dot(body.inverse_inertia_world * n) / body.inverse_mass_per_kg;
+  // The world's friction is a pyramid (ODE's dContactApprox1): each of two tangent directions bounded by the corner's
+  // share of μ·P on its own, the directions ODE picks for a contact without its own (dPlaneSpace of n).
+  const std::array<Eigen::Vector3d, 2> tangents = ode_tangents(n);
+  Eigen::Vector3d& v = body.velocity_mps;
+  Eigen::Vector3d& w = body.angular_velocity_radps;
+  // Sequential impulses, each corner's accumulated impulse per direction kept within its share of the limit; the
+  // corners in diagonal pairs and the order reversed on alternate passes, so a box that only slides gets no spin from
+  // the order.
+  constexpr std::array<int, 4> kOrder{0, 3, 1, 2};
+  std::array<std::array<double, 2>, 4> accumulated{};
+  const double corner_limit = 0.25 * limit;
+  for (int pass = 0; pass < kContactPasses; ++pass) {
+    for (int i = 0; i < 4; ++i) {
+      const auto c = static_cast<std::size_t>(kOrder[static_cast<std::size_t>(pass % 2 == 0 ? i : 3 - i)]);
+      const Eigen::Vector3d& r = corners[c];
+      for (std::size_t d = 0; d < 2; ++d) {
+        const Eigen::Vector3d& t = tangents[d];
+        const double slip_mps = (v + w.cross(r)).dot(t);
+        const double lever = n.dot(r.cross(t));
+        const double k = 1.0 + spin_per_impulse * lever * lever;  // the corner's inverse mass along t, per unit mass
+        const double total = std::clamp(accumulated[c][d] - slip_mps / k, -corner_limit, corner_limit);
+        const double j = total - accumulated[c][d];
+        accumulated[c][d] = total;
+        v += j * t;
+        w += spin_per_impulse * lever * j * n;
+      }
+    }
+  }
 }
 
 void LocalDynamics::share_with_neighbours(LocalBody& body) {

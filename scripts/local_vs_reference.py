@@ -16,7 +16,7 @@ percentage of the reference's value, and the spread over the phases. --check exi
 within --max-yaw-error of the reference's in every off-centre case and the second cube's travel is within
 --max-travel-error of the reference's in the scene as it is.
 
-usage: local_vs_reference.py [--check] [--out DIR] [--phases N] [--rate HZ] [--jobs N]
+usage: local_vs_reference.py [--check] [--off-centre-only] [--out DIR] [--phases N] [--rate HZ] [--jobs N]
 """
 import argparse
 import json
@@ -66,6 +66,7 @@ def main():
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--quiet", action="store_true", help="no progress bar (it shows only on a terminal anyway)")
     parser.add_argument("--check", action="store_true")
+    parser.add_argument("--off-centre-only", action="store_true", help="run only the off-centre taps (not the two cubes)")
     parser.add_argument("--max-yaw-error", type=float, default=0.10,
                         help="--check: largest |mean yaw - reference yaw| / |reference yaw| of local coupling")
     parser.add_argument("--max-travel-error", type=float, default=0.02,
@@ -83,6 +84,8 @@ def main():
         ("two cubes, no speculative contacts", without_speculative_contacts(args.out), "tap", "cube2", "travel",
          None),
     ]
+    if args.off_centre_only:
+        cases = [case for case in cases if case[0].startswith("off-centre")]
     ticks_per_step = round(HAPTIC_RATE_HZ / args.rate)
     phases = sorted({round(k * ticks_per_step / args.phases) for k in range(args.phases)})
     def trial_dir(index, label, phase):

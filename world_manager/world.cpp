@@ -146,8 +146,12 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
   RenderWindow window;
   window.length_s = known_start ? report.haptic_time_s - endpoint.last_report_time_s : period_s_;
   window.start_s = report.haptic_time_s - window.length_s;
+  if (known_start && report.tick > endpoint.last_report_tick) {
+    window.tick_s = window.length_s / static_cast<double>(report.tick - endpoint.last_report_tick);
+  }
   endpoint.last_report_session = report.haptic_session;
   endpoint.last_report_time_s = report.haptic_time_s;
+  endpoint.last_report_tick = report.tick;
   const std::size_t floor_id = scene_.objects.size();
   const CounterOwner owner{report.haptic_session, report.endpoint};
   std::vector<Eigen::Vector3d>& applied = applied_by_owner_[owner];

@@ -120,6 +120,7 @@ class World {
     // The haptic time of the previous report applied: the impulses of the next one were rendered after it.
     std::uint64_t last_report_session = 0;
     double last_report_time_s = 0.0;
+    std::uint64_t last_report_tick = 0;
   };
 
   void take_finger(Endpoint& endpoint, const HapticReport& report);

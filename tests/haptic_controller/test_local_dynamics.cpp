@@ -12,6 +12,8 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <memory>
 
 using namespace impetus;
 using impetus::test::make_frame;
@@ -98,6 +100,49 @@ TEST_CASE("local dynamics: a cube sliding on the floor loses mu*g*h per world su
   }
   REQUIRE(model.find(1)->velocity_mps.x() == 0.0);
   REQUIRE(last_x > 0.0);
+}
+
+TEST_CASE("local dynamics: a box on the floor brakes its spin at its four corners with the world's friction pyramid, "
+          "and a box that only slides does not turn") {
+  // The 1 kg, 5 cm cube resting on its face (kPlaneBox), floor friction 0.06, for `ticks` ticks (a 5 ms drift substep
+  // starts every 5).
+  auto box_on_floor = [](const Vector3d& velocity_mps, const Vector3d& angular_radps, int ticks) {
+    Plane face = cube_face();
+    face.flags |= kPlaneBox | kPlaneFlat;
+    face.box_axis_x = {1, 0, 0};
+    face.box_axis_y = {0, 1, 0};
+    face.box_half_m = {0.025, 0.025, 0.025};
+    face.velocity_mps = to_vec3(velocity_mps);
+    face.angular_velocity_radps = to_vec3(angular_radps);
+    add_support(face, Vector3d::UnitZ(), 0.06);
+    auto model = std::make_unique<LocalDynamics>();
+    model->on_plane_frame(grounded_frame(face), nullptr, Vector3d::Zero());
+    for (int tick = 1; tick <= ticks; ++tick) model->advance(kTick_s);
+    return model;
+  };
+  const double mu_g_h = 0.06 * 9.81 * 0.005;  // the speed friction takes from a sliding body in one substep
+  SECTION("spinning in place: each corner's friction at its pyramid limit on both axes") {
+    // The first substep, square to the pyramid's axes (x and y, ODE's for a floor): the corners' torque about z is
+    // 4 corners × 2 axes × (μ·m·g/4 per axis) × a lever of a = 2.5 cm, so dω = 2·a·μ·m·g·h / I, I = m·s²/6:
+    // 0.353 rad/s. Without the corners the spin stayed at 6 rad/s.
+    const double inertia_kgm2 = 0.05 * 0.05 / 6.0;
+    const double first_rad_ps = 2 * 0.025 * mu_g_h / inertia_kgm2;
+    CHECK(box_on_floor(Vector3d::Zero(), Vector3d(0, 0, -6), 1)->find(1)->angular_velocity_radps.z() ==
+          Approx(-6.0 + first_rad_ps).epsilon(1e-12));
+    // Then the box turns against the pyramid and its corners' levers along x and y shrink (to 1/√2 at 45°), as in
+    // the world: ten substeps take between 1/√2 and all of ten times the first one's.
+    const auto model = box_on_floor(Vector3d::Zero(), Vector3d(0, 0, -6), 50);
+    const double braked_rad_ps = 6.0 + model->find(1)->angular_velocity_radps.z();
+    CHECK(braked_rad_ps <= 10 * first_rad_ps);
+    CHECK(braked_rad_ps > 10 * first_rad_ps / std::sqrt(2.0));
+    CHECK(model->find(1)->velocity_mps.norm() < 1e-12);  // diagonal corners cancel: it spins in place
+  }
+  SECTION("sliding: μ·g of braking, as at the centre of mass, and no turn") {
+    const auto model = box_on_floor(Vector3d(0.3, 0, 0), Vector3d::Zero(), 50);
+    CHECK(model->find(1)->velocity_mps.x() == Approx(0.3 - 10 * mu_g_h).epsilon(1e-9));
+    CHECK(model->find(1)->velocity_mps.y() == Approx(0.0).margin(1e-9));
+    CHECK(model->find(1)->angular_velocity_radps.norm() < 1e-9);
+  }
 }
 
 TEST_CASE("local dynamics: a support blocks the push (a cube against a wall does not give way)") {

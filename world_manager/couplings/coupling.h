@@ -57,6 +57,7 @@ class AppliedImpulses {
 struct RenderWindow {
   double start_s = 0.0;
   double length_s = 0.0;
+  double tick_s = 0.0;  // the haptic tick's length, each tick's impulse a force over the tick before its time (0: unknown)
 };
 
 // What a coupling works on; owned by the World, valid for the World's lifetime.

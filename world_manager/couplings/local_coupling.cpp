@@ -34,15 +34,29 @@ void LocalCoupling::schedule(std::size_t id, const ImpulseDelta& delta, const Im
   // body may also take some at the window's end, as a velocity change after the last substep.
   const bool touching = context_.engine.contacts().touching(static_cast<std::int32_t>(id));
   const int slot_count = touching ? substeps : substeps + 1;
-  // What friction can hold in one substep: μ·N·h. A push friction could hold, spread evenly over the step, goes in
-  // evenly, its moment of force too: the ramp's centroid may lie near the step's end (one haptic tick per world step:
-  // a 1 kHz world), and there it puts most of the push in one substep, beyond what friction holds there, and most of
-  // its torque, which rocks a box off an edge; a resting object then creeps under a push it should resist. The push's
+  // What friction can hold in one substep: μ·N·h. A push friction could hold over the time it lasted goes in evenly,
+  // its moment of force too: the ramp's centroid may lie near the step's end (one haptic tick per world step: a 1 kHz
+  // world), and there it puts most of the push in one substep, beyond what friction holds there, and most of its
+  // torque, which rocks a box off an edge; a resting object then creeps under a push it should resist. The push's
   // timing shifts by up to one step, which an object friction holds does not show. A push friction cannot hold keeps
   // its exact timing: the object slides anyway.
+  // How long it lasted: each tick's impulse is a force over the tick before its time, so the force's centroid along
+  // the push is half a tick before the impulses' one, and a non-negative force with that centroid spans at most the
+  // slots a ramp about it covers (spread_length). A sharp push at a window's end (a tap's first ticks at a 10 Hz
+  // world) spans a substep or two, not the step: spread evenly, friction would swallow it.
   const double holdable_per_slot_Ns =
       touching ? context_.engine.contacts().friction_capacity_N(static_cast<std::int32_t>(id)) * h : 0.0;
-  const bool even = touching && delta.impulse_Ns.norm() <= holdable_per_slot_Ns * slot_count;
+  bool even = false;
+  if (touching && delta.impulse_Ns.norm() <= holdable_per_slot_Ns * slot_count) {
+    const double squared_Ns2 = delta.impulse_Ns.squaredNorm();
+    const double moment_about_start_Nss =
+        (moment.impulse_Ns - window.start_s * delta.impulse_Ns).dot(delta.impulse_Ns) * scale;
+    const double force_centroid_s =
+        squared_Ns2 > 0.0 ? moment_about_start_Nss / squared_Ns2 - 0.5 * window.tick_s * scale : 0.5 * period_s;
+    const int lasted_slots = std::isfinite(force_centroid_s) ? spread_length(force_centroid_s / h, slot_count)
+                                                             : slot_count;
+    even = delta.impulse_Ns.norm() <= holdable_per_slot_Ns * lasted_slots;
+  }
   auto place = [&](double amount, double first_moment, int axis, std::vector<Eigen::Vector3d>& slots) {
     // Moment about the window's start, mapped onto this step: Σ J_k·c_k with c_k ∈ [0, T_w].
     const double moment_about_start = (first_moment - window.start_s * amount) * scale;

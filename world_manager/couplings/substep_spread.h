@@ -21,6 +21,15 @@
 
 namespace impetus {
 
+// How many slots the spread of an impulse with `centroid` covers: the widest a non-negative ramp with that centroid
+// can be. `slot_count` ≥ 1, `centroid` clamped to [0, slot_count − 1].
+inline int spread_length(double centroid, int slot_count) {
+  const double last = static_cast<double>(slot_count - 1);
+  const double c = std::clamp(centroid, 0.0, last);
+  const double near = std::min(c, last - c);
+  return std::min(slot_count, static_cast<int>(std::floor(3.0 * near + 2.0)));
+}
+
 // Calls add(slot, weight) for each slot of the spread; `slot_count` ≥ 1, `centroid` clamped to [0, slot_count − 1].
 template <typename Add>
 void spread_over_slots(double centroid, int slot_count, Add&& add) {
@@ -28,7 +37,7 @@ void spread_over_slots(double centroid, int slot_count, Add&& add) {
   const double c = std::clamp(centroid, 0.0, last);
   const bool from_end = c > 0.5 * last;  // mirror: measure from the end the centroid is nearer
   const double near = from_end ? last - c : c;
-  const int length = std::min(slot_count, static_cast<int>(std::floor(3.0 * near + 2.0)));
+  const int length = spread_length(c, slot_count);
   if (length <= 1) {
     add(from_end ? slot_count - 1 : 0, 1.0);
     return;
