@@ -3,6 +3,7 @@
 
 #include "common/runtime/csv_line.h"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <stdexcept>
@@ -25,18 +26,24 @@ const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& comma
     throw std::invalid_argument("DeviceSim::tick: dt_s must be in (0, " + std::to_string(kMaxTick_s) + "] s, got " +
                                 std::to_string(dt_s));
   }
-  const int substeps = finger_.substeps_for(dt_s);
-  const double h_s = dt_s / substeps;
   // Motors without lag reach the command at once and hold it (SpidarHardware::apply with a zero time constant): one
-  // application stands for the tick's every sub-step. With lag they approach it sub-step by sub-step.
-  const bool motor_lag = hardware_.params().motor_time_constant_s > 0.0;
+  // application stands for the tick's every sub-step. With lag they approach it sub-step by sub-step, ten to a time
+  // constant, so the force the finger feels follows the tension's rise.
+  const double lag_s = hardware_.params().motor_time_constant_s;
+  const bool motor_lag = lag_s > 0.0;
+  int substeps = finger_.substeps_for(dt_s);
+  if (motor_lag) substeps = std::max(substeps, static_cast<int>(std::ceil(dt_s / (0.1 * lag_s))));
+  const double h_s = dt_s / substeps;
   if (!motor_lag) hardware_.apply(commanded_tension_N, h_s);
   for (int k = 0; k < substeps; ++k) {
     const double t_s = time_s_ + k * h_s;
     if (motor_lag) hardware_.apply(commanded_tension_N, h_s);
     const Eigen::Vector3d force_N = hardware_.force_on_finger(finger_.position_m());
-    const Trajectory::Sample target = trajectory_.sample_at(t_s, segment_hint_);
-    finger_.step(to_eigen(target.position_m), to_eigen(target.velocity_mps), force_N, h_s);
+    // The target over the sub-step as the chord from where it is now to where it will be: the finger's step takes it
+    // as moving in a straight line (Finger::step), and the chord ends the sub-step exactly on the trajectory.
+    const Eigen::Vector3d from_m = to_eigen(trajectory_.sample_at(t_s, segment_hint_).position_m);
+    const Eigen::Vector3d to_m = to_eigen(trajectory_.sample_at(t_s + h_s, segment_hint_).position_m);
+    finger_.step(from_m, (to_m - from_m) / h_s, force_N, h_s);
   }
   time_s_ += dt_s;
   ++state_.tick;

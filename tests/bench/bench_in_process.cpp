@@ -2,7 +2,7 @@
 // Throughput of the in-process loop (loop/in_process_trial.h): the tap trial's world, haptic controller and simulated
 // device on one thread under the lockstep schedule, without logs. Prints ticks per second for the 2 s tap trial and
 // the steady state of a long one (the tap, then a 20 s hold: (long − short) ticks over (long − short) wall time), and
-// what one device tick costs alone (DeviceSim: ten finger sub-steps per tick). Asserts nothing.
+// what one device tick costs alone (DeviceSim: one exact finger step per tick). Asserts nothing.
 //
 //   bench_in_process [SCENE=scenes/tap.json]
 
@@ -14,6 +14,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -41,7 +42,12 @@ double median(std::vector<double> values) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int bench(int argc, char** argv) {
+  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::printf("usage: bench_in_process [SCENE=scenes/tap.json]\nThroughput of the in-process loop on the tap trial, "
+                "without logs, and of the simulated device alone. Asserts nothing.\n");
+    return 0;
+  }
   const std::string scene = argc > 1 ? argv[1] : std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json";
   constexpr int kRuns = 5;
   std::vector<double> short_wall, long_wall;
@@ -71,4 +77,13 @@ int main(int argc, char** argv) {
   std::printf("simulated device alone: %.0f ns a tick (%d ticks; checksum %lld)\n", device_s / kDeviceTicks * 1e9,
               kDeviceTicks, static_cast<long long>(checksum));
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return bench(argc, argv);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "bench_in_process: %s\n", error.what());
+    return 1;
+  }
 }

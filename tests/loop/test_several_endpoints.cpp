@@ -262,13 +262,13 @@ namespace {
 std::string squeeze_path(const std::filesystem::path& dir, const std::string& name, double from_x, double to_x) {
   const std::filesystem::path path = dir / (name + ".csv");
   std::ofstream out(path);
-  out << "t,x,y,z\n0," << from_x << ",0,0.025\n0.5," << to_x << ",0,0.025\n12," << to_x << ",0,0.025\n";
+  out << "t,x,y,z\n0," << from_x << ",0,0.025\n0.5," << to_x << ",0,0.025\n24," << to_x << ",0,0.025\n";
   return path.string();
 }
 
 struct Squeeze {
   double largest_force_N = 0.0;
-  // The largest peak-to-peak of the first finger's force in any whole second of 1–6 s, and of 6–12 s.
+  // The largest peak-to-peak of the first finger's force in any whole second of 1–12 s, and of 12–24 s.
   double early_swing_N = 0.0;
   double late_swing_N = 0.0;
   double cube_moved_m = 0.0;
@@ -312,7 +312,7 @@ Squeeze squeeze(Coupling coupling, bool one_controller) {
   std::ifstream log(dir / "haptic.csv");
   std::string line;
   std::getline(log, line);
-  std::array<double, 12> low{}, high{};
+  std::array<double, 24> low{}, high{};
   low.fill(1e9);
   high.fill(-1e9);
   while (std::getline(log, line)) {
@@ -325,8 +325,8 @@ Squeeze squeeze(Coupling coupling, bool one_controller) {
     low[second] = std::min(low[second], values[8]);
     high[second] = std::max(high[second], values[8]);
   }
-  for (std::size_t second = 1; second < 12; ++second) {
-    double& swing = second < 6 ? out.early_swing_N : out.late_swing_N;
+  for (std::size_t second = 1; second < 23; ++second) {
+    double& swing = second < 12 ? out.early_swing_N : out.late_swing_N;
     swing = std::max(swing, high[second] - low[second]);
   }
   return out;
@@ -342,12 +342,14 @@ TEST_CASE("pinch across users: two controllers squeezing one cube keep bounded f
   for (const Coupling coupling : {Coupling::impulse, Coupling::local}) {
     const Squeeze two = squeeze(coupling, false);
     WARN(to_string(coupling) << " coupling, two users: largest force " << two.largest_force_N << " N, force swing "
-                             << two.early_swing_N << " N (1-6 s) and " << two.late_swing_N << " N (6-12 s), cube moved "
+                             << two.early_swing_N << " N (1-12 s) and " << two.late_swing_N << " N (12-23 s), cube moved "
                              << two.cube_moved_m * 1e3 << " mm");
     CHECK(two.largest_force_N < 5.0);            // about 2 N aimed: no spike
     // Not growing. Under local coupling across users the force settles into a limit cycle whose swing beats between
-    // 0.18 and 0.24 N over about 6 s (measured over 20 s); each half of the run holds a whole beat.
-    CHECK(two.late_swing_N <= two.early_swing_N + 0.01);
+    // about 0.1 and 0.27 N with a period of several seconds; each 11 s half of the run holds whole beats, so a bounded
+    // cycle reaches no more in the second half than in the first, where a growing one would. (Impulse coupling's
+    // cycle is stationary: its halves agree to 1e-5, hence the 0.1 %.)
+    CHECK(two.late_swing_N <= 1.001 * two.early_swing_N);
     CHECK(two.cube_moved_m < 0.005);
     CHECK(two.cube_speed_end_mps < 0.005);       // at rest: no energy gained
     if (coupling == Coupling::local) {
