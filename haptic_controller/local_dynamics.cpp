@@ -178,6 +178,13 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
       }
     }
   }
+  if (body.box_half_m.minCoeff() > 0.0 && body.inverse_mass_per_kg > 0.0) {
+    for (std::uint32_t c = 0; c < body.contact_count; ++c) {
+      if (body.contact_holds[c] && normal_impulse[c] > 0.0) {
+        normal_impulse[c] += hold_box_corners(body, body.contact_normal[c]);
+      }
+    }
+  }
   for (std::uint32_t c = 0; c < body.contact_count; ++c) {
     if (!(normal_impulse[c] > 0.0)) continue;
     const Eigen::Vector3d& n = body.contact_normal[c];
@@ -213,7 +220,7 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
   // in the world far past rolling with the finger, since the model would see its surface still.
 }
 
-void LocalDynamics::apply_box_friction(LocalBody& body, const Eigen::Vector3d& n, double limit) {
+std::array<Eigen::Vector3d, 4> LocalDynamics::support_corners(const LocalBody& body, const Eigen::Vector3d& n) {
   // The face that looks along −n (the support's side), from the box's axes as the model has turned them.
   const Eigen::Matrix3d axes = body.turn.toRotationMatrix() * body.box_axes;
   int down = 0;
@@ -228,6 +235,35 @@ void LocalDynamics::apply_box_friction(LocalBody& body, const Eigen::Vector3d& n
                                            ((c & 1) != 0 ? 1.0 : -1.0) * body.box_half_m[a] * axes.col(a) +
                                            ((c & 2) != 0 ? 1.0 : -1.0) * body.box_half_m[b] * axes.col(b);
   }
+  return corners;
+}
+
+double LocalDynamics::hold_box_corners(LocalBody& body, const Eigen::Vector3d& n) {
+  const std::array<Eigen::Vector3d, 4> corners = support_corners(body, n);
+  const Eigen::Matrix3d spin_per_impulse = body.inverse_inertia_world / body.inverse_mass_per_kg;  // m·I⁻¹
+  Eigen::Vector3d& v = body.velocity_mps;
+  Eigen::Vector3d& w = body.angular_velocity_radps;
+  constexpr std::array<int, 4> kOrder{0, 3, 1, 2};
+  std::array<double, 4> accumulated{};
+  for (int pass = 0; pass < kContactPasses; ++pass) {
+    for (int i = 0; i < 4; ++i) {
+      const auto c = static_cast<std::size_t>(kOrder[static_cast<std::size_t>(pass % 2 == 0 ? i : 3 - i)]);
+      const Eigen::Vector3d& r = corners[c];
+      const double closing_mps = (v + w.cross(r)).dot(n);
+      const Eigen::Vector3d lever = r.cross(n);
+      const double k = 1.0 + lever.dot(spin_per_impulse * lever);  // the corner's inverse mass along n, per unit mass
+      const double total = std::max(0.0, accumulated[c] - closing_mps / k);
+      const double p = total - accumulated[c];
+      accumulated[c] = total;
+      v += p * n;
+      w += spin_per_impulse * (p * lever);
+    }
+  }
+  return accumulated[0] + accumulated[1] + accumulated[2] + accumulated[3];
+}
+
+void LocalDynamics::apply_box_friction(LocalBody& body, const Eigen::Vector3d& n, double limit) {
+  const std::array<Eigen::Vector3d, 4> corners = support_corners(body, n);
   // Spin about n per unit of angular impulse about n, per unit mass: m·(n·I⁻¹·n).
   const double spin_per_impulse = n.dot(body.inverse_inertia_world * n) / body.inverse_mass_per_kg;
   // The world's friction is a pyramid (ODE's dContactApprox1): each of two tangent directions bounded by the corner's

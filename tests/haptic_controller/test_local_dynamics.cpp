@@ -137,6 +137,20 @@ TEST_CASE("local dynamics: a box on the floor brakes its spin at its four corner
     CHECK(braked_rad_ps > 10 * first_rad_ps / std::sqrt(2.0));
     CHECK(model->find(1)->velocity_mps.norm() < 1e-12);  // diagonal corners cancel: it spins in place
   }
+  SECTION("pitching into the floor: the corners that would go in are held, the box pivots on that edge") {
+    // ω about y drives the +x bottom corners down and lifts the −x ones: after the first substep no corner moves into
+    // the floor, and the box turns about its +x bottom edge (the centre of mass rises) instead of through the floor.
+    const auto model = box_on_floor(Vector3d::Zero(), Vector3d(0, 2, 0), 1);
+    const LocalBody& box = *model->find(1);
+    for (const double x : {-0.025, 0.025}) {
+      for (const double y : {-0.025, 0.025}) {
+        const Vector3d corner(x, y, -0.025);
+        CHECK((box.velocity_mps + box.angular_velocity_radps.cross(corner)).z() >= -1e-12);
+      }
+    }
+    CHECK(box.angular_velocity_radps.y() > 0.0);  // it may still tip that way: only the floor is enforced
+    CHECK(box.velocity_mps.z() > 0.0);
+  }
   SECTION("sliding: μ·g of braking, as at the centre of mass, and no turn") {
     const auto model = box_on_floor(Vector3d(0.3, 0, 0), Vector3d::Zero(), 50);
     CHECK(model->find(1)->velocity_mps.x() == Approx(0.3 - 10 * mu_g_h).epsilon(1e-9));

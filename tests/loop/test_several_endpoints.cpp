@@ -345,11 +345,10 @@ TEST_CASE("pinch across users: two controllers squeezing one cube keep bounded f
                              << two.early_swing_N << " N (1-12 s) and " << two.late_swing_N << " N (12-23 s), cube moved "
                              << two.cube_moved_m * 1e3 << " mm");
     CHECK(two.largest_force_N < 5.0);            // about 2 N aimed: no spike
-    // Not growing. Under local coupling across users the force settles into a limit cycle whose swing beats between
-    // about 0.1 and 0.27 N with a period of several seconds; each 11 s half of the run holds whole beats, so a bounded
-    // cycle reaches no more in the second half than in the first, where a growing one would. (Impulse coupling's
-    // cycle is stationary: its halves agree to 1e-5, hence the 0.1 %.)
-    CHECK(two.late_swing_N <= 1.001 * two.early_swing_N);
+    // Not growing: the second 11 s half of the run swings no more than the first, where a growing cycle would.
+    // Impulse coupling settles into a stationary cycle (its halves agree to 1e-5, hence the 0.1 %); local coupling
+    // settles to rest, where a swing under 1 mN is rounding, far below the ~50 mN a fingertip can tell apart.
+    CHECK((two.late_swing_N <= 1.001 * two.early_swing_N || two.late_swing_N < 1e-3));
     CHECK(two.cube_moved_m < 0.005);
     CHECK(two.cube_speed_end_mps < 0.005);       // at rest: no energy gained
     if (coupling == Coupling::local) {
