@@ -6,7 +6,7 @@
 #   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ...) [--user SPEC ...]
 #                  [--coupling impulse|position|local]
 #                  [--rate HZ] [--phase TICKS] [--substeps N]
-#                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet]
+#                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet] [--no-logs]
 #                  [--view [--view-listen HOST:PORT] [--view-wait S]]
 #                  [-- extra haptic_controller flags, e.g. --stiffness 5000]
 # --finger (once per finger, up to 8) runs a several-finger device: one endpoint of the world per finger; logs of
@@ -18,15 +18,17 @@
 # --view-wait S the finger starts S seconds after the world, time to open the page. Afterwards
 # `build/viewer/viewer --replay DIR` plays the trial back.
 #
+# --no-logs writes only the summaries (no CSV logs: for throughput, or sweeps that read summary.json alone).
+#
 # Binaries come from $IMPETUS_BUILD_DIR (default build/); build them with scripts/build.sh.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${IMPETUS_BUILD_DIR:-$root/build}"
 
-usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "run.sh: $*" >&2; exit 2; }
 
-view=0 view_listen="127.0.0.1:8080" view_wait=0
+view=0 view_listen="127.0.0.1:8080" view_wait=0 logs=1
 substeps="" scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
 haptic_extra=()
 fingers=()
@@ -45,6 +47,7 @@ while (($#)); do
     --duration) duration="${2:?}"; shift 2 ;;
     --out) out="${2:?}"; shift 2 ;;
     --quiet) quiet=1; shift ;;
+    --no-logs) logs=0; shift ;;
     --view) view=1; shift ;;
     --view-listen) view_listen="${2:?}"; shift 2 ;;
     --view-wait) view_wait="${2:?}"; shift 2 ;;
@@ -77,13 +80,17 @@ mkdir -p "$out"
 # One shared-memory name per trial, so trials can run in parallel.
 shm="impetus_run_$$_$RANDOM"
 
+# add_log ARRAY NAME: appends the flags of a process's log NAME.csv to ARRAY (nothing under --no-logs).
+add_log() { local -n flags=$1; if ((logs)); then flags+=(--log "$out/$2.csv"); fi; }
 world_args=(--scene "$scene" --coupling "$coupling" --clock "$clock" --phase "$phase" --shm "$shm"
-            --log "$out/world.csv" --summary "$out/world.json")
+            --summary "$out/world.json")
+add_log world_args world
 [ -n "$rate" ] && world_args+=(--rate "$rate")
 [ -n "$substeps" ] && world_args+=(--substeps "$substeps")
-haptic_args=(--clock "$clock" --duration "$duration" --shm "$shm" --log "$out/haptic.csv"
-             --summary "$out/haptic.json" "${haptic_extra[@]}")
-device_args=(--clock "$clock" --shm "$shm" --log "$out/device.csv" --summary "$out/device.json")
+haptic_args=(--clock "$clock" --duration "$duration" --shm "$shm" --summary "$out/haptic.json" "${haptic_extra[@]}")
+add_log haptic_args haptic
+device_args=(--clock "$clock" --shm "$shm" --summary "$out/device.json")
+add_log device_args device
 if ((${#fingers[@]})); then
   haptic_args+=(--fingers "${#fingers[@]}")
   for finger in "${fingers[@]}"; do device_args+=(--finger "$finger"); done
@@ -146,11 +153,15 @@ if ((${#users[@]})); then
     done
   fi
   for ((u = 1; u <= ${#users[@]}; ++u)); do
-    "$build/haptic_controller/haptic_controller" --clock "$clock" --duration "$duration" --shm "${shm}_u$u" \
-      --world-shm "$shm" --log "$out/user$u.haptic.csv" --summary "$out/user$u.haptic.json" "${haptic_extra[@]}" \
-      2>"$out/user$u.haptic.err" & user_haptics+=($!); pids+=($!)
-    "$build/spidar_sim/spidar_sim" --clock "$clock" --shm "${shm}_u$u" --trajectory "${users[u - 1]}" \
-      --log "$out/user$u.device.csv" --summary "$out/user$u.device.json" 2>"$out/user$u.device.err" &
+    user_haptic_args=(--clock "$clock" --duration "$duration" --shm "${shm}_u$u" --world-shm "$shm"
+                      --summary "$out/user$u.haptic.json" "${haptic_extra[@]}")
+    add_log user_haptic_args "user$u.haptic"
+    user_device_args=(--clock "$clock" --shm "${shm}_u$u" --trajectory "${users[u - 1]}"
+                      --summary "$out/user$u.device.json")
+    add_log user_device_args "user$u.device"
+    "$build/haptic_controller/haptic_controller" "${user_haptic_args[@]}" 2>"$out/user$u.haptic.err" &
+    user_haptics+=($!); pids+=($!)
+    "$build/spidar_sim/spidar_sim" "${user_device_args[@]}" 2>"$out/user$u.device.err" &
     user_devices+=($!); pids+=($!)
   done
 fi

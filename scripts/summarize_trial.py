@@ -57,7 +57,8 @@ def main():
           f"{h['lateness_max_ns'] / 1e3:.0f} µs")
     print(f"  world:  {w['steps']} steps, {w['time_s']:.3f} s simulated, skipped periods {w['skipped_periods']}, "
           f"rejected reports {w['rejected_reports']}")
-    print(f"  wall time {config.get('wall_time_s', 0):.2f} s; logs and summary.json in {args.dir}")
+    written = "logs and summary.json" if any(pathlib.Path(args.dir).glob("*.csv")) else "summary.json (no logs)"
+    print(f"  wall time {config.get('wall_time_s', 0):.2f} s; {written} in {args.dir}")
 
 
 if __name__ == "__main__":

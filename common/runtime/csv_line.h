@@ -71,7 +71,7 @@ class CsvLine {
   }
 
   std::ostream& out_;
-  std::array<char, 4096> buffer_{};
+  std::array<char, 4096> buffer_;  // not cleared: only the first size_ characters are ever read
   std::size_t size_ = 0;
   bool first_ = true;
   bool newline_ = true;

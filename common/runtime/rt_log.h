@@ -39,7 +39,10 @@ class RtLog {
   // `program` names the writer in the message of a failed write.
   RtLog(const std::string& path, const std::string& header, Formatter format, std::size_t capacity,
         LogOverflow overflow, const std::string& program = "log")
-      : file_(path), format_(std::move(format)), rows_(capacity), overflow_(overflow), watch_(program, path) {
+      : file_buffer_(std::make_unique<char[]>(kFileBufferBytes)), format_(std::move(format)), rows_(capacity),
+        overflow_(overflow), watch_(program, path) {
+    file_.rdbuf()->pubsetbuf(file_buffer_.get(), kFileBufferBytes);  // before open(), where it takes effect
+    file_.open(path);
     if (!file_) throw std::runtime_error("cannot open log file '" + path + "' for writing");
     file_ << header << '\n';
     drainer_ = std::thread([this] { drain_loop(); });
@@ -134,6 +137,11 @@ class RtLog {
     }
   }
 
+  // The file's buffer: a lockstep run formats hundreds of thousands of rows a second, and the stream's default 8 KB
+  // makes a write system call every ~30 rows (a third of a row's cost here). The drain thread still flushes every
+  // 2 ms, so a real-time log is no later on disk than before.
+  static constexpr std::size_t kFileBufferBytes = std::size_t{1} << 20;
+  std::unique_ptr<char[]> file_buffer_;  // outlives file_ (declared first)
   std::ofstream file_;
   Formatter format_;
   std::vector<Row> rows_;

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
 
 namespace impetus {
 
@@ -19,6 +20,27 @@ TEST_CASE("the same lockstep tap trial twice gives byte-identical logs") {
     CHECK(a.size() > 1000);
     CHECK(a == test::read_text(second.dir / log));
   }
+}
+
+// Logs are written by each process on the side (rt_log.h): leaving them out must not change the trial.
+TEST_CASE("run.sh --no-logs writes no CSV and the same trial: every object's final state and every total as with "
+          "logs") {
+  const std::string arguments = "--scene scenes/tap.json --trajectory tap --phase 13";
+  const test::Trial logged = test::run_trial("logs-on", arguments);
+  const test::Trial bare = test::run_trial("logs-off", arguments + " --no-logs");
+  REQUIRE(logged.exit_status == 0);
+  REQUIRE(bare.exit_status == 0);
+  CHECK(std::filesystem::exists(logged.dir / "haptic.csv"));
+  for (const auto& entry : std::filesystem::directory_iterator(bare.dir)) {
+    INFO(entry.path());
+    CHECK(entry.path().extension() != ".csv");
+  }
+  CHECK(logged.summary["objects"].dump() == bare.summary["objects"].dump());
+  CHECK(logged.summary["world"]["steps"] == bare.summary["world"]["steps"]);
+  CHECK(logged.summary["haptic"]["ticks"] == bare.summary["haptic"]["ticks"]);
+  const auto rendered_Ns = [](const test::Trial& trial) { return trial.summary["haptic"]["impulse_by_object_Ns"]; };
+  CHECK(rendered_Ns(logged).dump() == rendered_Ns(bare).dump());
+  CHECK(logged.summary["haptic"]["max_force_N"] == bare.summary["haptic"]["max_force_N"]);
 }
 
 TEST_CASE("impulse applied by the world equals impulse rendered by the haptic controller in a tap trial") {
