@@ -57,6 +57,13 @@ double interpolation_weight(double now_s, double frame_arrival_s, double world_p
 
 void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, double w,
                         const Eigen::Vector3d& pivot_m, PlaneSet& out) {
+  PlaneMatches matches;
+  match_planes(previous, current, matches);
+  interpolate_planes(previous, current, matches, w, pivot_m, out);
+}
+
+void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, const PlaneMatches& matches, double w,
+                        const Eigen::Vector3d& pivot_m, PlaneSet& out) {
   w = std::isfinite(w) ? std::clamp(w, 0.0, 1.0) : 1.0;
   const std::uint32_t count = std::min(current.plane_count, kMaxPlanes);
   out.count = count;
@@ -65,7 +72,7 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, d
     ContactPlane& plane = out.planes[k];
     plane = to_contact_plane(now);  // velocities, friction, flags: frame i's
 
-    const int match = find_plane(previous, now.object_id, occurrence_of(current, k));
+    const int match = matches.previous_index[k];
     if (match < 0) continue;  // new object: starts at frame i's value
     const Plane& before = previous.planes[match];
     // A box or capsule in both frames: its axes turn between them (the same body's: they correspond one to one).
@@ -122,10 +129,11 @@ void InterpolatedPlanes::on_frame(const PlaneFrame& previous, const PlaneFrame& 
                                   const Eigen::Vector3d&) {
   copy_used(previous, previous_);
   copy_used(frame, current_);
+  match_planes(previous_, current_, matches_);
 }
 
 void InterpolatedPlanes::planes_for_tick(double w, double, bool, const Eigen::Vector3d& pivot_m, PlaneSet& out) {
-  interpolate_planes(previous_, current_, w, pivot_m, out);
+  interpolate_planes(previous_, current_, matches_, w, pivot_m, out);
 }
 
 }  // namespace impetus

@@ -27,6 +27,7 @@
 
 #include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
+#include "haptic_controller/plane_matching.h"
 
 namespace impetus {
 
@@ -37,5 +38,9 @@ double interpolation_weight(double now_s, double frame_arrival_s, double world_p
 // `previous` may be the same object as `current` (first frame of a session). Allocation-free.
 void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, double w, const Eigen::Vector3d& pivot_m,
                         PlaneSet& out);
+// The same with the frames' planes already matched (match_planes(previous, current), plane_matching.h): a servo that
+// interpolates the same two frames every tick of a period pairs their planes once.
+void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, const PlaneMatches& matches, double w,
+                        const Eigen::Vector3d& pivot_m, PlaneSet& out);
 
 }  // namespace impetus

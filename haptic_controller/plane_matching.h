@@ -9,6 +9,7 @@
 #include "haptic_controller/contact_plane.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 
 namespace impetus {
@@ -32,6 +33,20 @@ int find_plane(const Planes& set, std::int32_t object_id, int occurrence) {
     if (set.planes[k].object_id == object_id && occurrence-- == 0) return static_cast<int>(k);
   }
   return -1;
+}
+
+// For each plane k of `current`, the index of the same plane in `previous` ((object_id, occurrence) as above), or −1:
+// what interpolation needs every tick, found once per pair of frames.
+struct PlaneMatches {
+  std::array<std::int16_t, kMaxPlanes> previous_index{};
+};
+template <class Planes>
+void match_planes(const Planes& previous, const Planes& current, PlaneMatches& out) {
+  const std::uint32_t count = plane_count(current);
+  for (std::uint32_t k = 0; k < count; ++k) {
+    out.previous_index[k] =
+        static_cast<std::int16_t>(find_plane(previous, current.planes[k].object_id, occurrence_of(current, k)));
+  }
 }
 
 // The flip rule of interpolation (plane_interpolator.h): two normals more than 90° apart (cos < 0) are not blended,

@@ -11,6 +11,7 @@
 #include "common/contract/frames.h"
 #include "haptic_controller/contact_plane.h"
 #include "haptic_controller/impulse_accumulator.h"
+#include "haptic_controller/plane_matching.h"
 #include "haptic_controller/proxy_projection.h"
 
 #include <Eigen/Core>
@@ -48,6 +49,7 @@ class InterpolatedPlanes final : public PlaneMotion {
  private:
   PlaneFrame previous_{};
   PlaneFrame current_{};
+  PlaneMatches matches_{};  // current_'s planes in previous_, paired once per frame
 };
 
 }  // namespace impetus

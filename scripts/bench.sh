@@ -48,6 +48,21 @@ bench() {
 
 section "1. Haptic tick cost vs number of planes (ns)"
 bench bench_haptic_tick
+# Instructions do not depend on the machine's load: count those of the servo and its SPIDAR driver per tick (the
+# finger's kinematics, the frame's intake every 50 ticks, the servo's tick, the tensions and the command).
+if command -v valgrind >/dev/null && [ -x "$build/tests/bench_haptic_tick" ]; then
+  for planes in 1 16; do
+    valgrind --tool=callgrind --callgrind-out-file="$tmp/callgrind.$planes" \
+      --toggle-collect='impetus::SpidarDriver::read*' --toggle-collect='impetus::HapticServo::tick*' \
+      --toggle-collect='impetus::SpidarDriver::command*' --toggle-collect='impetus::HapticServo::on_plane_frame*' \
+      "$build/tests/bench_haptic_tick" --planes "$planes" >/dev/null 2>&1
+    instructions=$(sed -n 's/^totals: *//p' "$tmp/callgrind.$planes")
+    echo "planes $planes: $((instructions / 20000)) instructions a tick (callgrind, 20000 ticks; goal: 5 k at 1 plane," \
+         "15 k at 16)"
+  done
+else
+  echo "(instruction counts skipped: valgrind is missing; scripts/deps.sh installs it)"
+fi
 
 section "2. World step and feature query vs number of objects; physics in the 1 kHz loop vs the 20 Hz world; sleeping"
 bench bench_world "${world_args[@]}"

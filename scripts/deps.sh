@@ -15,7 +15,8 @@ IMPETUS_PACKAGES=(cmake g++ make pkg-config libeigen3-dev libode-dev libboost-de
                   cyclonedds-dev cyclonedds-tools  # the world link over DDS (common/link/dds; idlc)
                   iproute2  # network namespaces: the DDS tests' and benchmark's two hosts
                   curl  # the install test fetches the installed viewer's page
-                  time)  # /usr/bin/time: each process's peak RSS in scripts/bench.sh
+                  time  # /usr/bin/time: each process's peak RSS in scripts/bench.sh
+                  valgrind)  # callgrind: the haptic tick's instruction counts in scripts/bench.sh
 # The viewer's page comes from the npm registry; a machine without Node.js gets Debian's.
 command -v npm >/dev/null || IMPETUS_PACKAGES+=(nodejs npm)
 ((browser)) && IMPETUS_PACKAGES+=(chromium fonts-liberation)  # headless, driven by Playwright in tests/viewer; a font for the page's text

@@ -2,13 +2,15 @@
 // Tick cost of the haptic servo with its SPIDAR driver (kinematics + interpolation + proxy + force + accumulation +
 // tensions) against the number of planes in the world frame: p50 / p99 in ns. Then the cost of one controller tick
 // with 1, 2, 4 and 8 endpoints (a SPIDAR string set, port and servo per finger, 4 planes each, the pushes exchanged
-// among them). Prints only; no assertions.
+// among them). Prints only; no assertions. `--planes N` runs only the plane sweep's N (for counting instructions).
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 #include <memory>
 #include <vector>
 
@@ -151,7 +153,21 @@ void run_endpoints(int endpoints) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  // --planes N: only the plane sweep's N (scripts/bench.sh counts its instructions under callgrind).
+  if (argc == 3 && std::string(argv[1]) == "--planes") {
+    const int planes = std::atoi(argv[2]);
+    if (planes < 1 || planes > static_cast<int>(kMaxPlanes)) {
+      std::fprintf(stderr, "bench_haptic_tick: --planes must be 1 to %u, not '%s'\n", kMaxPlanes, argv[2]);
+      return 2;
+    }
+    run(planes);
+    return 0;
+  }
+  if (argc != 1) {
+    std::fprintf(stderr, "usage: bench_haptic_tick [--planes N]\n");
+    return argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") ? 0 : 2;
+  }
   for (const int planes : {1, 4, 16, 64}) run(planes);
   for (const int endpoints : {1, 2, 4, 8}) run_endpoints(endpoints);
   return 0;
