@@ -644,6 +644,8 @@ CASES = [
      "c12d_pushed_into_finger.csv", None, check_arrival_no_pass),
     ("14", "grasp and lift: two fingers, 0.2 kg cube", "c14_grasp_lift.json",
      {"thumb": "c14_grasp_thumb.csv", "index": "c14_grasp_index.csv"}, None, check_grasp_lift),
+    ("14b", "grasp and lift at a 200 Hz world (omega T = 0.7)", "c14b_grasp_lift_200hz.json",
+     {"thumb": "c14_grasp_thumb.csv", "index": "c14_grasp_index.csv"}, None, check_grasp_lift),
 ]
 
 
