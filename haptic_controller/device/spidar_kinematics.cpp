@@ -44,7 +44,7 @@ bool SpidarKinematics::finger_position(const StringLengths& lengths_m, Eigen::Ve
   Eigen::Vector3d x = difference_inverse_ * rhs;
 
   // Gauss–Newton on r_i = |x − m_i| − l_i over all four strings: JᵀJ·δ = Jᵀr with the rows u_i = (x − m_i)/|x − m_i|.
-  // JᵀJ is symmetric, so δ = adj(JᵀJ)·Jᵀr / det from its six cofactors: 1.7× faster than a general 3×3 inverse.
+  // JᵀJ is symmetric, so δ = adj(JᵀJ)·Jᵀr / det from its six cofactors: fewer operations than a general 3×3 inverse.
   for (int step = 0; step < kGaussNewtonSteps; ++step) {
     double a00 = 0.0, a01 = 0.0, a02 = 0.0, a11 = 0.0, a12 = 0.0, a22 = 0.0;  // JᵀJ
     double b0 = 0.0, b1 = 0.0, b2 = 0.0;                                      // Jᵀr
