@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# Regenerates the figures and tables the README shows (docs/*.png, docs/*.md) from real lockstep runs.
+# Regenerates the figures and tables docs/results.md shows (docs/*.png, docs/*.md) from real lockstep runs.
 #   scripts/make_figures.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
