@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Force rendering (paper §3.3, DESIGN.md §1 haptic tick step 4): the spring–damper between proxy D and finger C,
+// Force rendering (paper §3.3, docs/architecture.md §1.2 step 4): the spring–damper between proxy D and finger C,
 //     f_j = k_p (D_j − C_j) + k_d ((D_j − C_j) − (D_{j−1} − C_{j−1})) / Δt      (paper §3.3)
 // with Δt the real elapsed time of this tick, with its part along D − C kept non-negative (a contact pushes, it never
 // pulls: the damper brakes an approach but does not drag the finger after a surface that lets go), then clamped in

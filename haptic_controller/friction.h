@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Friction on the proxy (paper §6.2, DESIGN.md §1 haptic tick step 3).
+// Friction on the proxy (paper §6.2, docs/architecture.md §1.2 step 3).
 //
 // The proxy sticks to a material point of the touched object (the anchor), which moves with the object's velocity as
 // sent by the world, v + ω × (anchor − com), while the spring force k(D − C) stays inside the static cone

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The god-object (Zilles & Salisbury; paper §3.3, DESIGN.md §1 haptic tick step 3): the proxy D_j, the point that
+// The god-object (Zilles & Salisbury; paper §3.3, docs/architecture.md §1.2 step 3): the proxy D_j, the point that
 // represents the finger on the surface, outside every interpolated plane, with friction (paper §6.2).
 //
 // GodObject::solve = project_outside_planes (the frictionless proxy and the contact's multipliers) followed by
@@ -41,9 +41,6 @@ class GodObject {
   // planes disarms those of resting objects that both this starting position and the current finger are behind —
   // the finger was inside from the start, not driven in while the first world frame was on its way.
   void begin_finger_session(const Eigen::Vector3d& finger_m);
-
-  // Planes currently disarmed because the finger started behind them.
-  int disarmed_count() const { return disarmed_count_; }
 
   const GodObjectResult& result() const { return result_; }
 

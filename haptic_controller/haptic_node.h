@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The haptic node (DESIGN.md §1.3): the 1 kHz servo on its schedule. Each tick: the finger from the device, the
-// world's newest frame from the world link, HapticServo::tick, the force back to the device, the report to the world,
-// a log row into the real-time ring. Real time: its own clock, and a supervisor thread that does what the
-// servo loop must not (re-attaching to a restarted world). Lockstep: the master; the device advances once per tick
-// and the world steps at tick i·n + phase (common/runtime/lockstep_schedule.h).
+// The haptic node (docs/architecture.md §1.3): the 1 kHz servo on its schedule. Each tick: the finger from the device,
+// the world's newest frame from the world link, HapticServo::tick, the force back to the device, the report to the
+// world, a log row into the real-time ring. Real time: its own clock, and a supervisor thread that does what the servo
+// loop must not (re-attaching to a restarted world). Lockstep: the master; the device advances once per tick and the
+// world steps at tick i·n + phase (common/runtime/lockstep_schedule.h).
 //
-// Owns the servo, its log and statistics; its summary is the haptic half of summary.json (DESIGN.md §4).
+// Owns the servo, its log and statistics; its summary is the haptic half of summary.json (docs/architecture.md §4).
 
 #include "common/link/inproc/inproc_world_link.h"
 #include "common/link/world_link.h"

@@ -150,7 +150,7 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     }
     add_to(entry->impulse_Ns, impulse_Ns);
     add_to(entry->angular_impulse_Nms, angular_Nms);
-    // First moments in time (link_types.h ObjectImpulse): where in the world period this impulse belongs.
+    // First moments in time (common/contract/frames.h ObjectImpulse): where in the world period this impulse belongs.
     add_to(entry->impulse_moment_Nss, impulse_Ns * report_.haptic_time_s);
     add_to(entry->angular_impulse_moment_Nmss, angular_Nms * report_.haptic_time_s);
     entry->last_tick = tick;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Impulse integration (paper §3.4, DESIGN.md §1 haptic tick step 5): the user's force on the world is the reaction
+// Impulse integration (paper §3.4, docs/architecture.md §1.2 step 5): the user's force on the world is the reaction
 // −f_j of the force rendered on the finger. Each tick it is shared among the active constraints: each plane takes
 // the part of the reaction along its own normal (least squares over the active normals, pushes only), and what lies
 // in no normal (friction along the surface) is shared in proportion to the multipliers (the normal load each plane
@@ -16,14 +16,14 @@
 // rather than the paper's single F_i at one point p_i. Planes without kPlaneDynamic (floor, fixed objects) feed
 // report.static_impulse_Ns.
 //
-// The report holds running totals (ObjectImpulse in common/link_types.h). When all kMaxImpulseEntries entries are in
-// use, an entry whose last_tick ≤ the world's report_tick_applied (for this haptic session) is final — the world has
+// The report holds running totals (ObjectImpulse in common/contract/frames.h). When all kMaxImpulseEntries entries are
+// in use, an entry whose last_tick ≤ the world's report_tick_applied (for this haptic session) is final — the world has
 // applied all of it — and is reused for the new object with a new epoch (a session-wide counter, so an object's epoch
 // changes at every re-allocation). If no entry is final the share is kept in a dropped total and counted; nothing
 // throws or allocates.
 //
-// The totals count against one world session (report().world_session, DESIGN.md §6: impulse rendered == impulse
-// applied across a restart of either side). A frame of another world session — a restarted world — starts them
+// The totals count against one world session (report().world_session, docs/architecture.md §6: impulse rendered ==
+// impulse applied across a restart of either side). A frame of another world session — a restarted world — starts them
 // afresh: every entry and the static total are moved to the abandoned total, so the new world, which starts from its
 // scene, is given only what is rendered against its own frames. Invariant:
 //     Σ entries + static + evicted + dropped + abandoned == Σ −f·Δt rendered.

@@ -63,7 +63,7 @@ double LocalDynamics::yield_scale(const PlaneSet& planes, const ProxySolution& c
     // anchor feels through the surface velocity (a 3 g ball pushed tangentially at its surface gives way 3.5× more
     // than pushed through its centre).
     const ContactPlane& plane = planes.planes[static_cast<std::size_t>(index)];
-    const Eigen::Vector3d turning = plane.sphere() ? Eigen::Vector3d(direction - direction.dot(plane.normal) * plane.normal)
+    const Eigen::Vector3d turning = plane.shape_traits().round ? Eigen::Vector3d(direction - direction.dot(plane.normal) * plane.normal)
                                                    : direction;  // the part of the push that turns the body
     const Eigen::Vector3d arm = (contact.proxy_m - body->com_m()).cross(turning);
     inverse_mass_per_kg += share * (body->inverse_mass_per_kg + arm.dot(body->inverse_inertia_world * arm));
@@ -97,7 +97,7 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
   for (std::uint32_t k = 0; k < plane_count_; ++k) {
     const Plane& plane = frame_.planes[k];
     body_of_plane_[k] = -1;
-    // Without a response model the object is immovable between world steps (link_types.h): rendered at the frame.
+    // No response model (common/contract/frames.h): the object is immovable between world steps, rendered at the frame.
     if ((plane.flags & kPlaneDynamic) == 0 || !(plane.inverse_mass_per_kg > 0.0)) continue;
     int index = -1;
     for (std::uint32_t b = 0; b < body_count_; ++b) {
@@ -116,13 +116,15 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
       body.velocity_mps = to_eigen(plane.velocity_mps);
       body.angular_velocity_radps = to_eigen(plane.angular_velocity_radps);
       body.contact_count = std::min(plane.local_contact_count, kMaxLocalContacts);
-      body.sphere_radius_m = (plane.flags & kPlaneSphere) != 0 && plane.extent_m > 0.0 ? plane.extent_m : 0.0;
-      body.turns = (plane.flags & kPlaneFlat) != 0;
-      body.turns_shape = (plane.flags & (kPlaneCapsule | kPlaneCylinder)) != 0;
-      if ((plane.flags & kPlaneBox) != 0) {
-        const Eigen::Vector3d x = to_eigen(plane.box_axis_x), y = to_eigen(plane.box_axis_y);
-        body.box_axes << x, y, x.cross(y);
-        body.box_half_m = to_eigen(plane.box_half_m);
+      const ShapeTraits& shape = traits(plane.shape.kind);
+      body.shape = plane.shape;
+      body.sphere_radius_m = shape.round ? plane.shape.radius_m : 0.0;
+      body.turns = shape.flat_faces;
+      body.turns_shape = shape.carries_axes && !shape.flat_faces;
+      body.rests_on_corners = shape.flat_faces;
+      if (shape.carries_axes) {
+        const Eigen::Vector3d x = to_eigen(plane.body_axis_x), y = to_eigen(plane.body_axis_y);
+        body.axes << x, y, x.cross(y);
       }
       for (std::uint32_t c = 0; c < body.contact_count; ++c) {
         body.contact_normal[c] = to_eigen(plane.local_contacts[c].normal);
@@ -178,7 +180,7 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
       }
     }
   }
-  if (body.box_half_m.minCoeff() > 0.0 && body.inverse_mass_per_kg > 0.0) {
+  if (body.rests_on_corners && body.inverse_mass_per_kg > 0.0) {
     for (std::uint32_t c = 0; c < body.contact_count; ++c) {
       if (body.contact_holds[c] && normal_impulse[c] > 0.0) {
         normal_impulse[c] += hold_box_corners(body, body.contact_normal[c]);
@@ -206,7 +208,7 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
       w += spin_per_impulse * lever.cross(j);
       continue;
     }
-    if (body.box_half_m.minCoeff() > 0.0 && body.inverse_mass_per_kg > 0.0) {
+    if (body.rests_on_corners && body.inverse_mass_per_kg > 0.0) {
       apply_box_friction(body, n, limit);
       continue;
     }
@@ -221,20 +223,9 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
 }
 
 std::array<Eigen::Vector3d, 4> LocalDynamics::support_corners(const LocalBody& body, const Eigen::Vector3d& n) {
-  // The face that looks along −n (the support's side), from the box's axes as the model has turned them.
-  const Eigen::Matrix3d axes = body.turn.toRotationMatrix() * body.box_axes;
-  int down = 0;
-  for (int k = 1; k < 3; ++k) {
-    if (std::fabs(axes.col(k).dot(n)) > std::fabs(axes.col(down).dot(n))) down = k;
-  }
-  const double side = axes.col(down).dot(n) > 0.0 ? -1.0 : 1.0;
-  const int a = (down + 1) % 3, b = (down + 2) % 3;
+  // From the body's axes as the model has turned them.
   std::array<Eigen::Vector3d, 4> corners;
-  for (int c = 0; c < 4; ++c) {
-    corners[static_cast<std::size_t>(c)] = side * body.box_half_m[down] * axes.col(down) +
-                                           ((c & 1) != 0 ? 1.0 : -1.0) * body.box_half_m[a] * axes.col(a) +
-                                           ((c & 2) != 0 ? 1.0 : -1.0) * body.box_half_m[b] * axes.col(b);
-  }
+  impetus::support_corners(body.shape, body.turn.toRotationMatrix() * body.axes, n, corners);
   return corners;
 }
 
@@ -395,7 +386,7 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
       plane.normal = body->carry_normal(normal);  // turned for a flat face only: see the header
       plane.com_m = body->com_m();
       // A shape travels with its plane: its centre is the CoM, its axes turn with the body (shape_planes.h).
-      for (int axis = 0; axis < 3; ++axis) plane.box_axes.col(axis) = body->carry_axis(plane.box_axes.col(axis));
+      for (int axis = 0; axis < 3; ++axis) plane.axes.col(axis) = body->carry_axis(plane.axes.col(axis));
       plane.velocity_mps = body->velocity_mps;
       plane.angular_velocity_radps = body->angular_velocity_radps;
     } else {

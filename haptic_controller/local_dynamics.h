@@ -7,7 +7,7 @@
 // receives more momentum than it would at 1 kHz and overshoots. Here the haptic controller "calculates some part of
 // the motion of the solid object" (§6.3): every dynamic object in the frame is a rigid body of the frame's state
 // (centre of mass, velocity, angular velocity, inverse mass and world inverse inertia) with the contacts the world saw
-// (link_types.h LocalContact), integrated at the haptic rate from the impulse rendered so far:
+// (LocalContact in common/contract/frames.h), integrated at the haptic rate from the impulse rendered so far:
 //
 //   at the start of each world substep h (frame.world_substep_s; every tick if unknown), the drift over h, on the
 //   same grid and with the same symplectic Euler as ODE, so a sliding object ends the period where the world puts it
@@ -53,7 +53,7 @@
 //
 // Curved planes translate, they do not rotate. A plane is §3.1's first-order picture of the surface at the nearest
 // point p to the finger; it holds near p only. Carrying it rigidly about the CoM (x ↦ com + u + R·(x − com), n ↦ R·n)
-// is right for a flat face, and a box's faces (kPlaneFlat) are carried so, R the model's turn since the frame from ω:
+// is right for a flat face, and a box's faces (ShapeTraits::flat_faces) are carried so, R the model's turn since the frame from ω:
 // an off-centre push turns the face away from the finger as in the world, where a face held square would take the
 // push too long and over-spin the box. It is not right for a curved surface: a sphere's surface does not move when it
 // spins, yet its rotated tangent plane sweeps the finger's position at ω·L, L = the finger's distance from p along the
@@ -64,8 +64,8 @@
 // rotation within a period is not lost: the world integrates the angular impulses, and its next frame brings the
 // rotated face, blended in like §3.2's interpolation (the lag impulse coupling has for every plane). ω is still
 // integrated: it gives the surface velocity friction sees (a sphere's plane is taken again at the proxy each tick
-// instead, shape_planes.h). A capsule's or a cylinder's axes turn with it (their ends move when they spin), and their
-// planes are taken again from the turned shape.
+// instead, shape_planes.h). The axes of a curved body that carries them turn with it (its ends move when it spins),
+// and its planes are taken again from the turned shape.
 //
 // Which way a wrong model errs. A model that gives way *less* than the world (a neighbour taken as immovable, a turn
 // it stopped) has the finger press a plane that does not yield, and the world then hands the object momentum the
@@ -117,17 +117,18 @@ struct LocalBody {
   std::array<Eigen::Vector3d, kMaxLocalContacts> neighbour_velocity_mps{};
   std::array<double, kMaxLocalContacts> neighbour_inverse_mass_per_kg{};
   std::uint32_t contact_count = 0;
-  double sphere_radius_m = 0.0;  // > 0 for a sphere (kPlaneSphere): its supports touch it at com − r·n
-  // A box (kPlaneBox): its axes at the frame (columns, world frame) and half sizes; its supports touch it at the four
-  // corners of the face that looks along −n, as the world's contacts do. Zero half sizes: not a box.
-  Eigen::Matrix3d box_axes = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d box_half_m = Eigen::Vector3d::Zero();
+  double sphere_radius_m = 0.0;  // > 0 for a ball (ShapeTraits::round): its supports touch it at com − r·n
+  // Its shape and its axes at the frame (columns, world frame). A flat-faced body's supports touch it at the four
+  // corners of the face that looks along −n (common/shape/shape.h support_corners), as the world's contacts do.
+  Shape shape;
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+  bool rests_on_corners = false;
   bool touched = false;       // the finger pushed it in the last tick
   Eigen::Vector3d pushed_Ns = Eigen::Vector3d::Zero();  // Σ J since the frame (diagnostics, tests)
 
-  bool turns = false;  // its planes are flat faces (kPlaneFlat): they turn with it (header)
-  // Its planes carry a capsule's or a cylinder's axes (shape_planes.h): the axes turn with it, the planes do not (they
-  // are taken again from the turned shape at the proxy every tick). An end of a spinning 3 cm cylinder moves 1 mm in
+  bool turns = false;  // its planes are flat faces (ShapeTraits::flat_faces): they turn with it (header)
+  // Its planes carry the axes of a curved body (shape_planes.h): the axes turn with it, the planes do not (they are
+  // taken again from the turned shape at the proxy every tick). An end of a spinning 3 cm cylinder moves 1 mm in
   // 0.1 rad, what a 10 Hz period of 1 rad/s turns it, and a shape held square would leave it there.
   bool turns_shape = false;
   Eigen::Quaterniond turn = Eigen::Quaterniond::Identity();  // R, the model's rotation since the frame (turning bodies)
@@ -141,7 +142,7 @@ struct LocalBody {
   Eigen::Vector3d carry_normal(const Eigen::Vector3d& normal) const {
     return turns ? Eigen::Vector3d(turn * normal) : normal;
   }
-  // Where the model has turned an axis of the body's shape (a box's, a capsule's, a cylinder's).
+  // Where the model has turned an axis of the body's shape.
   Eigen::Vector3d carry_axis(const Eigen::Vector3d& axis) const {
     return turns || turns_shape ? Eigen::Vector3d(turn * axis) : axis;
   }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// haptic_controller: the 1 kHz haptic servo (DESIGN.md §1.2). Parses the flags, creates the device port, opens the
-// world link and runs a HapticNode on them; writes the haptic half of summary.json at exit.
+// haptic_controller: the 1 kHz haptic servo (docs/architecture.md §1.2). Parses the flags, creates the device port,
+// opens the world link and runs a HapticNode on them; writes the haptic half of summary.json at exit.
 
 #include "common/link/dds/dds_world_link.h"
 #include "common/link/shm/shm_device_port.h"

@@ -14,16 +14,16 @@ Eigen::Vector3d lerp(const Vec3& from, const Vec3& to, double w) {
   return (1.0 - w) * to_eigen(from) + w * to_eigen(to);
 }
 
-// A box's axes between frames i−1 and i: its body axes, turned part of the way (the same body's in both frames, so
-// they correspond one to one). A turn too large to interpolate (half a revolution in a period) takes frame i's.
-void interpolate_box_axes(const Plane& before, const Plane& now, double w, ContactPlane& plane) {
-  const Eigen::Vector3d x = lerp(before.box_axis_x, now.box_axis_x, w);
-  const Eigen::Vector3d y = lerp(before.box_axis_y, now.box_axis_y, w);
+// A body's axes between frames i−1 and i: turned part of the way (the same body's in both frames, so they correspond
+// one to one). A turn too large to interpolate (half a revolution in a period) takes frame i's.
+void interpolate_axes(const Plane& before, const Plane& now, double w, ContactPlane& plane) {
+  const Eigen::Vector3d x = lerp(before.body_axis_x, now.body_axis_x, w);
+  const Eigen::Vector3d y = lerp(before.body_axis_y, now.body_axis_y, w);
   const Eigen::Vector3d y_across = y - y.dot(x) / x.squaredNorm() * x;
   if (!(x.norm() > 0.5) || !(y_across.norm() > 0.5)) return;
   const Eigen::Vector3d x_unit = x.normalized();
   const Eigen::Vector3d y_unit = y_across.normalized();
-  plane.box_axes << x_unit, y_unit, x_unit.cross(y_unit);
+  plane.axes << x_unit, y_unit, x_unit.cross(y_unit);
 }
 
 }  // namespace
@@ -40,11 +40,11 @@ ContactPlane to_contact_plane(const Plane& plane) {
   out.static_friction = plane.static_friction;
   out.dynamic_friction = plane.dynamic_friction;
   out.extent_m = plane.extent_m;
-  if ((plane.flags & kPlaneCarriesShape) != 0) {
-    const Eigen::Vector3d x = to_eigen(plane.box_axis_x);
-    const Eigen::Vector3d y = to_eigen(plane.box_axis_y);
-    out.box_axes << x, y, x.cross(y);
-    out.box_half_m = to_eigen(plane.box_half_m);
+  out.shape = plane.shape;
+  if (traits(plane.shape.kind).carries_axes) {
+    const Eigen::Vector3d x = to_eigen(plane.body_axis_x);
+    const Eigen::Vector3d y = to_eigen(plane.body_axis_y);
+    out.axes << x, y, x.cross(y);
   }
   return out;
 }
@@ -75,22 +75,21 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, c
     const int match = matches.previous_index[k];
     if (match < 0) continue;  // new object: starts at frame i's value
     const Plane& before = previous.planes[match];
-    // A box or capsule in both frames: its axes turn between them (the same body's: they correspond one to one).
-    const bool box_both =
-        (plane.box() || plane.capsule() || plane.cylinder()) && (before.flags & kPlaneCarriesShape) != 0;
+    // A body that carries its axes in both frames: they turn between them (the same body's: one to one).
+    const bool axes_both = plane.shape_traits().carries_axes && traits(before.shape.kind).carries_axes;
 
     if (normals_flip(to_eigen(before.normal), to_eigen(now.normal))) {
       const Plane& face = flip_switched(w) ? now : before;
-      if (box_both) {
+      if (axes_both) {
         // A body that carries its shape moves between the frames whichever face is shown: the face is carried
         // rigidly from its frame's pose to the interpolated one (a face held where frame i−1 left it would let a body
         // that comes at the finger close over the proxy for half a period).
         plane.com_m = lerp(before.com_m, now.com_m, w);
-        interpolate_box_axes(before, now, w, plane);  // frame i's axes when the turn is too large to interpolate
-        const Eigen::Vector3d face_x = to_eigen(face.box_axis_x), face_y = to_eigen(face.box_axis_y);
+        interpolate_axes(before, now, w, plane);  // frame i's axes when the turn is too large to interpolate
+        const Eigen::Vector3d face_x = to_eigen(face.body_axis_x), face_y = to_eigen(face.body_axis_y);
         Eigen::Matrix3d face_axes;
         face_axes << face_x, face_y, face_x.cross(face_y);
-        const Eigen::Matrix3d turn = plane.box_axes * face_axes.transpose();
+        const Eigen::Matrix3d turn = plane.axes * face_axes.transpose();
         plane.point_m = plane.com_m + turn * (to_eigen(face.point_m) - to_eigen(face.com_m));
         plane.normal = (turn * to_eigen(face.normal)).normalized();
       } else if (&face == &before) {
@@ -101,12 +100,12 @@ void interpolate_planes(const PlaneFrame& previous, const PlaneFrame& current, c
       continue;
     }
     plane.com_m = lerp(before.com_m, now.com_m, w);
-    if (box_both) interpolate_box_axes(before, now, w, plane);
+    if (axes_both) interpolate_axes(before, now, w, plane);
     const Eigen::Vector3d normal = lerp(before.normal, now.normal, w);
     plane.normal = normal / normal.norm();  // |normal| ≥ 1/√2 for unit inputs with dot ≥ 0
-    if (plane.sphere()) {
-      // A sphere: its centre moves between the frames, its tangent plane is taken again at the proxy (shape_planes.h).
-      const double radius_m = plane.extent_m;
+    if (plane.shape_traits().round) {
+      // A ball: its centre moves between the frames, its tangent plane is taken again at the proxy (shape_planes.h).
+      const double radius_m = plane.shape.radius_m;
       const Eigen::Vector3d centre_before = to_eigen(before.point_m) - radius_m * to_eigen(before.normal);
       const Eigen::Vector3d centre_now = to_eigen(now.point_m) - radius_m * to_eigen(now.normal);
       plane.point_m = (1.0 - w) * centre_before + w * centre_now + radius_m * plane.normal;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Plane interpolation between world frames i−1 and i (paper §3.2, DESIGN.md §1 haptic tick step 2).
+// Plane interpolation between world frames i−1 and i (paper §3.2, docs/architecture.md §1.2 step 2).
 //
 //   P_H = w·P_Wi + (1 − w)·P_W(i−1),   N_H = w·N_Wi + (1 − w)·N_W(i−1)   (paper §3.2 with w = j/n)
 //
@@ -12,8 +12,8 @@
 //    over an edge or through a thin object and the nearest point jumped to another face), linear blending would pass
 //    through a vanishing normal and sweep the plane through the object; instead the whole plane switches from frame
 //    i−1's to frame i's at the midpoint, w ≥ ½. For dot ≥ 0 the blended normal has length ≥ 1/√2, never near zero.
-//    A plane that carries its body (box, capsule, cylinder) shows the same face, but carried rigidly with the body's
-//    interpolated pose (centre lerped, axes turned part of the way): a face held where frame i−1 left it would let a
+//    A plane that carries its body's axes (ShapeTraits::carries_axes) shows the same face, but carried rigidly with
+//    the body's interpolated pose (centre lerped, axes turned part of the way): a face held where frame i−1 left it would let a
 //    body that comes at the finger close over the proxy for half a period.
 //  * The centre of mass is interpolated like the point; velocities, friction and flags are frame i's (the newest
 //    state the world has sent, §6.2).
@@ -22,7 +22,7 @@
 //    to match (keeping its place along the surface). Turning about a point 15 mm from the finger (a box's top face
 //    whose next frame is the edge the finger slid past) drops the plane 0.3 mm at the finger in one tick, and the
 //    damper turns that into a pull on the finger (hard case 6). For planes that do not turn this is the paper's rule.
-//  * A sphere's plane (kPlaneSphere) interpolates the centre instead; the servo then takes the tangent plane at the
+//  * A ball's plane (ShapeTraits::round) interpolates the centre instead; the servo then takes the tangent plane at the
 //    proxy (shape_planes.h).
 
 #include "common/contract/frames.h"

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// How the planes move on the haptic side between world frames (DESIGN.md §1.2 step 2), one strategy per coupling:
+// How the planes move on the haptic side between world frames (docs/architecture.md §1.2 step 2), per coupling:
 //   InterpolatedPlanes  impulse and position coupling: paper §3.2's interpolation between frames i−1 and i;
 //   LocalDynamics       local coupling (paper §6.3): frame i's planes carried by a local rigid-body model that the
 //                       finger's own reaction moves tick by tick (local_dynamics.h).

@@ -29,9 +29,9 @@
 //    it through its infinite tangent plane, at a lever that spun the 3 g ball to 1200 rad/s.
 //  * Locally infeasible sets: nearly opposed planes that overlap do meet, but δ/sin θ along their wedge, and tangent
 //    planes of balls packed around the finger close a pocket whose corners lie beside the balls. A plane is §3.1's
-//    first-order picture of its object near its point: it holds within its extent (a sphere's radius, a box's diagonal,
-//    a cylinder's or capsule's bounding diagonal), and the plane set as a whole within planes.valid_within_m of the
-//    goal (the world's reach: it sent nothing beyond). Once the proxy has left the finger's spot (an edge or corner is
+//    first-order picture of its object near its point: it holds within its extent (common/shape/shape.h
+//    describes_within_m: a sphere's radius, a box's diagonal, a long body's bounding diagonal), and the plane set as
+//    a whole within planes.valid_within_m of the goal (the world's reach: it sent nothing beyond). Once the proxy has left the finger's spot (an edge or corner is
 //    being built), a step that takes it beyond either treats the plane being added as conflicting with the active ones,
 //    exactly as an opposite parallel plane: same compromise, same flag. A single plane is never bounded: however deep
 //    the finger, its proxy is the projection onto that face.

@@ -192,7 +192,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   // The objects give way at the haptic rate (local coupling, paper §6.3): this tick's shares move the model.
   if (have_frame_) motion_->take_shares(accumulator_.last_shares(), accumulator_.last_share_count());
 
-  // 6. The device renders it (DESIGN.md §1.2 step 6: the haptic node commands the device).
+  // 6. The device renders it (docs/architecture.md §1.2 step 6: the haptic node commands the device).
   result_.render = true;
   return result_;
 }

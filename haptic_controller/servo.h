@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The 1 kHz haptic servo (DESIGN.md §1.2): `tick(finger sample, dt) -> force`, device-agnostic. Composes plane
-// interpolation (§3.2), the god-object with friction (§3.3, §6.2), force rendering (§3.3) and impulse integration
+// The 1 kHz haptic servo (docs/architecture.md §1.2): `tick(finger sample, dt) -> force`, device-agnostic. Composes
+// plane interpolation (§3.2), the god-object with friction (§3.3, §6.2), force rendering (§3.3) and impulse integration
 // (§3.4). The haptic node wires it to its clock, the world link and a HapticDevice; tests drive it directly.
 //
 // Threading: one servo thread owns the object; on_plane_frame, tick and report are called from that thread only.
@@ -33,7 +33,7 @@ struct ServoOptions {
   double max_force_N = 10.0;    // the device's limit (DeviceLimits): forces are clamped to it
 };
 
-// The DESIGN.md default for --stiffness when nothing else is given.
+// The default for --stiffness when nothing else is given (paper §4.2.1, docs/architecture.md §4).
 inline constexpr double kFallbackStiffness_Npm = 2000.0;
 
 struct TickResult {

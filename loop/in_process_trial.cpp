@@ -141,7 +141,7 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   if (!options.fingers.empty() && !options.trajectory.empty()) {
     throw std::invalid_argument("give trajectory or fingers, not both");
   }
-  // One controller per user: the first is the lockstep master, the others follow its ticks (DESIGN.md §3).
+  // One controller per user: the first is the lockstep master, the others follow its ticks (docs/architecture.md §3).
   std::vector<std::unique_ptr<Controller>> users;
   const std::size_t user_count = 1 + options.followers.size();
   for (std::size_t u = 0; u < user_count; ++u) {

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// One trial with the world, haptic and device nodes in this process over the in-process links (DESIGN.md §1.3, §2):
-// the same nodes the three daemons run, under the lockstep schedule, on the calling thread. Bitwise the same outcome
-// as the three processes in lockstep (`scripts/run.sh --clock lockstep`), without starting any process.
+// One trial with the world, haptic and device nodes in this process over the in-process links (docs/architecture.md
+// §1.3, §2): the same nodes the three daemons run, under the lockstep schedule, on the calling thread. Bitwise the same
+// outcome as the three processes in lockstep (`scripts/run.sh --clock lockstep`), without starting any process.
 //
 // This is the library's entry point for embedding Impetus (Impetus::loop): load a scene file, pick a trajectory and a
 // coupling, run, read the summary.
@@ -31,7 +31,7 @@ struct InProcessTrialOptions {
   // empty). Finger k is endpoint k of the world; its logs are haptic.endpointK.csv and device.endpointK.csv.
   std::vector<std::string> fingers;
   // Other users on the same world, each a haptic controller of its own with its fingers ("NAME=TRAJECTORY" each):
-  // they follow the first controller's lockstep ticks (DESIGN.md §3). User u's logs are userU.haptic.csv and
+  // they follow the first controller's lockstep ticks (docs/architecture.md §3). User u's logs are userU.haptic.csv and
   // userU.device.csv (u = 1, 2, ...), its summary under "followers".
   std::vector<std::vector<std::string>> followers;
   Coupling coupling = Coupling::impulse;

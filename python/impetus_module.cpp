@@ -58,8 +58,8 @@ std::string run_trial(const std::string& scene, const std::string& trajectory, c
   return text;
 }
 
-// A log written by the nodes (a header row of column names, then rows of numbers: DESIGN.md §4) as its header and
-// a rows x columns float64 array. Throws std::runtime_error naming the file, line and column of a bad value.
+// A log written by the nodes (a header row of column names, then rows of numbers: docs/architecture.md §4) as its
+// header and a rows x columns float64 array. Throws std::runtime_error naming the file, line and column of a bad value.
 py::tuple read_log(const std::string& path) {
   std::ifstream file(path);
   if (!file) throw std::runtime_error(path + ": cannot be read");

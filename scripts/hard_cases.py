@@ -40,6 +40,9 @@ from impetus_py.summary import Summary  # noqa: E402
 from impetus_py.trial import COUPLINGS, run_trial  # noqa: E402
 
 CASES_DIR = ROOT / "tests/hard_cases"
+# Case 14 is the shipped grasp scene (its fingers' paths from scripts/grasp_trajectories.py); 14b the same at 200 Hz.
+GRASP_SCENE = ROOT / "scenes/grasp.json"
+GRASP_FINGERS = {"thumb": str(ROOT / "scenes/grasp_thumb.csv"), "index": str(ROOT / "scenes/grasp_index.csv")}
 # Every trial runs at haptic_controller's default rate; the sweep's damping policies are planned with its period (the
 # theory afterwards takes the period the trials report).
 HAPTIC_PERIOD_S = 1.0 / HAPTIC_RATE_HZ
@@ -642,10 +645,9 @@ CASES = [
      "c12c_ball_rolls_into_finger.csv", None, check_arrival_no_pass),
     ("12d", "object comes to the finger: pushed by another", "c12d_pushed_into_finger.json",
      "c12d_pushed_into_finger.csv", None, check_arrival_no_pass),
-    ("14", "grasp and lift: two fingers, 0.2 kg cube", "c14_grasp_lift.json",
-     {"thumb": "c14_grasp_thumb.csv", "index": "c14_grasp_index.csv"}, None, check_grasp_lift),
+    ("14", "grasp and lift: two fingers, 0.2 kg cube", GRASP_SCENE, GRASP_FINGERS, None, check_grasp_lift),
     ("14b", "grasp and lift at a 200 Hz world (omega T = 0.7)", "c14b_grasp_lift_200hz.json",
-     {"thumb": "c14_grasp_thumb.csv", "index": "c14_grasp_index.csv"}, None, check_grasp_lift),
+     GRASP_FINGERS, None, check_grasp_lift),
 ]
 
 

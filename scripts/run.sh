@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# Runs one trial: world_manager + haptic_controller + spidar_sim (DESIGN.md §4), collects their logs under DIR,
-# prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
+# Runs one trial: world_manager + haptic_controller + spidar_sim (docs/architecture.md §4), collects their logs under
+# DIR, prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
 #
 #   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ...) [--user SPEC ...]
 #                  [--coupling impulse|position|local]

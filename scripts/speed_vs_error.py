@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Speed against error: how far a multi-rate trial lands from the 1 kHz single-rate reference, and what it costs.
 
-Grid (through the real processes in lockstep, see DESIGN.md §3):
+Grid (through the real processes in lockstep, see docs/architecture.md §3):
   scene {tap, spheres} x coupling (--couplings) x world rate (--rates, Hz) x --phases phases per rate,
   plus the world's ODE substeps per period as a second speed knob (--substeps at each of --substeps-rates Hz,
   --substeps-coupling coupling, on --substeps-scenes).

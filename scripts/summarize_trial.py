@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: Apache-2.0
-"""Merges one trial's per-process summaries into DIR/summary.json (DESIGN.md §4) and prints the outcome.
+"""Merges one trial's per-process summaries into DIR/summary.json (docs/architecture.md §4) and prints the outcome.
 
 usage: summarize_trial.py DIR [--set key=value ...] [--quiet]
 """

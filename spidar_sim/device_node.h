@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The device node (DESIGN.md §1.3): a simulated SPIDAR and finger (DeviceSim) on the device port. Each tick takes the
-// newest commanded tensions (minimum tension before the first command), advances the simulation and publishes the
-// encoder counts. Lockstep: one tick per turn the host gives (shared memory), or per in-process step_device() call;
+// The device node (docs/architecture.md §1.3): a simulated SPIDAR and finger (DeviceSim) on the device port. Each tick
+// takes the newest commanded tensions (minimum tension before the first command), advances the simulation and publishes
+// the encoder counts. Lockstep: one tick per turn the host gives (shared memory), or per in-process step_device() call;
 // when the trajectory ends the node detaches. Real time: its own 1 kHz clock until the trajectory ends.
 //
 // Owns the simulation's log and statistics.

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One simulated device session: the SPIDAR hardware, the finger and the scripted target, advanced one device tick at a
-// time (DESIGN.md §1 "One device tick"). main.cpp wires it to the device port and the clock; tests drive it directly.
+// time (docs/architecture.md §1.2 "One device tick"). main.cpp wires it to the device port and the clock; tests drive
+// it directly.
 //
 // Contract of tick(): the commanded tensions are held for dt_s (zero-order hold, like a motor amplifier's setpoint);
 // within the tick the finger is integrated in sub-steps, re-evaluating the target and the string directions at each;
@@ -20,7 +21,8 @@
 
 namespace impetus {
 
-// One row of the device log (DESIGN.md §4 "Logs"): copied out of a tick, formatted by another thread (rt_log.h).
+// One row of the device log (docs/architecture.md §4 "Logs"): copied out of a tick, formatted by another thread
+// (rt_log.h).
 struct DeviceLogRow {
   double time_s;
   Vec3 target_m, finger_m, finger_velocity_mps, force_N;
@@ -57,8 +59,8 @@ class DeviceSim {
   const SpidarHardware& hardware() const { return hardware_; }
   const Finger& finger() const { return finger_; }
 
-  // Log (DESIGN.md §4 "Logs"): one header, then one row per tick with time, target, finger position and velocity,
-  // device force, applied tensions and encoder counts.
+  // Log (docs/architecture.md §4 "Logs"): one header, then one row per tick with time, target, finger position and
+  // velocity, device force, applied tensions and encoder counts.
   static const char* log_header();  // the column names, without the line's end
   DeviceLogRow log_row() const;      // this tick's row; no allocation
   static void format_log_row(std::ostream& out, const DeviceLogRow& row);

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The user's fingertip: a point mass held by the hand, which tracks the scripted target like a spring and damper
-// (DESIGN.md §1 "One device tick"). The device's string force pushes it off the target, as a real finger is pushed:
+// (docs/architecture.md §1.2 "One device tick"). The device's string force pushes it off the target, as a real finger
+// is pushed:
 //   m·a = k_h·(target − x) + b_h·(target_velocity − v) + F_device.
 //
 // Defaults and their physical meaning:

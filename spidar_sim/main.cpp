@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// spidar_sim: a simulated SPIDAR and finger playing a scripted trajectory (DESIGN.md §1.2 step 1, §4). Parses the
-// flags, attaches to a running haptic controller's device port and runs a DeviceNode until the trajectory ends; then
-// detaches cleanly and exits 0.
+// spidar_sim: a simulated SPIDAR and finger playing a scripted trajectory (docs/architecture.md §1.2 step 1, §4).
+// Parses the flags, attaches to a running haptic controller's device port and runs a DeviceNode until the trajectory
+// ends; then detaches cleanly and exits 0.
 
 #include "common/link/shm/shm_device_port.h"
 #include "common/runtime/cli.h"

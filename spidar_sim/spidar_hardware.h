@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The SPIDAR hardware as the haptic controller sees it through the device port: four motors that pull strings with
-// the commanded tensions, and four encoders that report the string lengths (DESIGN.md §1 "One device tick").
+// the commanded tensions, and four encoders that report the string lengths (docs/architecture.md §1.2, device tick).
 //
-// Conventions shared with the driver (common/device_geometry.h):
+// Conventions shared with the driver (common/spidar/geometry.h):
 //   string i runs from motor i's exit point `motor_positions_m()[i]` straight to the finger cap;
 //   its length is the distance |finger − motor_i|, reported as count_i = round(length / metres_per_count), i.e. the
 //   encoders are calibrated so that count 0 means the finger sits on the motor (an absolute length, no offset);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Scripted finger trajectories: where the simulated hand wants the fingertip to be at each time (DESIGN.md §4
-// "Trajectory"). World frame, metres, seconds; time 0 is the start of the device session.
+// Scripted finger trajectories: where the simulated hand wants the fingertip to be at each time
+// (docs/trajectory-format.md). World frame, metres, seconds; time 0 is the start of the device session.
 //
 // A trajectory is either a CSV file or a built-in with named parameters. Evaluation (`position_at`, `velocity_at`) is
 // allocation-free and safe to call from the device tick; loading allocates and throws `TrajectoryError`.

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// viewer: the graphics process (paper §6.1, DESIGN.md §1). Shows a running world live, read-only, or replays a
-// finished trial, as a 3-D page served on loopback.
+// viewer: the graphics process (paper §6.1, docs/architecture.md §1). Shows a running world live, read-only, or replays
+// a finished trial, as a 3-D page served on loopback.
 
 #include "common/runtime/cli.h"
 #include "viewer/viewer_node.h"

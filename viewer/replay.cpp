@@ -19,7 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A numeric CSV log (header row, then numbers), as every node writes them (DESIGN.md §4).
+// A numeric CSV log (header row, then numbers), as every node writes them (docs/architecture.md §4).
 struct CsvTable {
   std::vector<std::string> columns;
   std::vector<std::vector<double>> rows;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "viewer/view_encoding.h"
 
+#include "common/shape/shape.h"
 #include "viewer/view_protocol.h"
 
 #include <nlohmann/json.hpp>
@@ -14,16 +15,6 @@ namespace impetus::view {
 namespace {
 
 static_assert(std::endian::native == std::endian::little, "frame messages are little-endian float64 (view_protocol.h)");
-
-const char* shape_name(ViewShape shape) {
-  switch (shape) {
-    case ViewShape::box: return "box";
-    case ViewShape::sphere: return "sphere";
-    case ViewShape::capsule: return "capsule";
-    case ViewShape::cylinder: return "cylinder";
-  }
-  return "box";
-}
 
 // Appends float64 values to a byte string.
 class Packer {
@@ -55,11 +46,11 @@ std::string scene_message(const ViewScene& scene, const std::string& source, con
   for (std::uint32_t k = 0; k < scene.body_count; ++k) {
     const ViewBodyInfo& body = scene.bodies[k];
     bodies.push_back({{"name", std::string(body.name.data())},  // NUL-terminated (scene_problem checked)
-                      {"shape", shape_name(body.shape)},
+                      {"shape", to_string(body.shape.kind)},
                       {"dynamic", body.dynamic != 0},
-                      {"size_m", body.box_size_m},
-                      {"radius_m", body.radius_m},
-                      {"length_m", body.length_m}});
+                      {"size_m", body.shape.box_size_m},
+                      {"radius_m", body.shape.radius_m},
+                      {"length_m", body.shape.length_m}});
   }
   message["bodies"] = std::move(bodies);
   if (replay) {

@@ -8,11 +8,10 @@
 //      {"type": "scene", "mode": "live" | "replay", "source": "<shm name or trial folder>",
 //       "coupling": "impulse" | "position" | "local", "world_rate_hz": 20,
 //       "floor": {"present": true, "height_m": 0.0},
-//       "bodies": [{"name": "cube", "shape": "box" | "sphere" | "capsule" | "cylinder", "dynamic": true,
-//                   "size_m": [x, y, z],   (box: full extents)   "radius_m": r, "length_m": l}, ...],
+//       "bodies": [{"name": "cube", "shape": "box" | "sphere" | ... (common/shape/shape.h to_string), "dynamic": true,
+//                   "size_m": [x, y, z], "radius_m": r, "length_m": l}, ...],   (common/shape/shape_descriptor.h)
 //       "replay": {"start_s": t0, "end_s": t1, "frame_count": n}}          (replay only)
-//    Body k of every frame below is bodies[k]. Capsule and cylinder axes are body z; a capsule's length excludes its
-//    caps.
+//    Body k of every frame below is bodies[k]. A shape's axis of symmetry is its body z.
 //
 // 2. Each world frame, one binary message: little-endian float64 values (a Float64Array on the page):
 //      header, kFrameHeaderValues values:

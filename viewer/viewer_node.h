@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The viewer node (DESIGN.md §1.3, paper §6.1 "graphics"): attaches read-only to a running world's view, or reads a
-// finished trial, and serves the page that shows it. It never writes anything the world, the haptic loop or the
+// The viewer node (docs/architecture.md §1.3, paper §6.1 "graphics"): attaches read-only to a running world's view, or
+// reads a finished trial, and serves the page that shows it. It never writes anything the world, the haptic loop or the
 // device reads.
 
 #include "common/link/link_options.h"

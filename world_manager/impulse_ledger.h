@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The world's side of "no impulse is lost or counted twice" (DESIGN.md §2).
+// The world's side of "no impulse is lost or counted twice" (docs/architecture.md §2).
 //
 // Each endpoint of each haptic session publishes, per object, a running total of impulse since its entry for that
 // object was (re)allocated, keyed by (haptic session, endpoint, object, epoch). The ledger remembers the last total it

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// world_manager: the rigid-body world at the world rate (DESIGN.md §1.1). Parses the flags, creates the world link
-// and runs a WorldNode on it; writes the world half of summary.json at exit.
+// world_manager: the rigid-body world at the world rate (docs/architecture.md §1.1). Parses the flags, creates the
+// world link and runs a WorldNode on it; writes the world half of summary.json at exit.
 
 #include "common/link/dds/dds_world_link.h"
 #include "common/link/dds/dds_world_view.h"

@@ -3,7 +3,7 @@
 // The state of one scene object at the end of a world step, in the world frame. The World refreshes it from ODE after
 // every step; the feature extractor, the log and the tests read it without touching ODE.
 
-#include "world_manager/features/body_geometry.h"
+#include "common/shape/shape.h"
 
 #include <Eigen/Core>
 

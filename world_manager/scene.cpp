@@ -2,14 +2,14 @@
 #include "world_manager/scene.h"
 
 #include "common/contract/limits.h"
+#include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <fstream>
-#include <initializer_list>
-#include <numbers>
+#include <span>
 #include <set>
 #include <sstream>
 #include <string_view>
@@ -23,153 +23,7 @@ using nlohmann::json;
 // A quaternion read from text with ~7 significant digits is still unit to ~1e-7; 1e-6 accepts those and rejects
 // anything a normalisation would noticeably change.
 constexpr double kUnitQuaternionTolerance = 1e-6;
-// Long values (a whole object echoed back) would drown the message; the start is enough to find it.
-constexpr std::size_t kMaxEchoedChars = 80;
-
-// A short quote of a value for an error message, built without recursion: a scalar as written (at most
-// kMaxEchoedChars), an array or object by its size. Dumping a container would recurse once per nesting level (a
-// stack overflow on a deeply nested file) and could quote megabytes.
-std::string echo(const json& value) {
-  if (value.is_array()) return "an array of " + std::to_string(value.size()) + " elements";
-  if (value.is_object()) return "an object with " + std::to_string(value.size()) + " keys";
-  return excerpt(value.dump(), kMaxEchoedChars);
-}
-
-// JSON pointer escaping (RFC 6901) for keys that contain '/' or '~'.
-std::string escape_key(std::string_view key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') {
-      out += "~0";
-    } else if (c == '/') {
-      out += "~1";
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-// A node of the document with its JSON pointer, so every error can name the field.
-class Node {
- public:
-  Node(const json& value, std::string pointer, const std::string& source)
-      : value_(value), pointer_(std::move(pointer)), source_(source) {}
-
-  const json& value() const { return value_; }
-  const std::string& pointer() const { return pointer_; }
-
-  [[noreturn]] void fail(const std::string& reason) const {
-    throw SceneError(source_ + ": " + where() + ": " + reason + " (got " + echo(value_) + ")");
-  }
-  [[noreturn]] void fail_missing(std::string_view key, std::string_view hint = {}) const {
-    std::string message = source_ + ": " + pointer_ + "/" + escape_key(key) + ": missing required field";
-    if (!hint.empty()) message += std::string(" (") + std::string(hint) + ")";
-    throw SceneError(message);
-  }
-
-  bool has(std::string_view key) const { return value_.contains(key); }
-
-  Node child(std::string_view key) const {
-    return Node(value_.at(std::string(key)), pointer_ + "/" + escape_key(key), source_);
-  }
-  Node element(std::size_t index) const {
-    return Node(value_.at(index), pointer_ + "/" + std::to_string(index), source_);
-  }
-  Node required(std::string_view key) const {
-    if (!has(key)) fail_missing(key);
-    return child(key);
-  }
-
-  void expect_object() const {
-    if (!value_.is_object()) fail("expected an object");
-  }
-  // Unknown keys are errors: a misspelt optional key would otherwise silently fall back to its default.
-  void expect_keys(std::initializer_list<std::string_view> allowed) const {
-    expect_object();
-    for (const auto& item : value_.items()) {
-      bool known = false;
-      for (std::string_view name : allowed) known = known || item.key() == name;
-      if (!known) {
-        const std::string key = excerpt(item.key(), kMaxEchoedChars);
-        throw SceneError(source_ + ": " + pointer_ + "/" + escape_key(key) + ": unknown key '" + key + "' (got " +
-                         echo(item.value()) + ")");
-      }
-    }
-  }
-
-  double number() const {
-    if (!value_.is_number()) fail("expected a number");
-    const double x = value_.get<double>();
-    if (!std::isfinite(x)) fail("expected a finite number");
-    return x;
-  }
-  double positive() const {
-    const double x = number();
-    if (!(x > 0.0)) fail("must be positive");
-    return x;
-  }
-  double non_negative() const {
-    const double x = number();
-    if (x < 0.0) fail("must not be negative");
-    return x;
-  }
-  double in_range(double lowest, double highest, const char* unit) const {
-    const double x = number();
-    if (x < lowest || x > highest) fail("must be between " + readable(lowest) + " and " + readable(highest) + unit);
-    return x;
-  }
-  double positive_up_to(double highest, const char* unit) const {
-    const double x = positive();
-    if (x > highest) fail("must be at most " + readable(highest) + unit);
-    return x;
-  }
-  // Three numbers whose Euclidean length is at most `highest`.
-  std::array<double, 3> vector_up_to(double highest, const char* unit) const {
-    const std::array<double, 3> v = numbers<3>();
-    if (std::hypot(v[0], v[1], v[2]) > highest) fail("its length must be at most " + readable(highest) + unit);
-    return v;
-  }
-  double in_unit_interval() const {
-    const double x = number();
-    if (x < 0.0 || x > 1.0) fail("must be in [0, 1]");
-    return x;
-  }
-  std::int64_t integer() const {
-    if (!value_.is_number_integer()) fail("expected an integer");
-    return value_.get<std::int64_t>();
-  }
-  int positive_int(int highest) const {
-    if (!value_.is_number_integer()) fail("expected a whole number");
-    // Compared as a double first: a huge integer must not wrap when converted.
-    if (value_.get<double>() < 1.0 || value_.get<double>() > highest) {
-      fail("must be a whole number from 1 to " + std::to_string(highest));
-    }
-    return static_cast<int>(value_.get<std::int64_t>());
-  }
-  bool boolean() const {
-    if (!value_.is_boolean()) fail("expected true or false");
-    return value_.get<bool>();
-  }
-  std::string string() const {
-    if (!value_.is_string()) fail("expected a string");
-    return value_.get<std::string>();
-  }
-  template <std::size_t N>
-  std::array<double, N> numbers() const {
-    if (!value_.is_array() || value_.size() != N) fail("expected an array of " + std::to_string(N) + " numbers");
-    std::array<double, N> out{};
-    for (std::size_t i = 0; i < N; ++i) out[i] = element(i).number();
-    return out;
-  }
-
- private:
-  std::string where() const { return pointer_.empty() ? std::string("/") : pointer_; }
-
-  const json& value_;
-  std::string pointer_;
-  const std::string& source_;
-};
+using Node = JsonNode;
 
 Material parse_material(const Node& node, Material material) {
   if (node.has("static_friction")) {
@@ -282,62 +136,22 @@ HapticParams parse_haptic(const Node& node) {
   return haptic;
 }
 
-Shape parse_shape(const Node& node, ShapeKind kind) {
-  constexpr double kMin = SceneLimits::kMinLength_m;
-  constexpr double kMax = SceneLimits::kMaxLength_m;
-  Shape shape;
-  shape.kind = kind;
-  switch (kind) {
-    case ShapeKind::box: {
-      const Node size = node.required("size_m");
-      shape.box_size_m = size.numbers<3>();
-      for (std::size_t i = 0; i < 3; ++i) size.element(i).in_range(kMin, kMax, " m");
-      break;
-    }
-    case ShapeKind::sphere:
-      shape.radius_m = node.required("radius_m").in_range(kMin, kMax, " m");
-      break;
-    case ShapeKind::capsule:
-    case ShapeKind::cylinder:
-      shape.radius_m = node.required("radius_m").in_range(kMin, kMax, " m");
-      // A capsule of zero length is a sphere, which is allowed; a cylinder needs a length.
-      shape.length_m = kind == ShapeKind::capsule ? node.required("length_m").in_range(0.0, kMax, " m")
-                                                  : node.required("length_m").in_range(kMin, kMax, " m");
-      break;
-  }
-  return shape;
+ShapeKind parse_shape_kind(const Node& node) {
+  ShapeKind kind = ShapeKind::none;
+  if (!shape_kind_from_string(node.string(), kind)) node.fail("unknown shape, expected " + shape_kind_names());
+  return kind;
 }
 
-ShapeKind parse_shape_kind(const Node& node) {
-  const std::string name = node.string();
-  for (ShapeKind kind : {ShapeKind::box, ShapeKind::sphere, ShapeKind::capsule, ShapeKind::cylinder}) {
-    if (name == to_string(kind)) return kind;
-  }
-  node.fail("unknown shape, expected box, sphere, capsule or cylinder");
-}
+// The keys every object may have; its shape's own come from the shape module.
+constexpr std::string_view kObjectKeys[] = {
+    "name", "shape", "dynamic", "mass_kg", "density_kgpm3", "position_m", "orientation_wxyz", "linear_velocity_mps",
+    "angular_velocity_radps", "static_friction", "dynamic_friction", "restitution"};
 
 SceneObject parse_object(const Node& node) {
   node.expect_object();
   SceneObject object;
   const ShapeKind kind = parse_shape_kind(node.required("shape"));
-  switch (kind) {
-    case ShapeKind::box:
-      node.expect_keys({"name", "shape", "size_m", "dynamic", "mass_kg", "density_kgpm3", "position_m",
-                        "orientation_wxyz", "linear_velocity_mps", "angular_velocity_radps", "static_friction",
-                        "dynamic_friction", "restitution"});
-      break;
-    case ShapeKind::sphere:
-      node.expect_keys({"name", "shape", "radius_m", "dynamic", "mass_kg", "density_kgpm3", "position_m",
-                        "orientation_wxyz", "linear_velocity_mps", "angular_velocity_radps", "static_friction",
-                        "dynamic_friction", "restitution"});
-      break;
-    case ShapeKind::capsule:
-    case ShapeKind::cylinder:
-      node.expect_keys({"name", "shape", "radius_m", "length_m", "dynamic", "mass_kg", "density_kgpm3",
-                        "position_m", "orientation_wxyz", "linear_velocity_mps", "angular_velocity_radps",
-                        "static_friction", "dynamic_friction", "restitution"});
-      break;
-  }
+  node.expect_keys({std::span<const std::string_view>(kObjectKeys), shape_keys(kind)});
   object.name = node.required("name").string();
   if (object.name.empty()) node.child("name").fail("name must not be empty");
   object.shape = parse_shape(node, kind);
@@ -353,7 +167,7 @@ SceneObject parse_object(const Node& node) {
     constexpr double kMinMass = SceneLimits::kMinMass_kg;
     constexpr double kMaxMass = SceneLimits::kMaxMass_kg;
     object.mass_kg = has_mass ? node.child("mass_kg").in_range(kMinMass, kMaxMass, " kg")
-                              : node.child("density_kgpm3").positive() * object.shape.volume_m3();
+                              : node.child("density_kgpm3").positive() * volume_m3(object.shape);
     if (!has_mass && !(object.mass_kg >= kMinMass && object.mass_kg <= kMaxMass)) {
       node.child("density_kgpm3").fail("density × volume = " + readable(object.mass_kg) + " kg; the mass must be " +
                                        "between " + readable(kMinMass) + " and " + readable(kMaxMass) + " kg");
@@ -419,36 +233,6 @@ double PhysicsParams::cfm_at(double substep_s) const {
 
 double combine_friction(double a, double b) { return std::sqrt(a * b); }
 double combine_restitution(double a, double b) { return std::max(a, b); }
-
-const char* to_string(ShapeKind kind) {
-  switch (kind) {
-    case ShapeKind::box:
-      return "box";
-    case ShapeKind::sphere:
-      return "sphere";
-    case ShapeKind::capsule:
-      return "capsule";
-    case ShapeKind::cylinder:
-      return "cylinder";
-  }
-  return "unknown";
-}
-
-double Shape::volume_m3() const {
-  constexpr double kPi = std::numbers::pi;
-  const double sphere_m3 = 4.0 / 3.0 * kPi * radius_m * radius_m * radius_m;
-  switch (kind) {
-    case ShapeKind::box:
-      return box_size_m[0] * box_size_m[1] * box_size_m[2];
-    case ShapeKind::sphere:
-      return sphere_m3;
-    case ShapeKind::capsule:
-      return kPi * radius_m * radius_m * length_m + sphere_m3;
-    case ShapeKind::cylinder:
-      return kPi * radius_m * radius_m * length_m;
-  }
-  return 0.0;
-}
 
 Scene parse_scene(const nlohmann::json& document, const std::string& source_name) {
   const Node root(document, "", source_name);

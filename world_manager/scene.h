@@ -1,66 +1,17 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The scene model: what a world contains (DESIGN.md §4), parsed and validated from JSON before anything starts.
+// The scene model (docs/architecture.md §4; the format: docs/scene-format.md): what a world contains, parsed and
+// validated from JSON before anything starts.
 //
-// File format (SI units; every key name carries its unit; world frame right-handed, z up):
-//
-//   {
-//     "description": "...",                     optional free text (JSON has no comments: the scene's reasoning)
-//     "gravity_mps2": [0, 0, -9.81],            optional, default [0, 0, -9.81]
-//     "floor": {                                optional object, default: a floor at z = 0 with default material;
-//       "height_m": 0.0,                        `"floor": null` means no floor at all
-//       "static_friction": 0.5, "dynamic_friction": 0.5, "restitution": 0.0
-//     },
-//     "physics": {                              optional, every key optional
-//       "world_rate_hz": 20,                    paper §4.2.1
-//       "substeps": 10,                         ODE steps inside one world period
-//       "solver": "quickstep",                  quickstep (iterative, O(n)) | direct (ODE's dWorldStep: exact
-//                                               LCP, O(n³), for stacks with large mass ratios QuickStep cannot hold)
-//       "solver_iterations": 20,                QuickStep iterations
-//       "erp": 0.2, "cfm": 1e-5,                ODE's error reduction / constraint force mixing per substep
-//       "contact_stiffness_Npm": 4e6,           or every contact as a spring and a damper, the same whatever the
-//       "contact_damping_Nspm": 8e4,            substep (ODE's ERP and CFM then follow from them per substep; not
-//                                               with "erp"/"cfm"); see PhysicsParams
-//       "max_correcting_velocity_mps": 0.005,   cap on the speed at which ODE pushes penetrating bodies apart
-//                                               (default: none, ODE's own); see PhysicsParams
-//       "speculative_contacts": true,           contacts one substep before bodies meet, so an impact neither sinks
-//                                               into the other body nor bounces off ERP's push-out
-//       "auto_disable": true,                   resting bodies sleep: out of the simulation until pushed or touched,
-//                                               so a step costs what moves, not what exists (docs/sleeping.md)
-//       "seed": 1                               dRandSetSeed, so QuickStep runs are bitwise reproducible
-//     },
-//     "haptic": {                               optional, every key optional
-//       "reach_radius_m": 0.05,                 base radius of the feature query (paper §3.1 step 1)
-//       "stiffness_Npm": 2000,                  k_p of paper §3.3 (2 kN/m in §4.2.1)
-//       "damping_Nspm": 5,                      k_d of paper §3.3
-//       "static_friction": 1.0,                 the finger pad's material; when given it is combined with each
-//       "dynamic_friction": 1.0                 object's material like two bodies are (see combine_friction)
-//     },
-//     "objects": [                              required (may be empty)
-//       { "name": "cube",                       required, unique
-//         "shape": "box",                       required: box | sphere | capsule | cylinder
-//         "size_m": [0.05, 0.05, 0.05],         box: full extents along body x, y, z
-//         "radius_m": 0.02,                     sphere, capsule, cylinder
-//         "length_m": 0.1,                      capsule: cylindrical part (caps excluded); cylinder: total length;
-//                                               both along body z
-//         "dynamic": true,                      required
-//         "mass_kg": 1.0,                       dynamic only, exactly one of mass_kg / density_kgpm3
-//         "density_kgpm3": 1000,
-//         "position_m": [x, y, z],              required: centre (= centre of mass)
-//         "orientation_wxyz": [1, 0, 0, 0],     optional, unit within 1e-6
-//         "linear_velocity_mps": [0, 0, 0],     optional, dynamic only
-//         "angular_velocity_radps": [0, 0, 0],  optional, dynamic only, world frame
-//         "static_friction": 0.5, "dynamic_friction": 0.5, "restitution": 0.0    optional material
-//       } ]
-//   }
-//
-// Keys for another shape (e.g. "radius_m" on a box) are unknown keys. Every error throws SceneError with the message
-// `FILE: /json/pointer: reason (got VALUE)`.
-//
-// Every number must lie in a range the engine can simulate: SceneLimits below, and common/contract/limits.h for rates,
-// substeps, iterations, stiffness and damping; each bound has its reason next to it.
+// Every key with its unit, range and default is in docs/scene-format.md; a shape's own keys are its kind's
+// (common/shape/shape.h shape_keys). Unknown keys (a box's "radius_m") are errors, and every error throws SceneError
+// with the message `FILE: /json/pointer: reason (got VALUE)`. Every number must lie in a range the engine can simulate:
+// SceneLimits below and common/contract/limits.h, each bound with its reason next to it.
 
+#include "common/contract/limits.h"
 #include "common/contract/vec3.h"
+#include "common/runtime/input_error.h"
+#include "common/shape/shape.h"
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -75,17 +26,15 @@
 
 namespace impetus {
 
-class SceneError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+// A bad scene: the message names the file, the JSON path and the value.
+using SceneError = InputError;
 
 // The physical ranges a scene's values must lie in. ODE's broadphase stores bounding boxes as integers in cells of
 // 1/8 m and asserts when a coordinate leaves that range (measured: 10^6 m works, 10^12 m aborts), and its solver
 // loses all digits when masses or lengths differ by more than ~10^12; these ranges keep a scene well inside both.
 struct SceneLimits {
-  static constexpr double kMinLength_m = 1e-4;     // sizes and radii: 0.1 mm, below a device's position resolution
-  static constexpr double kMaxLength_m = 1e3;      // 1 km
+  static constexpr double kMinLength_m = limits::kMinLength_m;  // sizes and radii (common/contract/limits.h)
+  static constexpr double kMaxLength_m = limits::kMaxLength_m;
   static constexpr double kMaxCoordinate_m = 1e4;  // positions and floor height: a 20 km world around the device
   static constexpr double kMinMass_kg = 1e-6;      // 1 mg
   static constexpr double kMaxMass_kg = 1e6;       // 1000 t
@@ -122,21 +71,9 @@ struct Material {
 double combine_friction(double a, double b);
 double combine_restitution(double a, double b);
 
-enum class ShapeKind { box, sphere, capsule, cylinder };
-const char* to_string(ShapeKind kind);
-
-// Shape in the body frame, centred on the body origin (which is the centre of mass).
-struct Shape {
-  ShapeKind kind = ShapeKind::sphere;
-  Vec3 box_size_m{};      // box: full extents along body x, y, z
-  double radius_m = 0.0;  // sphere, capsule, cylinder
-  double length_m = 0.0;  // capsule: between the cap centres; cylinder: total; along body z
-  double volume_m3() const;
-};
-
 struct SceneObject {
   std::string name;
-  Shape shape;
+  Shape shape;  // common/shape/shape.h
   bool dynamic = false;
   double mass_kg = 0.0;  // dynamic: resolved from mass_kg or density × volume; static: 0 (immovable)
   Vec3 position_m{};

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The virtual world of the world manager: a Scene on a rigid-body engine, stepped once per world period T_w
-// (DESIGN.md §1.1): the report's impulses through the ledger to the coupling, the engine's substeps, the planes.
+// (docs/architecture.md §1.1): the report's impulses through the ledger to the coupling, engine substeps, the planes.
 //
 // Threading and ownership: a World owns its engine (ODE: engine/ode_engine.h) and its coupling strategy
 // (couplings/) and is used from one thread. The process must have called init_ode_once()
@@ -51,12 +51,12 @@ class World {
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
-  // One world step (DESIGN.md §1.1) for every endpoint slot at once. `reports[k]` is the newest report of slot k
-  // (nullptr: none yet, or none new — the slot keeps its last finger); the transport has validated them. Each report's
-  // new impulses go to the coupling (only those counted against this world's session), the engine advances by T_w in
-  // the scene's substeps, and each slot gets a frame of the planes around its proxy. A slot taken over by another
-  // (haptic session, endpoint) starts afresh. At most kMaxEndpoints slots (std::invalid_argument otherwise); the
-  // returned frames, one per slot, stay valid until the next step.
+  // One world step (docs/architecture.md §1.1) for every endpoint slot at once. `reports[k]` is the newest report of
+  // slot k (nullptr: none yet, or none new — the slot keeps its last finger); the transport has validated them. Each
+  // report's new impulses go to the coupling (only those counted against this world's session), the engine advances by
+  // T_w in the scene's substeps, and each slot gets a frame of the planes around its proxy. A slot taken over by
+  // another (haptic session, endpoint) starts afresh. At most kMaxEndpoints slots (std::invalid_argument otherwise);
+  // the returned frames, one per slot, stay valid until the next step.
   std::span<const PlaneFrame> step(std::span<const HapticReport* const> reports);
   // The same with a single endpoint slot: the one-finger trial.
   const PlaneFrame& step(const HapticReport* report) { return step(std::span<const HapticReport* const>(&report, 1))[0]; }

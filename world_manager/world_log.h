@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The world log (DESIGN.md §4 "Logs"): a CSV with a header row and one row per world step, time first, then for every
-// dynamic object its pose, velocity and the impulse the world applied to it (this step and since the start), then the
-// cumulative reaction into static geometry. Column names carry units: `cube.x_m`, `cube.jx_Ns`, `cube.jx_total_Ns`.
+// The world log (docs/architecture.md §4 "Logs"): a CSV with a header row and one row per world step, time first, then
+// for every dynamic object its pose, velocity and the impulse the world applied to it (this step and since the start),
+// then the cumulative reaction into static geometry. Column names carry units: `cube.x_m`, `cube.jx_Ns`,
+// `cube.jx_total_Ns`.
 //
 // Written out of the world's turn: a step only copies its numbers into a preallocated ring (common/runtime/rt_log.h),
 // and the log's own thread formats and writes them, so in lockstep the haptic side does not wait on the world's CSV.

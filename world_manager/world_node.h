@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The world node (DESIGN.md §1.3): one World on its schedule. Each step takes the newest report from the world link,
-// steps the world, publishes the frame and the loop statistics, and logs a row. Real time: its own clock at the world
-// rate. Lockstep: a step per turn the link gives (shared memory), or whenever the in-process link calls step_world().
+// The world node (docs/architecture.md §1.3): one World on its schedule. Each step takes the newest report from the
+// world link, steps the world, publishes the frame and the loop statistics, and logs a row. Real time: its own clock at
+// the world rate. Lockstep: a step per turn the link gives (shared memory), or whenever the in-process link calls
+// step_world().
 //
-// Owns its World, log and statistics; its summary is the world half of summary.json (DESIGN.md §4).
+// Owns its World, log and statistics; its summary is the world half of summary.json (docs/architecture.md §4).
 
 #include "common/link/inproc/inproc_world_link.h"
 #include "common/contract/world_view.h"

@@ -7,16 +7,6 @@
 namespace impetus {
 namespace {
 
-ViewShape view_shape(ShapeKind kind) {
-  switch (kind) {
-    case ShapeKind::box: return ViewShape::box;
-    case ShapeKind::sphere: return ViewShape::sphere;
-    case ShapeKind::capsule: return ViewShape::capsule;
-    case ShapeKind::cylinder: return ViewShape::cylinder;
-  }
-  return ViewShape::box;
-}
-
 double squared_distance(const Vec3& a, const Vec3& b) {
   const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
   return dx * dx + dy * dy + dz * dz;
@@ -35,11 +25,8 @@ void describe_scene(const Scene& scene, Coupling coupling, double world_rate_hz,
   for (std::uint32_t k = 0; k < out.body_count; ++k) {
     const SceneObject& object = scene.objects[k];
     ViewBodyInfo& body = out.bodies[k];
-    body.shape = view_shape(object.shape.kind);
+    body.shape = object.shape;
     body.dynamic = object.dynamic ? 1 : 0;
-    body.box_size_m = object.shape.box_size_m;
-    body.radius_m = object.shape.radius_m;
-    body.length_m = object.shape.length_m;
     body.name.fill('\0');
     std::memcpy(body.name.data(), object.name.data(), std::min(object.name.size(), body.name.size() - 1));
   }

@@ -1,26 +1,27 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// What crosses the world link and the device port (DESIGN.md §1, §2), as the nodes and algorithms see it: plain data,
-// fixed capacity (the 1 kHz path never allocates), SI units, world frame (right-handed, z up).
+// What crosses the world link and the device port (docs/architecture.md §1, §2), as the nodes and algorithms see it:
+// plain data, fixed capacity (the 1 kHz path never allocates), SI units, world frame (right-handed, z up).
 //
 // These are not the bytes on a wire. Each transport encodes them its own way (common/link/shm/wire_frames.h seals
 // them with a checksum in a fixed layout; the in-process link hands them over as they are) and validates what it
 // receives, so a frame an algorithm sees is always usable: counts within capacity, numbers finite, normals unit.
 
 #include "common/contract/vec3.h"
+#include "common/shape/shape_descriptor.h"
 
 #include <cstdint>
 #include <type_traits>
 
 namespace impetus {
 
-// One finger of a haptic session (DESIGN.md §1): a report and a plane frame name the endpoint they belong to, and the
-// world keys what it applies by (haptic session, endpoint, object).
+// One finger of a haptic session (docs/architecture.md §1): a report and a plane frame name the endpoint they belong
+// to, and the world keys what it applies by (haptic session, endpoint, object).
 using EndpointId = std::uint32_t;
 
 inline constexpr std::uint32_t kMaxPlanes = 64;          // planes in one world → haptic frame
-// Endpoints one world serves at once, over all its haptic controllers (DESIGN.md §1): two hands of four fingers, or
-// several users with a finger or two each.
+// Endpoints one world serves at once, over all its haptic controllers (docs/architecture.md §1): two hands of four
+// fingers, or several users with a finger or two each.
 inline constexpr std::uint32_t kMaxEndpoints = 8;
 // Fingers one device may serve (a SPIDAR with a string set per finger): each is an endpoint of the world.
 inline constexpr std::uint32_t kMaxFingers = kMaxEndpoints;
@@ -38,27 +39,7 @@ inline constexpr std::uint32_t kMaxLocalContacts = 4;
 
 // Plane flags.
 inline constexpr std::uint32_t kPlaneDynamic = 1u << 0;  // the object moves; impulses on it are applied by the world
-// A sphere's tangent plane: the centre is point_m − extent_m·normal and the radius extent_m. The haptic side takes the
-// tangent plane again at its proxy every tick (haptic_controller/shape_planes.h), as the world does every step.
-inline constexpr std::uint32_t kPlaneSphere = 1u << 1;
-// A face of a polyhedron (a box): flat, so it turns rigidly with the body about its centre of mass (the haptic side's
-// local model carries it so, haptic_controller/local_dynamics.h). Curved surfaces do not set it: their tangent plane
-// does not turn with a spin.
-inline constexpr std::uint32_t kPlaneFlat = 1u << 2;
-// A box's plane: the box itself travels with it (Plane::box_axis_x_m, box_axis_y, box_half_m; its centre is com_m),
-// so the haptic side can take the plane again at its proxy every tick (haptic_controller/shape_planes.h) and a face's
-// plane ends where the face does.
-inline constexpr std::uint32_t kPlaneBox = 1u << 3;
-// A capsule's plane: the capsule travels with it (its axis is box_axis_x × box_axis_y through com_m, its radius
-// extent_m, the half distance between its cap centres box_half_m[2]), so the haptic side takes the tangent plane again
-// at the point nearest its proxy every tick, as for a sphere about the axis point nearest the proxy.
-inline constexpr std::uint32_t kPlaneCapsule = 1u << 4;
-// A cylinder's plane: the cylinder travels with it (its axis is box_axis_x × box_axis_y through com_m, its radius
-// extent_m, its half length box_half_m[2]), so the haptic side takes its side's tangent plane again at the proxy every
-// tick and a cap's plane ends at the cap's rim, as a box face's does.
-inline constexpr std::uint32_t kPlaneCylinder = 1u << 5;
-// The planes that carry their body's axes and half sizes (box_axis_x, box_axis_y, box_half_m).
-inline constexpr std::uint32_t kPlaneCarriesShape = kPlaneBox | kPlaneCapsule | kPlaneCylinder;
+// A plane's shape travels in Plane::shape (a tagged descriptor, common/shape/shape_descriptor.h), not in flags.
 
 // LocalContact flags.
 // The other side holds a push along −normal: static geometry, or a body joined to static geometry by a chain of
@@ -90,16 +71,16 @@ struct Plane {
   Vec3 angular_velocity_radps{};  // angular velocity, world frame
   double static_friction = 0.0;   // coefficient, dimensionless
   double dynamic_friction = 0.0;  // coefficient, dimensionless, <= static_friction
-  // How far from point_m the plane still describes the object (world_manager/features/body_geometry.h plane_extent_m): a
+  // How far from point_m the plane still describes the object (common/shape/shape.h plane_extent_m): a
   // sphere's radius, a box's diagonal. 0: unbounded (the floor).
   double extent_m = 0.0;
-  // kPlaneBox or kPlaneCapsule: the body's x and y axes in the world frame (unit, orthogonal; z = x × y) and its half
-  // sizes along x, y, z (m): a box's (> 0), a capsule's radius, radius and half length between its cap centres (≥ 0),
-  // a cylinder's radius, radius and half length (> 0).
-  // Zero otherwise.
-  Vec3 box_axis_x{};
-  Vec3 box_axis_y{};
-  Vec3 box_half_m{};
+  // The body's shape (kind none for the floor), so the haptic side takes the plane again from it every tick
+  // (common/shape/shape.h retake_plane). For a kind whose traits carry axes, the body's x and y axes in the world frame
+  // (unit, orthogonal; z = x × y) about its centre com_m; zero otherwise (a sphere's plane carries its centre as
+  // point_m − radius·normal).
+  Shape shape;
+  Vec3 body_axis_x{};
+  Vec3 body_axis_y{};
   // Local response model for the coming world period (paper §6.3). Zero means "not provided": the haptic
   // side must then treat the object as immovable between world steps.
   double inverse_mass_per_kg = 0.0;
@@ -111,7 +92,7 @@ struct Plane {
   std::array<LocalContact, kMaxLocalContacts> local_contacts{};
 };
 
-// World → haptic, published once per world step i (DESIGN.md §1 step 5).
+// World → haptic, published once per world step i (docs/architecture.md §1.1 step 4).
 struct PlaneFrame {
   std::uint64_t frame_index = 0;       // i; 0 is the first frame of a world session
   std::uint64_t world_session = 0;     // changes when the world manager restarts
@@ -137,7 +118,7 @@ struct PlaneFrame {
 };
 
 // Running impulse on one object since the haptic session started (never reset while the session lives), so the world
-// applies `total - applied_so_far` whatever the timing and nothing is lost or counted twice (DESIGN.md §2).
+// applies `total - applied_so_far` whatever the timing and nothing is lost or counted twice (docs/architecture.md §2).
 struct ObjectImpulse {
   std::int32_t object_id = -1;
   // Incremented by the haptic side each time it (re)allocates an entry for this object: a new epoch restarts the
@@ -153,7 +134,7 @@ struct ObjectImpulse {
   std::uint64_t last_tick = 0;    // last haptic tick that added to this entry
 };
 
-// Haptic → world, published every haptic tick (DESIGN.md §1 "One haptic tick").
+// Haptic → world, published every haptic tick (docs/architecture.md §1.2).
 struct HapticReport {
   std::uint64_t tick = 0;           // haptic tick j of this session
   std::uint64_t haptic_session = 0; // nonzero; changes when the haptic controller restarts
@@ -177,7 +158,7 @@ struct HapticReport {
 
 inline constexpr int kStringCount = 4;
 
-// Haptic → device: the tensions to command (DESIGN.md §1 step 6).
+// Haptic → device: the tensions to command (docs/architecture.md §1.2 step 6).
 struct DeviceCommand {
   std::uint64_t tick = 0;
   std::uint64_t haptic_session = 0;

@@ -21,4 +21,9 @@ inline constexpr double kMaxStiffness_Npm = 1e6;
 // Contact damping: 10^4 N·s/m gives 10 kN at 1 m/s, a thousand times what a desktop device can exert.
 inline constexpr double kMaxDamping_Nspm = 1e4;
 
+// A body's sizes and radii: 0.1 mm (below a device's position resolution) to 1 km. ODE's solver loses all digits when
+// lengths differ by more than ~10^12; this range keeps a scene well inside that.
+inline constexpr double kMinLength_m = 1e-4;
+inline constexpr double kMaxLength_m = 1e3;
+
 }  // namespace impetus::limits

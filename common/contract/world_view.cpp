@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "common/contract/world_view.h"
 
+#include "common/shape/shape.h"
+
 #include <cmath>
 
 namespace impetus {
@@ -56,12 +58,8 @@ const char* scene_problem(const ViewScene& scene) {
   }
   for (std::uint32_t k = 0; k < scene.body_count; ++k) {
     const ViewBodyInfo& body = scene.bodies[k];
-    if (static_cast<std::uint32_t>(body.shape) > static_cast<std::uint32_t>(ViewShape::cylinder)) return "unknown shape";
-    if (!all_finite(body.box_size_m) || !std::isfinite(body.radius_m) || !std::isfinite(body.length_m) ||
-        body.box_size_m[0] < 0.0 || body.box_size_m[1] < 0.0 || body.box_size_m[2] < 0.0 || body.radius_m < 0.0 ||
-        body.length_m < 0.0) {
-      return "body size not finite and non-negative";
-    }
+    if (body.shape.kind == ShapeKind::none) return "a body without a shape";
+    if (const char* problem = shape_problem(body.shape); problem != nullptr) return problem;
     if (body.name.back() != '\0') return "body name not terminated";
   }
   return "";

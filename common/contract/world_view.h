@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// What a world shows its viewers (DESIGN.md §1, paper §6.1 "graphics"): the scene's shapes once, and after every
-// world step a snapshot of every body's pose and of each endpoint's finger, proxy, force and active planes.
-// Plain data of fixed capacity, SI units, world frame (right-handed, z up). Publishing it never waits on a viewer.
+// What a world shows its viewers (docs/architecture.md §1, paper §6.1 "graphics"): the scene's shapes once, and after
+// every world step a snapshot of every body's pose and of each endpoint's finger, proxy, force and active planes. Plain
+// data of fixed capacity, SI units, world frame (right-handed, z up). Publishing it never waits on a viewer.
 
 #include "common/contract/frames.h"
 #include "common/contract/vec3.h"
@@ -19,18 +19,14 @@ namespace impetus {
 // The largest scene a viewer can show. A shipped scene has at most a few hundred bodies; 2048 leaves room for the
 // 2000-body scenes the viewer's frame rate is measured on. Larger scenes run, and their viewers show the first 2048.
 inline constexpr std::uint32_t kMaxViewBodies = 2048;
-inline constexpr std::uint32_t kMaxViewEndpoints = 8;    // the world serves up to 8 endpoints (DESIGN.md §1)
+inline constexpr std::uint32_t kMaxViewEndpoints = 8;    // the world serves up to 8 endpoints (docs/architecture.md §1)
 inline constexpr std::uint32_t kMaxViewPlanes = 16;      // planes drawn per endpoint: those nearest the finger
 inline constexpr std::uint32_t kMaxViewNameBytes = 48;   // a body's name, NUL-terminated, cut to fit
 
-enum class ViewShape : std::uint32_t { box = 0, sphere = 1, capsule = 2, cylinder = 3 };
-
 struct ViewBodyInfo {
-  ViewShape shape = ViewShape::box;
+  Shape shape;  // common/shape/shape_descriptor.h
   std::uint32_t dynamic = 0;
-  Vec3 box_size_m{};      // box: full extents along body x, y, z
-  double radius_m = 0.0;  // sphere, capsule, cylinder
-  double length_m = 0.0;  // capsule: between the cap centres; cylinder: total; along body z
+  std::uint32_t reserved = 0;
   std::array<char, kMaxViewNameBytes> name{};
 };
 

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The device port (DESIGN.md §1, §2): a haptic node and its device, always on one machine. The host end belongs to the
-// haptic side's device driver; the device end to the device (spidar_sim, or a real device's bridge). Transports
-// (shared memory, in-process) encode, seal and validate, so both ends see only validated contract frames.
+// The device port (docs/architecture.md §1, §2): a haptic node and its device, always on one machine. The host end
+// belongs to the haptic side's device driver; the device end to the device (spidar_sim, or a real device's bridge).
+// Transports (shared memory, in-process) encode, seal and validate, so both ends see only validated contract frames.
 //
 // Attach: one device at a time claims the port; a device that detaches or dies frees it and the next may attach.
 // Lockstep: the host is the master; the device advances exactly once per turn. Real time: the device publishes

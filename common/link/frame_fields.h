@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The fields of the contract frames (common/contract/frames.h), listed once for every encoding of them: the contract
-// structs, the shared-memory wire frames (shm/wire_frames.h) and the DDS topic types (dds/world_link.idl) name their
+// structs, the shared-memory wire frames (shm/wire_frames.h) and the DDS topic types (dds/impetus_link.idl) name their
 // fields alike, so visit_X(a, b, f) calls f(a.field, b.field) for every field of X, whichever two of them a and b
 // are. A transport's f converts or copies; adding a field to the contract means adding it here and to each encoding.
 //
@@ -25,6 +25,14 @@ void visit_contact(A& a, B& b, F&& f) {
 }
 
 template <class A, class B, class F>
+void visit_shape(A& a, B& b, F&& f) {
+  f(a.kind, b.kind);
+  f(a.box_size_m, b.box_size_m);
+  f(a.radius_m, b.radius_m);
+  f(a.length_m, b.length_m);
+}
+
+template <class A, class B, class F>
 void visit_plane(A& a, B& b, F&& f) {
   f(a.object_id, b.object_id);
   f(a.flags, b.flags);
@@ -36,9 +44,9 @@ void visit_plane(A& a, B& b, F&& f) {
   f(a.static_friction, b.static_friction);
   f(a.dynamic_friction, b.dynamic_friction);
   f(a.extent_m, b.extent_m);
-  f(a.box_axis_x, b.box_axis_x);
-  f(a.box_axis_y, b.box_axis_y);
-  f(a.box_half_m, b.box_half_m);
+  visit_shape(a.shape, b.shape, f);
+  f(a.body_axis_x, b.body_axis_x);
+  f(a.body_axis_y, b.body_axis_y);
   f(a.inverse_mass_per_kg, b.inverse_mass_per_kg);
   f(a.inverse_inertia_world, b.inverse_inertia_world);
   f(a.local_contact_count, b.local_contact_count);

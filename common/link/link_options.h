@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Which transport carries the world link (DESIGN.md §2), as the daemons' --link flags choose it: shared memory on one
-// host (the default; lockstep and real time), or DDS across hosts (real time; common/link/dds).
+// Which transport carries the world link (docs/architecture.md §2), as the daemons' --link flags choose it: shared
+// memory on one host (the default; lockstep and real time), or DDS across hosts (real time; common/link/dds).
 
 #include <cstdint>
 #include <string>

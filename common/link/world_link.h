@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The world link (DESIGN.md §1, §2): plane frames from the world to each endpoint, running impulse totals and the
-// finger back. Two ends, each an interface the nodes talk through; the transports (shared memory, in-process) encode,
-// seal and validate, so a node only ever sees contract frames that passed validation.
+// The world link (docs/architecture.md §1, §2): plane frames from the world to each endpoint, running impulse totals
+// and the finger back. Two ends, each an interface the nodes talk through; the transports (shared memory, in-process)
+// encode, seal and validate, so a node only ever sees contract frames that passed validation.
 //
 // Threading: each end is used by its node's loop thread, except WorldLinkClient::reattach(), which a real-time haptic
 // node calls from its supervisor thread while the servo thread keeps reading (implementations make that safe).
@@ -76,8 +76,8 @@ class WorldLinkClient {
   // follower waiting in wait_follower_turn().
   virtual void end_session() = 0;
 
-  // Several controllers on one lockstep world (DESIGN.md §3): the first is the master, the others follow its ticks.
-  // Whether this end is a follower.
+  // Several controllers on one lockstep world (docs/architecture.md §3): the first is the master, the others follow its
+  // ticks. Whether this end is a follower.
   virtual bool follower() const { return false; }
   // Master, before its first tick: waits until `count` followers have attached (a lockstep run of several users
   // starts when they are all there); false if a stop was requested first.

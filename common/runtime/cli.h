@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The command-line vocabulary every node's main.cpp shares (DESIGN.md §4): the same flag names, checks and wording
-// everywhere, and bad values rejected with the flag, the value and the reason.
+// The command-line vocabulary every node's main.cpp shares (docs/architecture.md §4): the same flag names, checks and
+// wording everywhere, and bad values rejected with the flag, the value and the reason.
 
 #include "common/contract/frames.h"
 #include "common/contract/limits.h"

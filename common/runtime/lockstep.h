@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Turn-taking for `--clock lockstep` (DESIGN.md §3): the haptic controller's tick count is the master clock; the device
-// advances once per haptic tick and the world steps at tick i·n + phase. A follower sleeps on an interprocess semaphore
-// until the master gives it a turn, does its step, and hands the turn back — no long spinning (the machine has 2 cores) and
-// the order of every read and write is fixed, so runs are bitwise reproducible.
+// Turn-taking for `--clock lockstep` (docs/architecture.md §3): the haptic controller's tick count is the master clock;
+// the device advances once per haptic tick and the world steps at tick i·n + phase. A follower sleeps on an
+// interprocess semaphore until the master gives it a turn, does its step, and hands the turn back — no long spinning
+// (the machine has 2 cores) and the order of every read and write is fixed, so runs are bitwise reproducible.
 //
 // Every wait is sliced (kWaitSlice) so a waiter notices a dead peer or a shutdown request instead of hanging forever.
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The multi-rate schedule of `--clock lockstep` (DESIGN.md §3): the haptic tick is the master clock and world step i
-// happens at haptic tick i·n + phase, n = T_w / T the haptic ticks per world period.
+// The multi-rate schedule of `--clock lockstep` (docs/architecture.md §3): the haptic tick is the master clock and
+// world step i happens at haptic tick i·n + phase, n = T_w / T the haptic ticks per world period.
 
 #include <cmath>
 #include <cstdint>

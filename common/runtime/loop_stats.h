@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Loop statistics every daemon publishes on its link (DESIGN.md §2: heartbeat and loop statistics), and the fixed-size
-// lateness histogram behind the percentiles: recording a sample is O(1) and never allocates, so the 1 kHz loop can
-// record every tick.
+// Loop statistics every daemon publishes on its link (docs/architecture.md §2: heartbeat and loop statistics), and the
+// fixed-size lateness histogram behind the percentiles: recording a sample is O(1) and never allocates, so the 1 kHz
+// loop can record every tick.
 
 #include <array>
 #include <cstdint>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The real-time clock of a periodic loop (DESIGN.md §3, `--clock realtime`).
+// The real-time clock of a periodic loop (docs/architecture.md §3, `--clock realtime`).
 //
 // Deadlines are absolute (clock_nanosleep with TIMER_ABSTIME on CLOCK_MONOTONIC), so lateness in one period does not
 // shift the next. When the loop wakes more than a period late (a host stall: up to 60 ms on this VM) the missed periods
@@ -52,7 +52,7 @@ LoopStats loop_stats_now(const RealtimeClock* clock);
 
 // Asks for SCHED_FIFO at `priority`, locks memory (mlockall) and sets a 1 ns timer slack for the calling thread.
 // Returns "" if everything was granted, else a warning naming what was refused and why; the caller prints it and
-// carries on (DESIGN.md §3).
+// carries on (docs/architecture.md §3).
 std::string request_realtime(int fifo_priority);
 
 }  // namespace impetus

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// When a peer counts as silent (DESIGN.md §2 "Staleness"): one policy, used by every node and transport.
+// When a peer counts as silent (docs/architecture.md §2 "Staleness"): one policy, used by every node and transport.
 //
 //   a world silent for kWorldStalePeriods world periods  → the haptic side keeps its last planes, no extrapolation;
 //   a device silent for kDeviceStale_s                   → the driver commands minimum output;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "common/spidar/geometry.h"
 
+#include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
 
 #include <nlohmann/json.hpp>
@@ -16,22 +17,15 @@ namespace {
   throw SpidarGeometryError(path + ": " + key + ": " + reason);
 }
 
-// A quote of a value: scalars as written (capped), containers by size; never a recursive dump of a deep document.
-std::string quote(const nlohmann::json& value) {
-  if (value.is_array()) return "an array of " + std::to_string(value.size()) + " elements";
-  if (value.is_object()) return "an object with " + std::to_string(value.size()) + " keys";
-  return excerpt(value.dump(), 80);
-}
-
 // A value in (0, highest]: each key's bound is given with its reason where the key is read.
 double positive(const nlohmann::json& document, const std::string& path, const char* key, double fallback,
                 double highest) {
   if (!document.contains(key)) return fallback;
   const nlohmann::json& value = document.at(key);
-  if (!value.is_number()) fail(path, key, "must be a number, got " + quote(value));
+  if (!value.is_number()) fail(path, key, "must be a number, got " + quote_json(value));
   const double number = value.get<double>();
   if (!std::isfinite(number) || !(number > 0.0) || number > highest) {
-    fail(path, key, "must be positive and at most " + readable(highest) + ", got " + quote(value));
+    fail(path, key, "must be positive and at most " + readable(highest) + ", got " + quote_json(value));
   }
   return number;
 }
@@ -74,7 +68,7 @@ SpidarGeometry load_spidar_geometry(const std::string& path) {
     for (int a = 0; a < 3; ++a) {
       if (!centre[a].is_number() || !(std::abs(centre[a].get<double>()) <= kMaxFrameSide_m)) {
         fail(path, "centre_m", "must hold three numbers within ±" + readable(kMaxFrameSide_m) + " m, got " +
-                                   quote(centre[a]));
+                                   quote_json(centre[a]));
       }
       geometry.centre_m[a] = centre[a].get<double>();
     }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "examples/generic_device/generic_impedance_device.h"
 
+#include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
 #include "common/runtime/process.h"
 
@@ -54,31 +55,24 @@ std::string vector_text(const Eigen::Vector3d& v) {
   throw GenericDeviceConfigError(path + ": " + key + ": " + reason);
 }
 
-// A quote of a value: scalars as written (capped), containers by size; never a dump of a deep document.
-std::string quote(const nlohmann::json& value) {
-  if (value.is_array()) return "an array of " + std::to_string(value.size()) + " elements";
-  if (value.is_object()) return "an object with " + std::to_string(value.size()) + " keys";
-  return excerpt(value.dump(), 80);
-}
-
 const nlohmann::json& required(const nlohmann::json& document, const std::string& path, const char* key) {
   if (!document.contains(key)) fail(path, key, "missing (every key but max_reading_age_s is required)");
   return document.at(key);
 }
 
 double number(const nlohmann::json& value, const std::string& path, const std::string& key) {
-  if (!value.is_number()) fail(path, key, "must be a number, got " + quote(value));
+  if (!value.is_number()) fail(path, key, "must be a number, got " + quote_json(value));
   return value.get<double>();
 }
 
 Eigen::Vector3d vector3(const nlohmann::json& value, const std::string& path, const std::string& key) {
-  if (!value.is_array() || value.size() != 3) fail(path, key, "must be [x, y, z], got " + quote(value));
+  if (!value.is_array() || value.size() != 3) fail(path, key, "must be [x, y, z], got " + quote_json(value));
   return {number(value[0], path, key), number(value[1], path, key), number(value[2], path, key)};
 }
 
 Eigen::Matrix3d matrix3(const nlohmann::json& value, const std::string& path, const std::string& key) {
   if (!value.is_array() || value.size() != 3) {
-    fail(path, key, "must be three rows of three numbers, got " + quote(value));
+    fail(path, key, "must be three rows of three numbers, got " + quote_json(value));
   }
   Eigen::Matrix3d matrix;
   for (int row = 0; row < 3; ++row) matrix.row(row) = vector3(value[row], path, key).transpose();

@@ -9,7 +9,7 @@
 //   GenericImpedanceDevice  staleness and range checks, the force limit, minimum output (zero force).
 //
 // Units and frames: what the servo sees is SI in the world frame (metres, newtons, seconds; right-handed, z up,
-// DESIGN.md §4). Only the backend speaks the device frame.
+// docs/architecture.md §4). Only the backend speaks the device frame.
 //
 // Threading: one servo thread owns the device. read(), command() and counters() never allocate, lock, throw or block;
 // wait_attached() sleeps (lockstep only, between ticks). The constructor and load_generic_device_config() throw for

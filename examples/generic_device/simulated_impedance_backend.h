@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// A simulated impedance device behind ImpedanceBackend, beside the real ones (STYLE.md "Seams"): an end effector that
-// stays where it is put, or moves by a fixed step per reading (one reading per lockstep tick), and a record of the
-// forces written to it. Faults on request: silence (its readings go stale), NaN, a position anywhere, any reading
-// age, unplugging (a device lost), closing (a clean end, as spidar_sim detaches when its trajectory ends).
+// A simulated impedance device behind ImpedanceBackend, beside the real ones (docs/architecture.md §7): an end effector
+// that stays where it is put, or moves by a fixed step per reading (one reading per lockstep tick), and a record of the
+// forces written to it. Faults on request: silence (its readings go stale), NaN, a position anywhere, any reading age,
+// unplugging (a device lost), closing (a clean end, as spidar_sim detaches when its trajectory ends).
 //
 // Positions are in the device frame and the device's length unit, forces in the device frame (newtons), exactly what
 // a vendor backend would see. One thread: the test drives it between the servo's calls. poll() and write_force()

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Several one-finger devices as one device of several fingers (DESIGN.md §1.2): a SPIDAR with a string set per
-// finger is a SpidarDriver per finger, each on its own device port. Finger k of the set is device k.
+// Several one-finger devices as one device of several fingers (docs/architecture.md §1.2): a SPIDAR with a string set
+// per finger is a SpidarDriver per finger, each on its own device port. Finger k of the set is device k.
 //
 // Lockstep: read() gives each finger's device its turn in finger order, so a tick is one deterministic sequence.
 // Real time: each finger's newest reading; a finger whose device is absent or stale is marked not present (its servo

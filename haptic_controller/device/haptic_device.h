@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// A haptic device as the servo sees it (DESIGN.md §1.2): finger samples in, forces out, within its limits. What a
-// device is made of — strings and encoders (SpidarDriver), linkages, a network bridge — stays behind this interface,
-// so the servo is `tick(finger sample, dt) -> force` for any of them.
+// A haptic device as the servo sees it (docs/architecture.md §1.2): finger samples in, forces out, within its limits.
+// What a device is made of — strings and encoders (SpidarDriver), linkages, a network bridge — stays behind this
+// interface, so the servo is `tick(finger sample, dt) -> force` for any of them.
 //
 // Called from the servo thread once per tick: read() first, then command(). Implementations do not allocate, lock or
 // throw there; read() may block only in lockstep (the device's turn).

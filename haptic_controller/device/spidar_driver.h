@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The SPIDAR driver: a HapticDevice made of three parts, each testable alone (DESIGN.md §1.2) —
+// The SPIDAR driver: a HapticDevice made of three parts, each testable alone (docs/architecture.md §1.2) —
 //   SpidarKinematics      encoder counts → finger position;
 //   distribute_tension    force on the finger → four string tensions within [t_min, t_max];
 //   DevicePortHost        the port the counts arrive on and the tensions leave by (shared memory or in-process).
@@ -29,8 +29,6 @@ class SpidarDriver final : public HapticDevice {
   bool command(std::uint64_t tick, const Eigen::Vector3d& force_N, bool render) override;
   void end_session() override { port_.end_session(); }
   DeviceCounters counters() const override;
-
-  const std::array<double, kStringCount>& last_tensions_N() const { return command_.tension_N; }
 
  private:
   SpidarGeometry geometry_;

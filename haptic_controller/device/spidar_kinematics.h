@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// SPIDAR kinematics (DESIGN.md §1 haptic tick step 1): encoder counts ↔ string lengths ↔ finger position.
+// SPIDAR kinematics (docs/architecture.md §1.2 step 1): encoder counts ↔ string lengths ↔ finger position.
 //
 // Zero of the encoders: a count is an absolute string length, length_m = count · metres_per_count, so count 0 means
 // the finger cap sits at the motor's string exit. The device (or spidar_sim) is calibrated that way at start-up; the

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Tension distribution (DESIGN.md §1 haptic tick step 6): the force on the finger → four string tensions.
+// Tension distribution (docs/architecture.md §1.2 step 6): the force on the finger → four string tensions.
 //
 // Strings only pull: tension t_i acts along u_i, the unit vector from the finger toward motor i, so the force is A·t
 // with A = [u_0 u_1 u_2 u_3]. We solve the box-constrained least-squares problem

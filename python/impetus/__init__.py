@@ -60,10 +60,10 @@ class Trial:
     """The outcome of one trial.
 
     summary  summary.json's document as a dict: "objects" (each dynamic object at the end: "position", "velocity",
-             "impulse_Ns", ...), "world", "haptic", "device" and "config" (README, "What a trial leaves").
+             "impulse_Ns", ...), "world", "haptic", "device" and "config" (README, "Where the results are").
     logs     {"world", "haptic", "device"} -> {column name -> numpy float64 array, one value per row}: the world's
              state per step, the servo's finger, proxy and force per tick, the device's per tick. Column names carry
-             their units (DESIGN.md §4). Empty when run_trial was called with logs=False.
+             their units (docs/architecture.md §4). Empty when run_trial was called with logs=False.
     out_dir  where the logs and summary.json were written, or None (a temporary directory, removed).
     """
 
@@ -95,7 +95,7 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
     """Runs one trial and returns its Trial.
 
     scene          a scene file (str or path; shipped_scene("tap") for a shipped one)
-    trajectory     the finger's path: a built-in ("tap", "tap:speed=0.2", "hold", ...) or a trajectory CSV file, as
+    trajectory     the finger's path: a built-in ("tap", "tap:speed=0.2", "press", ...) or a trajectory CSV file, as
                    spidar_sim --trajectory takes; or, for a device of several fingers, a dict {name: path} in finger
                    order (spidar_sim --finger NAME=PATH), each finger an endpoint of the world (Trial.logs holds
                    the first finger's logs)

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The daemons' CSV logs of one trial (DESIGN.md §4: a header row, time first, units in the column names):
+"""The daemons' CSV logs of one trial (docs/architecture.md §4: a header row, time first, units in the column names):
 
   world.csv   world_manager: one row per world step, the state after it; per object NAME.x_m .. NAME.z_m,
               NAME.qw .. NAME.qz, NAME.vx_mps .., NAME.wx_radps .., and the impulses NAME.jx_Ns .., NAME.jx_total_Ns ..

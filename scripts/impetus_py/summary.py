@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""summary.json, the machine-readable outcome of one trial (DESIGN.md §4), on the Python side. scripts/run.sh has
+"""summary.json, a trial's machine-readable outcome (docs/architecture.md §4), on the Python side. scripts/run.sh has
 summarize_trial.py merge it from the daemons' own summaries; every other script reads it through Summary.
 
   {"objects": {NAME: {"position", "orientation", "velocity", "angular_velocity", "impulse_Ns",

@@ -3,11 +3,12 @@
 
   module     the impetus Python package (python/, built into BUILD/python): the three nodes in this process, no
              process started; the default whenever the package is built
-  processes  the three daemons through scripts/run.sh (DESIGN.md §3); used when the package is not built (sanitizer
-             builds do not build it: their daemons are what such a run checks) or when IMPETUS_TRIALS=processes
+  processes  the three daemons through scripts/run.sh (docs/architecture.md §3); used when the package is not built
+             (sanitizer builds do not build it: their daemons are what such a run checks) or when
+             IMPETUS_TRIALS=processes
 
 Both give the same trial bit for bit (tests/python/test_impetus_module.py); the module is several times faster per
-trial (README, "Use it from Python").
+trial (README, "From Python").
 """
 import importlib
 import os

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-// What the finger feels at a box's edge between world frames, for the README's figure (scripts/edge_figure.py).
-// A finger pressed 3 mm into the top of a static 5 cm box slides along +x at 0.2 m/s and off the +x edge, at the
-// top's depth: beyond the edge it is in free space beside the box. A 20 Hz world sends its planes; the servo renders
-// them (a) as the world sent them, a face's plane until the next frame (the shape stripped from each plane), and (b)
-// taken again at the proxy every tick (shape_planes.h). The exact god-object: K·depth over the face, nothing past it.
-// Prints CSV: time_s, finger_x_m (from the edge), then the upward force in N of (a), (b) and the exact one.
+// What the finger feels at a box's edge between world frames, for the figure in docs/results.md
+// (scripts/edge_figure.py). A finger pressed 3 mm into the top of a static 5 cm box slides along +x at 0.2 m/s and off
+// the +x edge, at the top's depth: beyond the edge it is in free space beside the box. A 20 Hz world sends its planes;
+// the servo renders them (a) as the world sent them, a face's plane until the next frame (the shape stripped from each
+// plane), and (b) taken again at the proxy every tick (shape_planes.h). The exact god-object: K·depth over the face,
+// nothing past it. Prints CSV: time_s, finger_x_m (from the edge), then the upward force in N of (a), (b) and the exact
+// one.
 
 #include "haptic_controller/servo.h"
 #include "world_manager/engine/ode_runtime.h"
@@ -65,7 +66,7 @@ int main() {
       report.haptic_session = 1;
       const PlaneFrame& frame = world.step(&report);
       PlaneFrame stripped = frame;
-      for (std::uint32_t k = 0; k < stripped.plane_count; ++k) stripped.planes[k].flags &= ~kPlaneCarriesShape;
+      for (std::uint32_t k = 0; k < stripped.plane_count; ++k) stripped.planes[k].shape = Shape{};
       as_sent.on_plane_frame(stripped, t_s);
       retaken.on_plane_frame(frame, t_s);
     }

@@ -78,35 +78,46 @@ TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {
           f.planes[0].local_contacts[0].other_inverse_mass_per_kg = -1.0;
         }) == FrameError::bad_mass);
   CHECK(rejected([&](PlaneFrame& f) { f.reach_radius_m = nan; }) == FrameError::not_finite);
-  // A box's plane carries the box: orthonormal axes and positive half sizes, or the frame is refused.
+  // A box's plane carries the box: orthonormal axes and sizes within the scene's limits, or the frame is refused.
   const auto box = [](PlaneFrame& f) {
-    f.planes[0].flags |= kPlaneBox;
-    f.planes[0].box_axis_x = {1.0, 0.0, 0.0};
-    f.planes[0].box_axis_y = {0.0, 1.0, 0.0};
-    f.planes[0].box_half_m = {0.025, 0.025, 0.025};
+    f.planes[0].shape.kind = ShapeKind::box;
+    f.planes[0].shape.box_size_m = {0.05, 0.05, 0.05};
+    f.planes[0].body_axis_x = {1.0, 0.0, 0.0};
+    f.planes[0].body_axis_y = {0.0, 1.0, 0.0};
   };
   CHECK(rejected(box) == FrameError::ok);
-  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_axis_y = {0.0, 0.0, 1.001}; }) == FrameError::bad_box);
-  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_axis_y = {0.1, 0.995, 0.0}; }) == FrameError::bad_box);
-  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_half_m[1] = 0.0; }) == FrameError::bad_box);
-  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].box_half_m[2] = nan; }) == FrameError::not_finite);
-  // A capsule's likewise, its half length between the cap centres may be 0 (a ball), its radius not.
+  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].body_axis_y = {0.0, 0.0, 1.001}; }) == FrameError::bad_shape);
+  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].body_axis_y = {0.1, 0.995, 0.0}; }) == FrameError::bad_shape);
+  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].shape.box_size_m[1] = 0.0; }) == FrameError::bad_shape);
+  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].shape.box_size_m[2] = nan; }) == FrameError::not_finite);
+  CHECK(rejected([&](PlaneFrame& f) { box(f); f.planes[0].shape.kind = static_cast<ShapeKind>(99); }) ==
+        FrameError::bad_shape);
+  // A capsule's likewise, its length between the cap centres may be 0 (a ball), its radius not.
   const auto capsule = [&](PlaneFrame& f) {
     box(f);
-    f.planes[0].flags = kPlaneCapsule;
-    f.planes[0].box_half_m = {0.01, 0.01, 0.0};
+    f.planes[0].shape = Shape{};
+    f.planes[0].shape.kind = ShapeKind::capsule;
+    f.planes[0].shape.radius_m = 0.01;
   };
   CHECK(rejected(capsule) == FrameError::ok);
-  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].box_half_m[0] = 0.0; }) == FrameError::bad_box);
-  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].box_half_m[2] = -0.01; }) == FrameError::bad_box);
-  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].box_axis_x = {0.0, 1.0, 0.0}; }) ==
-        FrameError::bad_box);
+  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].shape.radius_m = 0.0; }) == FrameError::bad_shape);
+  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].shape.length_m = -0.01; }) == FrameError::bad_shape);
+  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].body_axis_x = {0.0, 1.0, 0.0}; }) ==
+        FrameError::bad_shape);
   // A cylinder's: a length it must have.
-  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].flags = kPlaneCylinder; }) == FrameError::bad_box);
+  CHECK(rejected([&](PlaneFrame& f) { capsule(f); f.planes[0].shape.kind = ShapeKind::cylinder; }) ==
+        FrameError::bad_shape);
   CHECK(rejected([&](PlaneFrame& f) {
           capsule(f);
-          f.planes[0].flags = kPlaneCylinder;
-          f.planes[0].box_half_m[2] = 0.03;
+          f.planes[0].shape.kind = ShapeKind::cylinder;
+          f.planes[0].shape.length_m = 0.06;
+        }) == FrameError::ok);
+  // A sphere's carries no axes: none are checked.
+  CHECK(rejected([&](PlaneFrame& f) {
+          capsule(f);
+          f.planes[0].shape.kind = ShapeKind::sphere;
+          f.planes[0].body_axis_x = {};
+          f.planes[0].body_axis_y = {};
         }) == FrameError::ok);
   // Planes past the count are not looked at: garbage there is harmless.
   CHECK(rejected([&](PlaneFrame& f) { f.planes[5].point_m[0] = nan; }) == FrameError::ok);

@@ -84,7 +84,7 @@ PlaneFrame box_frame(std::uint64_t index) {
   for (std::uint32_t k = 0; k < 2; ++k) {
     Plane& plane = frame.planes[k];
     plane.object_id = static_cast<std::int32_t>(k);
-    plane.flags = kPlaneDynamic | kPlaneFlat | kPlaneBox;
+    plane.flags = kPlaneDynamic;
     plane.point_m = {0.005, 0.001 * k, 0.025};
     plane.normal = {-1.0, 0.0, 0.0};
     plane.com_m = {0.03, 0.0, 0.025};
@@ -92,9 +92,10 @@ PlaneFrame box_frame(std::uint64_t index) {
     plane.static_friction = 0.6;
     plane.dynamic_friction = 0.4;
     plane.extent_m = 0.043;
-    plane.box_axis_x = {1.0, 0.0, 0.0};
-    plane.box_axis_y = {0.0, 1.0, 0.0};
-    plane.box_half_m = {0.025, 0.025, 0.025};
+    plane.shape.kind = ShapeKind::box;
+    plane.shape.box_size_m = {0.05, 0.05, 0.05};
+    plane.body_axis_x = {1.0, 0.0, 0.0};
+    plane.body_axis_y = {0.0, 1.0, 0.0};
     plane.inverse_mass_per_kg = 1.0;
     plane.inverse_inertia_world = {2400.0, 0.0, 0.0, 0.0, 2400.0, 0.0, 0.0, 0.0, 2400.0};
     plane.local_contact_count = 1;

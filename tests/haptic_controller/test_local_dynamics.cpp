@@ -104,14 +104,11 @@ TEST_CASE("local dynamics: a cube sliding on the floor loses mu*g*h per world su
 
 TEST_CASE("local dynamics: a box on the floor brakes its spin at its four corners with the world's friction pyramid, "
           "and a box that only slides does not turn") {
-  // The 1 kg, 5 cm cube resting on its face (kPlaneBox), floor friction 0.06, for `ticks` ticks (a 5 ms drift substep
+  // The 1 kg, 5 cm cube resting on its face, floor friction 0.06, for `ticks` ticks (a 5 ms drift substep
   // starts every 5).
   auto box_on_floor = [](const Vector3d& velocity_mps, const Vector3d& angular_radps, int ticks) {
     Plane face = cube_face();
-    face.flags |= kPlaneBox | kPlaneFlat;
-    face.box_axis_x = {1, 0, 0};
-    face.box_axis_y = {0, 1, 0};
-    face.box_half_m = {0.025, 0.025, 0.025};
+    impetus::test::set_shape(face, impetus::test::box_shape(Vector3d::Constant(0.025)));
     face.velocity_mps = to_vec3(velocity_mps);
     face.angular_velocity_radps = to_vec3(angular_radps);
     add_support(face, Vector3d::UnitZ(), 0.06);
@@ -385,8 +382,7 @@ namespace {
 // A ball of radius 1 cm resting on the floor (support +z, friction 0.5) and moving at `velocity`, spinning at `spin`.
 Plane ball_on_floor(const Vector3d& velocity_mps, const Vector3d& spin_radps) {
   Plane plane = spinning_ball(Vector3d(0.0, 0.0, 0.01), spin_radps);
-  plane.flags |= impetus::kPlaneSphere;
-  plane.extent_m = 0.01;
+  impetus::test::set_shape(plane, impetus::test::round_shape(impetus::ShapeKind::sphere, 0.01));
   plane.velocity_mps = to_vec3(velocity_mps);
   add_support(plane, Vector3d::UnitZ(), 0.5);
   return plane;
@@ -420,14 +416,12 @@ TEST_CASE("local dynamics: a spinning cylinder's and capsule's axes turn with th
   // A cylinder and a capsule lying along x, spinning end over end about z at 1 rad/s; the plane is the side's top. In
   // 100 ticks the axis turns 0.1 rad, as the world's will; the plane itself is only carried with the centre (the
   // servo takes it again from the turned shape, shape_planes.h).
-  for (const std::uint32_t kind : {kPlaneCylinder, kPlaneCapsule}) {
+  for (const impetus::ShapeKind kind : {impetus::ShapeKind::cylinder, impetus::ShapeKind::capsule}) {
     Plane plane = wire_plane(3, {0.0, 0.0, 0.01}, {0, 0, 1});
-    plane.flags |= kind;
-    plane.extent_m = 0.01;
     plane.com_m = {0.0, 0.0, 0.0};
-    plane.box_axis_x = {0.0, 1.0, 0.0};
-    plane.box_axis_y = {0.0, 0.0, 1.0};  // body z along world x
-    plane.box_half_m = {0.01, 0.01, 0.02};
+    Eigen::Matrix3d along_x;
+    along_x << 0, 0, 1, 1, 0, 0, 0, 1, 0;  // body x, y, z along world y, z, x
+    impetus::test::set_shape(plane, impetus::test::round_shape(kind, 0.01, 0.04), along_x);
     plane.inverse_mass_per_kg = 1.0;
     plane.inverse_inertia_world = {1e4, 0, 0, 0, 1e4, 0, 0, 0, 1e4};
     plane.angular_velocity_radps = {0.0, 0.0, 1.0};
@@ -438,7 +432,7 @@ TEST_CASE("local dynamics: a spinning cylinder's and capsule's axes turn with th
       model.advance(kTick_s);
       model.render(tick / 50.0, Vector3d(0.0, 0.0, 0.02), planes);
     }
-    const Vector3d axis = planes.planes[0].box_axes.col(2);
+    const Vector3d axis = planes.planes[0].axes.col(2);
     CHECK((axis - Vector3d(std::cos(0.1), std::sin(0.1), 0.0)).norm() < 1e-9);
     CHECK((planes.planes[0].normal - Vector3d::UnitZ()).norm() < 1e-12);
   }

@@ -126,11 +126,8 @@ TEST_CASE("a box whose face flips between frames moves with its body whichever f
   // held where frame i−1 left it, the box would close over the proxy for half a period.
   auto box_plane = [](double x_m, const Vector3d& point, const Vector3d& normal) {
     Plane plane = wire_plane(5, point, normal);
-    plane.flags |= kPlaneFlat | kPlaneBox;
     plane.com_m = {x_m, 0.0, 0.0};
-    plane.box_axis_x = {1.0, 0.0, 0.0};
-    plane.box_axis_y = {0.0, 1.0, 0.0};
-    plane.box_half_m = {0.01, 0.01, 0.01};
+    impetus::test::set_shape(plane, impetus::test::box_shape(Vector3d::Constant(0.01)));
     return plane;
   };
   const PlaneFrame previous = make_frame({box_plane(0.0, {0.01, 0.0, 0.0}, {1, 0, 0})}, 0);

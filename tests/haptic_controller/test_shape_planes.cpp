@@ -27,7 +27,7 @@ namespace {
 // A ball of radius 1 cm at `centre`, its tangent plane at its top (where the world saw the finger).
 ContactPlane ball_plane(const Vector3d& centre, int id = 4) {
   ContactPlane plane = make_plane(centre + Vector3d(0, 0, 0.01), {0, 0, 1}, id, true);
-  plane.flags |= kPlaneSphere;
+  plane.shape = test::round_shape(ShapeKind::sphere, 0.01);
   plane.extent_m = 0.01;
   plane.com_m = centre;
   return plane;
@@ -63,7 +63,7 @@ TEST_CASE("sphere planes: a push along the normal turns nothing, wherever the pr
   REQUIRE((turned - Vector3d(0, 1e-5, 0)).norm() < 1e-15);
   // A flat face keeps the lever of the proxy.
   ContactPlane face = plane;
-  face.flags &= ~kPlaneSphere;
+  face.shape = Shape{};
   REQUIRE(face.angular_impulse_Nms(proxy, Vector3d(0, 0, -0.002)).norm() > 1e-6);
 }
 
@@ -77,11 +77,8 @@ Plane box_top_plane(const Vector3d& centre, const Eigen::Quaterniond& turn, cons
   Vector3d local = axes.transpose() * (query - centre);
   local.z() = half.z();
   Plane plane = test::wire_plane(3, centre + axes * local, axes.col(2), false);
-  plane.flags |= kPlaneFlat | kPlaneBox;
   plane.com_m = to_vec3(centre);
-  plane.box_axis_x = to_vec3(axes.col(0));
-  plane.box_axis_y = to_vec3(axes.col(1));
-  plane.box_half_m = to_vec3(half);
+  test::set_shape(plane, test::box_shape(half), axes);
   return plane;
 }
 
@@ -94,7 +91,7 @@ TEST_CASE("box planes: a face's plane stays over the face, past its rim the box'
     const Eigen::Matrix3d axes = turn.toRotationMatrix();
     const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
     const ContactPlane top = to_contact_plane(box_top_plane(centre, turn, at(0.0, 0.0, 0.06)));
-    REQUIRE(top.box());
+    REQUIRE(top.shape.kind == ShapeKind::box);
     const auto retaken = [&](const Vector3d& proxy) {
       PlaneSet planes = make_set({top});
       retake_shape_planes(planes, proxy);
@@ -187,12 +184,8 @@ Plane capsule_plane(const Vector3d& centre, const Eigen::Quaterniond& turn) {
   const Eigen::Matrix3d axes = turn.toRotationMatrix();
   const Vector3d up = axes.col(0);  // the body x: square to the axis
   Plane plane = test::wire_plane(6, centre + 0.01 * up, up, false);
-  plane.flags |= kPlaneCapsule;
-  plane.extent_m = 0.01;
   plane.com_m = to_vec3(centre);
-  plane.box_axis_x = to_vec3(axes.col(0));
-  plane.box_axis_y = to_vec3(axes.col(1));
-  plane.box_half_m = {0.01, 0.01, 0.03};
+  test::set_shape(plane, test::round_shape(ShapeKind::capsule, 0.01, 0.06), axes);
   return plane;
 }
 
@@ -206,7 +199,7 @@ TEST_CASE("capsule planes: the tangent plane about the axis point nearest the pr
     const Vector3d centre(0.02, -0.01, 0.03);
     const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
     ContactPlane plane = to_contact_plane(capsule_plane(centre, turn));
-    REQUIRE(plane.capsule());
+    REQUIRE(plane.shape.kind == ShapeKind::capsule);
     PlaneSet planes = make_set({plane});
     // Beside the side, 2 cm along the axis from the middle: the side's plane there, not the middle's.
     retake_shape_planes(planes, at(0.0, 0.015, 0.02));
@@ -279,12 +272,8 @@ namespace {
 ContactPlane cylinder_top_plane(const Vector3d& centre, const Eigen::Quaterniond& turn) {
   const Eigen::Matrix3d axes = turn.toRotationMatrix();
   Plane plane = test::wire_plane(7, centre + 0.03 * axes.col(2), axes.col(2), false);
-  plane.flags |= kPlaneCylinder;
-  plane.extent_m = 0.02;
   plane.com_m = to_vec3(centre);
-  plane.box_axis_x = to_vec3(axes.col(0));
-  plane.box_axis_y = to_vec3(axes.col(1));
-  plane.box_half_m = {0.02, 0.02, 0.03};
+  test::set_shape(plane, test::round_shape(ShapeKind::cylinder, 0.02, 0.06), axes);
   return to_contact_plane(plane);
 }
 
@@ -297,7 +286,7 @@ TEST_CASE("cylinder planes: a cap's plane stays over the cap and ends at its rim
     const Vector3d centre(-0.01, 0.02, 0.05);
     const auto at = [&](double x, double y, double z) { return Vector3d(centre + axes * Vector3d(x, y, z)); };
     const ContactPlane top = cylinder_top_plane(centre, turn);
-    REQUIRE(top.cylinder());
+    REQUIRE(top.shape.kind == ShapeKind::cylinder);
     // Over the cap, anywhere within the rim: the plane stays as it came.
     PlaneSet planes = make_set({top});
     retake_shape_planes(planes, at(0.015, -0.005, 0.04));
@@ -442,16 +431,14 @@ TEST_CASE("a finger inside a long cylinder or capsule is held by its plane howev
   // A cylinder and a capsule of radius 1 cm, 8 cm long, lying along x; the plane is the side's top at x = −3 cm, where
   // the world saw the proxy. The finger is 5 mm into the side at x = +2 cm, 5 cm from the plane's point along it: more
   // than the radius, within the body.
-  for (const std::uint32_t kind : {kPlaneCylinder, kPlaneCapsule}) {
+  for (const ShapeKind kind : {ShapeKind::cylinder, ShapeKind::capsule}) {
     Plane wire = test::wire_plane(7, {-0.03, 0.0, 0.01}, {0, 0, 1}, false);
-    wire.flags |= kind;
-    wire.extent_m = 0.01;
     wire.com_m = {0.0, 0.0, 0.0};
-    wire.box_axis_x = {0.0, 1.0, 0.0};
-    wire.box_axis_y = {0.0, 0.0, 1.0};  // body z = x × y along world x
-    wire.box_half_m = {0.01, 0.01, kind == kPlaneCylinder ? 0.04 : 0.03};
+    Eigen::Matrix3d along_x;
+    along_x << 0, 0, 1, 1, 0, 0, 0, 1, 0;  // body x, y, z along world y, z, x
+    test::set_shape(wire, test::round_shape(kind, 0.01, kind == ShapeKind::cylinder ? 0.08 : 0.06), along_x);
     const ContactPlane plane = to_contact_plane(wire);
-    REQUIRE((plane.cylinder() || plane.capsule()));
+    REQUIRE(plane.shaped());
     const ProxySolution solution = project_outside_planes(make_set({plane}), Vector3d(0.02, 0.0, 0.005));
     CHECK(solution.active_count == 1);
     CHECK(solution.proxy_m.z() == Approx(0.01).margin(1e-12));
@@ -508,25 +495,22 @@ TEST_CASE("the way past a sphere, a capsule and a cylinder is told from a way th
   // plane came with the proxy above it. A way passing 0.8 mm outside the body leaves the finger free, one dipping
   // 0.1 mm into it keeps the plane about the proxy.
   Plane sphere_wire = test::wire_plane(8, {0.0, 0.0, 0.01}, {0, 0, 1}, false);
-  sphere_wire.flags |= kPlaneSphere;
-  sphere_wire.extent_m = 0.01;
+  test::set_shape(sphere_wire, test::round_shape(ShapeKind::sphere, 0.01));
   sphere_wire.com_m = {0.0, 0.0, 0.0};
   std::vector<ContactPlane> bodies{to_contact_plane(sphere_wire)};
-  for (const std::uint32_t kind : {kPlaneCapsule, kPlaneCylinder}) {
+  for (const ShapeKind kind : {ShapeKind::capsule, ShapeKind::cylinder}) {
     Plane wire = test::wire_plane(7, {0.0, 0.0, 0.01}, {0, 0, 1}, false);
-    wire.flags |= kind;
-    wire.extent_m = 0.01;
     wire.com_m = {0.0, 0.0, 0.0};
-    wire.box_axis_x = {0.0, 1.0, 0.0};
-    wire.box_axis_y = {0.0, 0.0, 1.0};
-    wire.box_half_m = {0.01, 0.01, kind == kPlaneCylinder ? 0.03 : 0.02};
+    Eigen::Matrix3d along_x;
+    along_x << 0, 0, 1, 1, 0, 0, 0, 1, 0;  // body x, y, z along world y, z, x
+    test::set_shape(wire, test::round_shape(kind, 0.01, kind == ShapeKind::cylinder ? 0.06 : 0.04), along_x);
     bodies.push_back(to_contact_plane(wire));
   }
   for (const ContactPlane& body : bodies) {
-    INFO("flags " << body.flags);
+    INFO("shape " << impetus::to_string(body.shape.kind));
     // Across the body, from 64° up its side to 26° (at x = 0 for the sphere, 1 cm along the others), on the line
     // y + z = 15.3 mm, 10.8 mm from the axis. The finger is behind the plane the proxy had.
-    const double x = body.sphere() ? 0.0 : 0.01;
+    const double x = body.shape.kind == ShapeKind::sphere ? 0.0 : 0.01;
     const Vector3d proxy(x, 0.005, 0.0103), clear_finger(x, 0.0103, 0.005);
     PlaneSet planes = make_set({body});
     retake_shape_planes(planes, proxy, clear_finger);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// Several users on one lockstep world (DESIGN.md §3: the first haptic controller is the master, the others follow its
-// ticks), as separate processes over shared memory: each user a haptic controller with its own device port and a
-// simulated finger, all on one world manager.
+// Several users on one lockstep world (docs/architecture.md §3: the first haptic controller is the master, the others
+// follow its ticks), as separate processes over shared memory: each user a haptic controller with its own device port
+// and a simulated finger, all on one world manager.
 
 #include "csv_columns.h"
 #include "users_support.h"

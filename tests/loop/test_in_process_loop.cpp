@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The in-process loop against the three daemons: the same nodes over the in-process links must reproduce a trial
-// run through shared memory bit for bit (DESIGN.md §6: the same trial in one process or three gives the same outcome).
+// run through shared memory bit for bit (docs/architecture.md §6: the same trial in one process or three gives the same
+// outcome).
 
 #include "tests/integration/trial_support.h"
 #include "tests/integration/users_support.h"

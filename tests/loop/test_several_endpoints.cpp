@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// Several endpoints on one world (DESIGN.md §1, §6), deterministically: a world and one servo per finger in this
-// thread, the fingers on scripted paths (kinematic: the device holds them exactly where the script says, so what is
-// tested is the world and the servos, not a hand model).
+// Several endpoints on one world (docs/architecture.md §1, §6), deterministically: a world and one servo per finger in
+// this thread, the fingers on scripted paths (kinematic: the device holds them exactly where the script says, so what
+// is tested is the world and the servos, not a hand model).
 //   - Grasp and lift: thumb and index squeeze the grasp scene's cube from opposite sides, lift it 5 cm, hold 5 s and
 //     put it down. Friction alone holds it.
 //   - Two users, one cube: two haptic sessions push the tap scene's cube from opposite sides, equally (it stays) and
@@ -65,7 +65,7 @@ struct Run {
   double max_force_N = 0.0;
 };
 
-// The world steps at ticks phase, phase + 50, ... (the lockstep phase, DESIGN.md §3).
+// The world steps at ticks phase, phase + 50, ... (the lockstep phase, docs/architecture.md §3).
 Run run(const Scene& scene, Coupling coupling, std::vector<ScriptedFinger>& fingers, double duration_s,
         int phase_ticks = 0) {
   init_ode_once();

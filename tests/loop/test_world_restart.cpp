@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-// A world that restarts mid-contact (DESIGN.md §6: impulse rendered == impulse applied, across a restart of either
-// side), deterministically: the servo and two worlds in this thread. The finger presses the cube of the tap scene from
-// above; at 0.6 s the first world is gone and a fresh one (a new world session, the cube back where the scene puts
-// it) takes its place. The new world must apply only what was rendered against its own frames — not the running
-// total the finger built up against the dead world (which, applied at once, threw the cube off at hundreds of m/s).
+// A world that restarts mid-contact (docs/architecture.md §6: impulse rendered == impulse applied, across a restart of
+// either side), deterministically: the servo and two worlds in this thread. The finger presses the cube of the tap
+// scene from above; at 0.6 s the first world is gone and a fresh one (a new world session, the cube back where the
+// scene puts it) takes its place. The new world must apply only what was rendered against its own frames — not the
+// running total the finger built up against the dead world (which, applied at once, threw the cube off at hundreds
+// of m/s).
 
 #include "haptic_controller/servo.h"
 #include "world_manager/engine/ode_runtime.h"

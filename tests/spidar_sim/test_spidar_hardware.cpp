@@ -15,7 +15,7 @@ using impetus::SpidarHardware;
 
 namespace {
 
-// The motor corners as device_geometry.h describes them, written out independently of motor_positions_m().
+// The motor corners as common/spidar/geometry.h describes them, written out independently of motor_positions_m().
 std::array<Eigen::Vector3d, kStringCount> documented_motors(const SpidarGeometry& g) {
   const Eigen::Vector3d centre(g.centre_m[0], g.centre_m[1], g.centre_m[2]);
   const double h = g.frame_side_m / 2;

@@ -17,7 +17,7 @@
 
 #include "haptic_controller/servo.h"
 #include "world_manager/engine/ode_runtime.h"
-#include "world_manager/features/body_geometry.h"
+#include "common/shape/shape.h"
 #include "world_manager/scene.h"
 #include "world_manager/world.h"
 

@@ -38,7 +38,7 @@ RandomWorld make_random_world(std::uint32_t seed, int count) {
     SceneObject object;
     object.name = "o";
     object.name += std::to_string(i);
-    object.shape.kind = static_cast<ShapeKind>(i % 4);
+    object.shape.kind = static_cast<ShapeKind>(1 + i % 4);
     object.shape.box_size_m = {0.01 + 0.08 * unit(rng), 0.01 + 0.08 * unit(rng), 0.01 + 0.08 * unit(rng)};
     object.shape.radius_m = 0.005 + 0.04 * unit(rng);
     object.shape.length_m = 0.01 + 0.1 * unit(rng);
@@ -54,7 +54,7 @@ RandomWorld make_random_world(std::uint32_t seed, int count) {
   return world;
 }
 
-// Brute force: every object (and the floor), exact distance against the reach of DESIGN.md §1 step 4.
+// Brute force: every object (and the floor), exact distance against the reach of docs/architecture.md §1.1 step 4.
 std::set<std::int32_t> brute_force_within_reach(const RandomWorld& world, const ReachQuery& finger) {
   std::set<std::int32_t> ids;
   const double finger_speed = finger.velocity_mps.norm();
@@ -170,22 +170,25 @@ TEST_CASE("a capsule's and a cylinder's plane carry their body: its axes, radius
   const impetus::PlaneFrame& frame = world->step(&report);
   REQUIRE(frame.plane_count >= 1);
   const impetus::Plane& plane = frame.planes[0].object_id == 0 ? frame.planes[0] : frame.planes[1];
-  CHECK(plane.flags == (impetus::kPlaneDynamic | impetus::kPlaneCapsule));
+  CHECK(plane.flags == impetus::kPlaneDynamic);
+  CHECK(plane.shape.kind == impetus::ShapeKind::capsule);
   CHECK(plane.extent_m == 0.01);
-  CHECK(plane.box_half_m == impetus::Vec3{0.01, 0.01, 0.03});
+  CHECK(plane.shape.radius_m == 0.01);
+  CHECK(plane.shape.length_m == 0.06);
   // Its axis (x × y, the body z) lies along the world x, and the plane is the side's above the query.
-  const Eigen::Vector3d axis = impetus::to_eigen(plane.box_axis_x).cross(impetus::to_eigen(plane.box_axis_y));
+  const Eigen::Vector3d axis = impetus::to_eigen(plane.body_axis_x).cross(impetus::to_eigen(plane.body_axis_y));
   CHECK(std::abs(axis.x()) == Approx(1.0).margin(1e-3));
   CHECK(plane.normal[2] == Approx(1.0).margin(1e-3));
   CHECK(plane.point_m[0] == Approx(0.02).margin(1e-3));
-  // The same body as a cylinder: its own flag, the same frame.
+  // The same body as a cylinder: its own kind, the same frame.
   scene.objects[0].shape.kind = impetus::ShapeKind::cylinder;
   auto cylinder_world = impetus::test::make_world(scene);
   const impetus::PlaneFrame& cylinder_frame = cylinder_world->step(&report);
   const impetus::Plane& side =
       cylinder_frame.planes[0].object_id == 0 ? cylinder_frame.planes[0] : cylinder_frame.planes[1];
-  CHECK(side.flags == (impetus::kPlaneDynamic | impetus::kPlaneCylinder));
-  CHECK(side.box_half_m == impetus::Vec3{0.01, 0.01, 0.03});
+  CHECK(side.flags == impetus::kPlaneDynamic);
+  CHECK(side.shape.kind == impetus::ShapeKind::cylinder);
+  CHECK(side.shape.length_m == 0.06);
 }
 
 TEST_CASE("planes carry the object's state, friction and the floor") {
@@ -196,11 +199,12 @@ TEST_CASE("planes carry the object's state, friction and the floor") {
   REQUIRE(frame.plane_count == 2);
   const impetus::Plane& cube = frame.planes[0].object_id == 0 ? frame.planes[0] : frame.planes[1];
   const impetus::Plane& floor = frame.planes[0].object_id == 0 ? frame.planes[1] : frame.planes[0];
-  // A box: its faces are flat, and the box travels with its plane (its axes and half sizes; the cube is 5 cm).
-  CHECK(cube.flags == (impetus::kPlaneDynamic | impetus::kPlaneFlat | impetus::kPlaneBox));
-  CHECK(cube.box_half_m == impetus::Vec3{0.025, 0.025, 0.025});
-  CHECK(cube.box_axis_x[0] == Approx(1.0).margin(1e-6));  // resting unturned
-  CHECK(cube.box_axis_y[1] == Approx(1.0).margin(1e-6));
+  // A box: the box travels with its plane (its axes and size; the cube is 5 cm).
+  CHECK(cube.flags == impetus::kPlaneDynamic);
+  CHECK(cube.shape.kind == impetus::ShapeKind::box);
+  CHECK(cube.shape.box_size_m == impetus::Vec3{0.05, 0.05, 0.05});
+  CHECK(cube.body_axis_x[0] == Approx(1.0).margin(1e-6));  // resting unturned
+  CHECK(cube.body_axis_y[1] == Approx(1.0).margin(1e-6));
   CHECK(cube.normal[0] == Approx(-1.0));
   CHECK(cube.point_m[0] == Approx(0.005).margin(1e-4));  // the −x face (the cube has barely settled)
   CHECK(cube.inverse_mass_per_kg == Approx(1.0));
@@ -223,7 +227,7 @@ TEST_CASE("a query an object moved onto keeps the face it met, for every shape a
     scene.floor.present = false;
     SceneObject object;
     object.name = "o";
-    object.shape.kind = static_cast<ShapeKind>(trial % 4);
+    object.shape.kind = static_cast<ShapeKind>(1 + trial % 4);
     object.shape.box_size_m = {0.05, 0.04, 0.03};
     object.shape.radius_m = 0.02;
     object.shape.length_m = 0.04;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// How the haptic side's push reaches the world (DESIGN.md §1.1 step 2): one strategy per coupling, chosen by
+// How the haptic side's push reaches the world (docs/architecture.md §1.1 step 2): one strategy per coupling, chosen by
 // --coupling. The World hands each strategy the new impulse the ledger found per dynamic object, lets it add forces
 // before every engine substep, and lets it annotate the frame it publishes.
 //

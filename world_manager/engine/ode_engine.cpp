@@ -38,17 +38,7 @@ Eigen::AlignedBox3d geom_bounds(dGeomID geom) {
 // The median object extent: a grid cell then holds a few objects and an object spans a few cells.
 double grid_cell_size_m(const Scene& scene) {
   std::vector<double> extents_m;
-  for (const SceneObject& object : scene.objects) {
-    const Shape& shape = object.shape;
-    switch (shape.kind) {
-      case ShapeKind::box:
-        extents_m.push_back(std::max({shape.box_size_m[0], shape.box_size_m[1], shape.box_size_m[2]}));
-        break;
-      case ShapeKind::sphere: extents_m.push_back(2.0 * shape.radius_m); break;
-      case ShapeKind::capsule: extents_m.push_back(shape.length_m + 2.0 * shape.radius_m); break;
-      case ShapeKind::cylinder: extents_m.push_back(std::max(shape.length_m, 2.0 * shape.radius_m)); break;
-    }
-  }
+  for (const SceneObject& object : scene.objects) extents_m.push_back(largest_extent_m(object.shape));
   if (extents_m.empty()) return 1.0;
   auto middle = extents_m.begin() + static_cast<std::ptrdiff_t>(extents_m.size() / 2);
   std::nth_element(extents_m.begin(), middle, extents_m.end());
@@ -587,6 +577,8 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
         geom = dCreateCylinder(home, shape.radius_m, shape.length_m);
         if (object.dynamic) dMassSetCylinderTotal(&mass, object.mass_kg, kAxisZ, shape.radius_m, shape.length_m);
         break;
+      case ShapeKind::none:
+        throw SceneError("object '" + object.name + "' has no shape");
     }
     dGeomSetData(geom, id_to_data(id));
     ode.geoms[id] = geom;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The rigid-body engine behind the world (DESIGN.md §1.3): the scene's bodies, advanced in substeps. The World and the
-// couplings see only this interface; ODE is one implementation (ode_engine.h).
+// The rigid-body engine behind the world (docs/architecture.md §1.3): the scene's bodies, advanced in substeps. The
+// World and the couplings see only this interface; ODE is one implementation (ode_engine.h).
 //
 // Ids are scene object indices. Velocities and forces are in the world frame, SI units. Static objects have no body:
 // calls naming them are not allowed (callers check SceneObject::dynamic).

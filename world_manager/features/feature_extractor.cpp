@@ -14,8 +14,7 @@ double choose_cell_size_m(const Scene& scene) {
   std::vector<double> extents_m;
   extents_m.reserve(scene.objects.size());
   for (const SceneObject& object : scene.objects) {
-    const Eigen::AlignedBox3d box = world_bounds(object.shape, BodyPose{});
-    extents_m.push_back(box.sizes().maxCoeff());
+    extents_m.push_back(largest_extent_m(object.shape));
   }
   double median_m = 0.0;
   if (!extents_m.empty()) {
@@ -85,14 +84,14 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
     const ObjectState& state = states[static_cast<std::size_t>(id)];
     const Shape& shape = scene_.objects[static_cast<std::size_t>(id)].shape;
     SurfacePoint surface = nearest_surface_point(shape, state.pose, finger.position_m);
-    if (shape.kind == ShapeKind::box && surface.signed_distance_m <= kFaceTie_m) {
-      surface = open_box_face(id, surface, finger.position_m, states);
+    const ShapeTraits& kind = traits(shape.kind);
+    if (kind.flat_faces && surface.signed_distance_m <= kFaceTie_m) {
+      surface = open_face(id, surface, finger.position_m, states);
     }
-    // The frame the face is remembered in: the body's, so a face turns with it; a sphere's surface does not change
-    // when it spins (a rolling ball turns half a revolution in a period), so a sphere's is the world's axes about its
-    // centre.
+    // The frame the face is remembered in: the body's, so a face turns with it; a ball's surface does not change when
+    // it spins (a rolling ball turns half a revolution in a period), so a ball's is the world's axes about its centre.
     BodyPose frame = state.pose;
-    if (shape.kind == ShapeKind::sphere) frame.orientation = Eigen::Quaterniond::Identity();
+    if (kind.round) frame.orientation = Eigen::Quaterniond::Identity();
     const Eigen::Vector3d query_local_m = frame.orientation.conjugate() * (finger.position_m - frame.position_m);
     if (memory != nullptr) {
       // Inside, or swept over within the step: keep the face of the last step, if the query is behind it
@@ -100,11 +99,12 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
       if (const FeatureMemory::Face* kept = memory->previous(id); kept != nullptr) {
         const SurfacePoint face = supporting_plane(shape, frame, finger.position_m, kept->normal_body);
         // Past the middle: the query is beyond the object's centre along the kept normal, where the nearest face is
-        // the far one. Inside a box any other face than the one it met is a face the object brought over the query
-        // (its faces are discrete); a curved surface turns continuously under a query that slides over it, so there
-        // only past the middle is the far side. Swept over: outside now, past the middle, through the object since.
+        // the far one. Inside a flat-faced body any other face than the one it met is a face the object brought over
+        // the query (its faces are discrete); a curved surface turns continuously under a query that slides over it,
+        // so there only past the middle is the far side. Swept over: outside now, past the middle, through the
+        // object since.
         const bool past_middle = kept->normal_body.dot(query_local_m) < 0.0;
-        const bool inside = surface.signed_distance_m < 0.0 && (shape.kind == ShapeKind::box || past_middle);
+        const bool inside = surface.signed_distance_m < 0.0 && (kind.flat_faces || past_middle);
         const bool swept = surface.signed_distance_m >= 0.0 && past_middle &&
                            segment_enters_body(shape, kept->query_body_m, query_local_m);
         if (face.signed_distance_m < 0.0 && face.point_m.allFinite() && face.normal.allFinite() && (inside || swept)) {
@@ -112,7 +112,7 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
         }
       }
     }
-    // DESIGN.md §1 step 4: reach = base radius + (finger speed + object speed)·T_w.
+    // docs/architecture.md §1.1 step 4: reach = base radius + (finger speed + object speed)·T_w.
     const double reach_m = base_reach_m + (finger_speed_mps + state.velocity_mps.norm()) * world_period_s;
     // A NaN distance fails this test: a broken object gives no plane rather than a frame the haptic side rejects.
     if (surface.signed_distance_m <= reach_m && surface.point_m.allFinite() && surface.normal.allFinite()) {
@@ -144,7 +144,7 @@ bool FeatureExtractor::occupied(const Eigen::Vector3d& point_m, std::int32_t sel
   return false;
 }
 
-SurfacePoint FeatureExtractor::open_box_face(std::int32_t id, const SurfacePoint& nearest,
+SurfacePoint FeatureExtractor::open_face(std::int32_t id, const SurfacePoint& nearest,
                                              const Eigen::Vector3d& query_m,
                                              std::span<const ObjectState> states) const {
   const auto i = static_cast<std::size_t>(id);
@@ -152,7 +152,7 @@ SurfacePoint FeatureExtractor::open_box_face(std::int32_t id, const SurfacePoint
   const BodyPose& pose = states[i].pose;
   const Eigen::Vector3d query_body_m = pose.orientation.conjugate() * (query_m - pose.position_m);
   std::array<Eigen::Vector3d, 3> faces;
-  const int count = nearest_box_faces(0.5 * to_eigen(shape.box_size_m), query_body_m, kFaceTie_m, faces);
+  const int count = nearest_faces_body(shape, query_body_m, kFaceTie_m, faces);
   if (count == 0) return nearest;
   // On a face within rounding, outside it or in: its plane, not the direction of a rounding-sized offset.
   if (count == 1) return supporting_plane(shape, pose, query_m, faces[0]);
@@ -191,7 +191,7 @@ Plane FeatureExtractor::make_plane(const ReachCandidate& candidate, std::span<co
   plane.static_friction = material.static_friction;
   plane.dynamic_friction = material.dynamic_friction;
   if (scene_.haptic.finger_material_given) {
-    // The finger pad is one more material: combined like any two bodies (common/scene.h).
+    // The finger pad is one more material: combined like any two bodies (world_manager/scene.h).
     plane.static_friction = combine_friction(plane.static_friction, scene_.haptic.finger_material.static_friction);
     plane.dynamic_friction = combine_friction(plane.dynamic_friction, scene_.haptic.finger_material.dynamic_friction);
   }
@@ -202,16 +202,11 @@ Plane FeatureExtractor::make_plane(const ReachCandidate& candidate, std::span<co
   const ObjectState& state = states[static_cast<std::size_t>(candidate.object_id)];
   const SceneObject& object = scene_.objects[static_cast<std::size_t>(candidate.object_id)];
   plane.flags = object.dynamic ? kPlaneDynamic : 0u;
-  if (object.shape.kind == ShapeKind::sphere) plane.flags |= kPlaneSphere;
-  if (object.shape.kind != ShapeKind::sphere) {
-    const bool box = object.shape.kind == ShapeKind::box;
-    plane.flags |= box ? (kPlaneFlat | kPlaneBox)
-                       : object.shape.kind == ShapeKind::capsule ? kPlaneCapsule : kPlaneCylinder;
+  plane.shape = object.shape;
+  if (traits(object.shape.kind).carries_axes) {
     const Eigen::Matrix3d axes = state.pose.orientation.toRotationMatrix();
-    plane.box_axis_x = to_vec3(axes.col(0));
-    plane.box_axis_y = to_vec3(axes.col(1));
-    plane.box_half_m = box ? to_vec3(0.5 * to_eigen(object.shape.box_size_m))
-                           : Vec3{object.shape.radius_m, object.shape.radius_m, 0.5 * object.shape.length_m};
+    plane.body_axis_x = to_vec3(axes.col(0));
+    plane.body_axis_y = to_vec3(axes.col(1));
   }
   plane.extent_m = plane_extent_m(object.shape);
   plane.com_m = to_vec3(state.pose.position_m);

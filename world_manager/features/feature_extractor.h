@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Paper §3.1 and DESIGN.md §1 step 4: the planes of the objects near the finger.
+// Paper §3.1 and docs/architecture.md §1.1 step 4: the planes of the objects near the finger.
 //
 // An object is *within reach* when its surface is at most
 //     reach = base radius + (finger speed + object speed) · T_w
@@ -19,7 +19,7 @@
 
 #include "common/contract/frames.h"
 #include "world_manager/scene.h"
-#include "world_manager/features/body_geometry.h"
+#include "common/shape/shape.h"
 #include "world_manager/features/feature_memory.h"
 #include "world_manager/object_state.h"
 #include "world_manager/features/spatial_grid.h"
@@ -78,7 +78,7 @@ class FeatureExtractor {
   Plane make_plane(const ReachCandidate& candidate, std::span<const ObjectState> states) const;
   // The face of a box for a query on its surface within rounding: the face's own plane (not the direction of a
   // rounding-sized offset), and on an edge or corner a face whose outside is free (header: touching boxes).
-  SurfacePoint open_box_face(std::int32_t id, const SurfacePoint& nearest, const Eigen::Vector3d& query_m,
+  SurfacePoint open_face(std::int32_t id, const SurfacePoint& nearest, const Eigen::Vector3d& query_m,
                              std::span<const ObjectState> states) const;
   // Whether `point_m` lies inside the floor or an object of the last query other than `self`.
   bool occupied(const Eigen::Vector3d& point_m, std::int32_t self, std::span<const ObjectState> states) const;

@@ -6,10 +6,10 @@
 // still while an object arrives faster than that (half a 5 cm cube in one 20 Hz period is 0.5 m/s) would get the far
 // face's plane: the proxy jumps across, the finger is pulled into the object and the object passes through. So a
 // point on an object's far side keeps the face it had in the last step, the side it was on, as the object's supporting
-// plane with that body-frame normal (body_geometry.h supporting_plane). The far side: inside a box, any face but that
-// one (a box's faces are discrete); inside a curved surface, which turns continuously under a finger sliding over it,
-// past the middle (beyond the centre along the kept normal); outside, past the middle with the object swept over the
-// point within the step (faster than its own size per period: the segment from where the point was in the body's
+// plane with that body-frame normal (common/shape/shape.h supporting_plane). The far side: inside a box, any face but
+// that one (a box's faces are discrete); inside a curved surface, which turns continuously under a finger sliding over
+// it, past the middle (beyond the centre along the kept normal); outside, past the middle with the object swept over
+// the point within the step (faster than its own size per period: the segment from where the point was in the body's
 // frame a step ago to where it is now passes through the body). Any other point takes the nearest face, as does an
 // object that had no face for this query in the last step.
 //

@@ -17,6 +17,7 @@ struct ToDds {
   void operator()(const Vec3& from, impetus_dds_Vec3& to) const { to = {from[0], from[1], from[2]}; }
   void operator()(const std::array<double, 9>& from, double (&to)[9]) const { std::copy(from.begin(), from.end(), to); }
   void operator()(const Coupling& from, std::uint32_t& to) const { to = static_cast<std::uint32_t>(from); }
+  void operator()(const ShapeKind& from, std::uint32_t& to) const { to = static_cast<std::uint32_t>(from); }
   template <class T>
   void operator()(const T& from, T& to) const {
     to = from;
@@ -27,6 +28,7 @@ struct FromDds {
   void operator()(Vec3& to, const impetus_dds_Vec3& from) const { to = {from.x, from.y, from.z}; }
   void operator()(std::array<double, 9>& to, const double (&from)[9]) const { std::copy(from, from + 9, to.begin()); }
   void operator()(Coupling& to, const std::uint32_t& from) const { to = static_cast<Coupling>(from); }
+  void operator()(ShapeKind& to, const std::uint32_t& from) const { to = static_cast<ShapeKind>(from); }
   template <class T>
   void operator()(T& to, const T& from) const {
     to = from;

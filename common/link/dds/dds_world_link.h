@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The world link over DDS (DESIGN.md §2), for a world and its haptic controllers on different machines. Real time
-// only: lockstep turns stay a shared-memory (or in-process) matter. Each 1 kHz servo stays on its device's machine;
-// only plane frames, reports and the world's info travel (topics and QoS in impetus_link.idl).
+// The world link over DDS (docs/architecture.md §2), for a world and its haptic controllers on different machines. Real
+// time only: lockstep turns stay a shared-memory (or in-process) matter. Each 1 kHz servo stays on its device's
+// machine; only plane frames, reports and the world's info travel (topics and QoS in impetus_link.idl).
 //
 // Who serves whom. A controller names itself with a random client id; each of its endpoints is a (client id,
 // endpoint) key. The world gives a key the first free endpoint slot when its first report arrives, and publishes the

@@ -62,11 +62,11 @@ void DdsWorldViewPublisher::publish_scene(const ViewScene& scene) {
   for (std::uint32_t k = 0; k < count; ++k) {
     const ViewBodyInfo& body = scene.bodies[k];
     impetus_dds_ViewBodyInfo& to = out.bodies._buffer[k];
-    to.shape = static_cast<std::uint32_t>(body.shape);
+    to.shape = static_cast<std::uint32_t>(body.shape.kind);
     to.dynamic = body.dynamic;
-    to.box_size_m = to_dds(body.box_size_m);
-    to.radius_m = body.radius_m;
-    to.length_m = body.length_m;
+    to.box_size_m = to_dds(body.shape.box_size_m);
+    to.radius_m = body.shape.radius_m;
+    to.length_m = body.shape.length_m;
     std::memcpy(to.name, body.name.data(), kMaxViewNameBytes);
   }
   out.bodies._length = count;
@@ -175,11 +175,11 @@ bool DdsWorldViewReader::read_scene(ViewScene& out) {
   for (std::uint32_t k = 0; k < scene.body_count; ++k) {
     const impetus_dds_ViewBodyInfo& from = in.bodies._buffer[k];
     ViewBodyInfo& to = scene.bodies[k];
-    to.shape = static_cast<ViewShape>(from.shape);
+    to.shape.kind = static_cast<ShapeKind>(from.shape);
     to.dynamic = from.dynamic;
-    to.box_size_m = from_dds(from.box_size_m);
-    to.radius_m = from.radius_m;
-    to.length_m = from.length_m;
+    to.shape.box_size_m = from_dds(from.box_size_m);
+    to.shape.radius_m = from.radius_m;
+    to.shape.length_m = from.length_m;
     std::memcpy(to.name.data(), from.name, kMaxViewNameBytes);
     to.name.back() = '\0';
   }

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The device port inside one process (DESIGN.md §2 "In-process"): commands and states handed over as they are; the
-// host's lockstep_turn() runs the device's tick on the caller's thread. Only lockstep: an in-process device has no
-// clock of its own.
+// The device port inside one process (docs/architecture.md §2 "In-process"): commands and states handed over as they
+// are; the host's lockstep_turn() runs the device's tick on the caller's thread. Only lockstep: an in-process device
+// has no clock of its own.
 
 #include "common/link/device_port.h"
 

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The world link inside one process (DESIGN.md §2 "In-process"): the world's end and every haptic node's end in one
-// object, lockstep by construction. Haptic nodes attach in turn and take the next endpoint slots; the first one is the
-// master: its step_world() runs the world node's step on the caller's thread, so a whole trial runs on one thread in a
-// fixed order and is bitwise reproducible. The others follow its ticks (their step_world() does nothing).
+// The world link inside one process (docs/architecture.md §2 "In-process"): the world's end and every haptic node's end
+// in one object, lockstep by construction. Haptic nodes attach in turn and take the next endpoint slots; the first one
+// is the master: its step_world() runs the world node's step on the caller's thread, so a whole trial runs on one
+// thread in a fixed order and is bitwise reproducible. The others follow its ticks (their step_world() does nothing).
 //
-// Delay line (DESIGN.md §3): the link can hold frames and reports back by d haptic ticks each way, to measure what
-// network latency does to a coupling, reproducibly. Time on the link is the tick count the reports carry
+// Delay line (docs/architecture.md §3): the link can hold frames and reports back by d haptic ticks each way, to
+// measure what network latency does to a coupling, reproducibly. Time on the link is the tick count the reports carry
 // (HapticReport::tick: a servo's report of its k-th tick carries k); in an in-process lockstep run every servo starts
 // with the master and ticks once per master tick, so the counts of all nodes are one clock.
 //   - A haptic node is "at tick k" from its publishing the reports of its k-th tick until it publishes the next ones;

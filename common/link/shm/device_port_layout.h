@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The device port segment (DESIGN.md §2): created by the haptic controller, opened by a device (spidar_sim).
-// Name on the system: "<shm>.device" (see link_names.h).
+// The device port segment (docs/architecture.md §2): created by the haptic controller, opened by a device (spidar_sim).
+// Name on the system: "<shm>.device" (see names.h).
 //
 // Attach protocol: a device claims the port by swapping device_pid from 0 to its pid, then follows the haptic
 // controller (lockstep: waits for turns; real time: publishes states at its own rate). To detach it sets

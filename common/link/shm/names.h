@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// System names of the segments for a `--shm NAME` (DESIGN.md §2: one segment per link).
+// System names of the segments for a `--shm NAME` (docs/architecture.md §2: one segment per link).
 
 #include <string>
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// A named shared-memory segment holding one fixed-layout struct (DESIGN.md §2).
+// A named shared-memory segment holding one fixed-layout struct (docs/architecture.md §2).
 //
 // We map a plain boost::interprocess::shared_memory_object instead of a managed segment: a managed segment's allocator
 // keeps a mutex in shared memory that stays locked forever if a process dies holding it. Here nothing in the segment is
@@ -28,7 +28,7 @@
 namespace impetus {
 
 inline constexpr std::uint64_t kSegmentMagic = 0x31535554'45504D49ull;  // "IMPETUS1" in little-endian bytes
-inline constexpr std::uint32_t kLayoutVersion = 12;  // bump on any change to wire_frames.h or a *Layout struct
+inline constexpr std::uint32_t kLayoutVersion = 13;  // bump on any change to wire_frames.h or a *Layout struct
 
 enum class SegmentKind : std::uint32_t { world_link = 1, device_port = 2, world_view = 3 };
 const char* to_string(SegmentKind kind);

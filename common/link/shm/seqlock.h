@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Single-writer, many-reader channel for one trivially-copyable frame, placed in shared memory (DESIGN.md §2).
+// Single-writer, many-reader channel for one trivially-copyable frame in shared memory (docs/architecture.md §2).
 //
 // The writer never waits: it bumps the sequence word to odd, stores the payload, then bumps it to even. A reader polls
 // the sequence word first (cheap, so it copies only when something new was published), copies the payload, and keeps

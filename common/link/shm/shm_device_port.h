@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The device port over shared memory (DESIGN.md §2): one segment "<shm>.device" (device_port_layout.h), created by
-// the haptic node, opened by the device. A device claims the port by swapping device_pid from 0 to its pid; to leave
-// it sets `detaching` (in lockstep, inside its last turn); a dead device is noticed by the host (pid gone), which
-// resets the turn and frees the slot.
+// The device port over shared memory (docs/architecture.md §2): one segment "<shm>.device" (device_port_layout.h),
+// created by the haptic node, opened by the device. A device claims the port by swapping device_pid from 0 to its pid;
+// to leave it sets `detaching` (in lockstep, inside its last turn); a dead device is noticed by the host (pid gone),
+// which resets the turn and frees the slot.
 
 #include "common/link/device_port.h"
 #include "common/link/shm/device_port_layout.h"

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The world link over shared memory (DESIGN.md §2): one segment "<shm>.world" (world_link_layout.h), created by the
-// world node, opened by the haptic node. Frames cross as sealed wire frames (wire_frames.h); lockstep turns are the
-// segment's turns (futex words); liveness is the creator's pid and start time.
+// The world link over shared memory (docs/architecture.md §2): one segment "<shm>.world" (world_link_layout.h), created
+// by the world node, opened by the haptic node. Frames cross as sealed wire frames (wire_frames.h); lockstep turns are
+// the segment's turns (futex words); liveness is the creator's pid and start time.
 
 #include "common/link/shm/latest_valid.h"
 #include "common/link/shm/world_link_layout.h"

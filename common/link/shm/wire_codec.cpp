@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "common/link/shm/wire_frames.h"
+#include "common/shape/shape.h"
 
 #include "common/link/frame_fields.h"
 
@@ -76,7 +77,7 @@ const char* to_string(FrameError error) {
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
     case FrameError::bad_reach: return "reach radius or plane extent is negative";
     case FrameError::bad_mass: return "a local contact's inverse mass is negative";
-    case FrameError::bad_box: return "a box's axes are not orthonormal or its sizes not positive";
+    case FrameError::bad_shape: return "a plane's shape is unknown or out of range, or its body axes not orthonormal";
   }
   return "unknown frame error";
 }
@@ -118,17 +119,17 @@ FrameError validate(const wire::PlaneFrame& frame) {
       return FrameError::not_finite;
     }
     if (plane.extent_m < 0.0) return FrameError::bad_reach;
-    if ((plane.flags & kPlaneCarriesShape) != 0) {
-      if (!all_finite(plane.box_axis_x) || !all_finite(plane.box_axis_y) || !all_finite(plane.box_half_m)) {
-        return FrameError::not_finite;
-      }
+    if (!all_finite(plane.body_axis_x) || !all_finite(plane.body_axis_y) || !all_finite(plane.shape.box_size_m) ||
+        !finite(plane.shape.radius_m) || !finite(plane.shape.length_m)) {
+      return FrameError::not_finite;
+    }
+    if (shape_problem(plane.shape) != nullptr) return FrameError::bad_shape;
+    if (traits(plane.shape.kind).carries_axes) {
       const auto dot = [](const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
-      if (std::fabs(dot(plane.box_axis_x, plane.box_axis_x) - 1.0) > kUnitNormalTolerance ||
-          std::fabs(dot(plane.box_axis_y, plane.box_axis_y) - 1.0) > kUnitNormalTolerance ||
-          std::fabs(dot(plane.box_axis_x, plane.box_axis_y)) > kUnitNormalTolerance ||
-          !(plane.box_half_m[0] > 0.0 && plane.box_half_m[1] > 0.0 &&
-            ((plane.flags & kPlaneCapsule) != 0 ? plane.box_half_m[2] >= 0.0 : plane.box_half_m[2] > 0.0))) {
-        return FrameError::bad_box;
+      if (std::fabs(dot(plane.body_axis_x, plane.body_axis_x) - 1.0) > kUnitNormalTolerance ||
+          std::fabs(dot(plane.body_axis_y, plane.body_axis_y) - 1.0) > kUnitNormalTolerance ||
+          std::fabs(dot(plane.body_axis_x, plane.body_axis_y)) > kUnitNormalTolerance) {
+        return FrameError::bad_shape;
       }
     }
     for (double value : plane.inverse_inertia_world) {

@@ -42,9 +42,9 @@ struct Plane {
   double static_friction = 0.0;
   double dynamic_friction = 0.0;
   double extent_m = 0.0;
-  Vec3 box_axis_x{};
-  Vec3 box_axis_y{};
-  Vec3 box_half_m{};
+  Shape shape;
+  Vec3 body_axis_x{};
+  Vec3 body_axis_y{};
   double inverse_mass_per_kg = 0.0;
   std::array<double, 9> inverse_inertia_world{};
   std::uint32_t local_contact_count = 0;
@@ -133,7 +133,7 @@ enum class FrameError : std::uint32_t {
   bad_friction,
   bad_reach,
   bad_mass,
-  bad_box,
+  bad_shape,
 };
 const char* to_string(FrameError error);
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The world link segment (DESIGN.md §2): created by the world manager, opened by the haptic controller.
+// The world link segment (docs/architecture.md §2): created by the world manager, opened by the haptic controller.
 // Name on the system: "<shm>.world" (see names.h).
 
 #include "common/link/shm/wire_frames.h"

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The world view segment (DESIGN.md §1, §2): created by the world manager beside its world link, opened read-only by
-// any number of viewers. Name on the system: "<shm>.view" (see names.h).
+// The world view segment (docs/architecture.md §1, §2): created by the world manager beside its world link, opened
+// read-only by any number of viewers. Name on the system: "<shm>.view" (see names.h).
 
 #include "common/contract/world_view.h"
 #include "common/link/shm/segment.h"
