@@ -104,8 +104,8 @@ def check_generic(trial):
         problems.append(f"{h['faults']} servo faults (non-finite finger or force)")
     if not h["max_force_N"] <= h["force_limit_N"] + 1e-9:
         problems.append(f"max force {h['max_force_N']:.3f} N > {h['force_limit_N']} N")
-    energy = energy_balance(trial.scene, trial.devices, trial.world, trial.summary.device, trial.world_period_s,
-                            trial.haptic_period_s)
+    energy = energy_balance(trial.scene, trial.summary.objects, trial.devices, trial.world, trial.summary.device,
+                            trial.world_period_s, trial.haptic_period_s)
     if not energy["ok"]:
         problems.append(f"energy grew {energy['excess_J']:.4f} J beyond the hand's work at t={energy['at_s']:.3f} s "
                         f"(tolerance {energy['tolerance_J']:.4f} J)")

@@ -97,7 +97,8 @@ def energy_gain(out_dir, summary, scene, devices, phase_ticks):
     world = logs.read_log(out_dir / logs.WORLD)
     haptic_period_s = summary.haptic_period_s
     world.columns["time_s"] = world["time_s"] + phase_ticks * haptic_period_s
-    balance = energy_balance(scene, devices, world, summary.device, summary.world_period_s, haptic_period_s)
+    balance = energy_balance(scene, summary.objects, devices, world, summary.device, summary.world_period_s,
+                             haptic_period_s)
     return balance["excess_J"], balance["tolerance_J"]
 
 

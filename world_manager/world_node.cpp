@@ -220,7 +220,10 @@ nlohmann::json WorldNode::summary() const {
     if (!object.dynamic) continue;
     const ObjectState& state = states[id];
     const Eigen::Quaterniond& q = state.pose.orientation;
-    objects[object.name] = {{"position", to_json(state.pose.position_m)},
+    const Eigen::Vector3d inertia_kgm2 = impetus::inertia_kgm2(object.shape, object.mass_kg).diagonal();  // principal
+    objects[object.name] = {{"mass_kg", object.mass_kg},
+                            {"inertia_kgm2", to_json(inertia_kgm2)},
+                            {"position", to_json(state.pose.position_m)},
                             {"orientation", {q.w(), q.x(), q.y(), q.z()}},
                             {"velocity", to_json(state.velocity_mps)},
                             {"angular_velocity", to_json(state.angular_velocity_radps)},

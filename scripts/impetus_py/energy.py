@@ -12,24 +12,11 @@ import numpy as np
 CONTACT_SLOP_M = 1e-3
 
 
-def mass_and_inertia(obj):
-    """Mass (kg) and principal moments of inertia (kg·m²) about the centre of mass, in the body frame, of a scene
-    object (a solid box or sphere; its mass_kg, or density_kgpm3 × volume)."""
-    shape = obj["shape"]
-    if shape == "box":
-        a, b, c = obj["size_m"]
-        volume = a * b * c
-    elif shape == "sphere":
-        r = obj["radius_m"]
-        volume = 4.0 / 3.0 * math.pi * r ** 3
-    else:
-        raise ValueError(f"energy accounting supports boxes and spheres only, not {shape} ({obj['name']})")
-    mass = obj["mass_kg"] if "mass_kg" in obj else obj["density_kgpm3"] * volume
-    if shape == "box":
-        inertia = (mass / 12 * (b * b + c * c), mass / 12 * (a * a + c * c), mass / 12 * (a * a + b * b))
-    else:
-        inertia = (0.4 * mass * r * r,) * 3
-    return mass, inertia
+def mass_and_inertia(body):
+    """Mass (kg) and principal moments of inertia (kg·m²) about the centre of mass, in the body frame, of a dynamic
+    body as the world simulated it: its entry in summary.json's "objects" (mass_kg, inertia_kgm2, which the world
+    takes from its shape, common/shape/shape.h), whatever its shape."""
+    return float(body["mass_kg"]), tuple(float(x) for x in body["inertia_kgm2"])
 
 
 def rotate_to_body(q_wxyz, w):
@@ -46,28 +33,28 @@ def _dot3(a, b):
     return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
 
 
-def object_energy_J(obj, gravity_mps2, position_m, orientation_wxyz, velocity_mps, omega_radps):
-    """Kinetic plus potential energy (J) of scene object `obj` in each of n states (n x 3 arrays, n x 4 for the
-    orientation; world frame): 1/2 m v² + 1/2 ω_b · I ω_b - m g · p, with ω_b the angular velocity in the body
-    frame."""
-    mass, inertia = mass_and_inertia(obj)
+def object_energy_J(body, gravity_mps2, position_m, orientation_wxyz, velocity_mps, omega_radps):
+    """Kinetic plus potential energy (J) of a dynamic body (its summary entry, mass_and_inertia) in each of n states
+    (n x 3 arrays, n x 4 for the orientation; world frame): 1/2 m v² + 1/2 ω_b · I ω_b - m g · p, with ω_b the angular
+    velocity in the body frame."""
+    mass, inertia = mass_and_inertia(body)
     wb = rotate_to_body(orientation_wxyz, omega_radps)
     kinetic = 0.5 * mass * _dot3(velocity_mps, velocity_mps) + 0.5 * _dot3(np.asarray(inertia) * wb, wb)
     potential = -mass * _dot3(np.broadcast_to(np.asarray(gravity_mps2, dtype=float), position_m.shape), position_m)
     return kinetic + potential
 
 
-def _initial_energy_J(obj, gravity_mps2):
-    """object_energy_J of `obj` in its state in the scene file."""
-    return object_energy_J(obj, gravity_mps2, *(np.array([obj[key]], dtype=float) for key in (
+def _initial_energy_J(obj, body, gravity_mps2):
+    """object_energy_J of scene object `obj` (its summary entry `body`) in its state in the scene file."""
+    return object_energy_J(body, gravity_mps2, *(np.array([obj[key]], dtype=float) for key in (
         "position_m", "orientation_wxyz", "linear_velocity_mps", "angular_velocity_radps")))[0]
 
 
-def energy_balance(scene, device, world, finger, world_period_s, haptic_period_s):
-    """Energy of finger + dynamic objects against the hand's work, from a trial's scene (scene.Scene), device log (or
-    the list of a several-finger device's logs, one per finger) and world log (logs.Log) and the finger and hand it
-    ran with (the summary's "device" section: finger_mass_kg,
-    hand_stiffness_Npm, hand_damping_Nspm).
+def energy_balance(scene, bodies, device, world, finger, world_period_s, haptic_period_s):
+    """Energy of finger + dynamic objects against the hand's work, from a trial's scene (scene.Scene), its bodies'
+    mass properties (the summary's "objects"), device log (or the list of a several-finger device's logs, one per
+    finger) and world log (logs.Log) and the finger and hand it ran with (the summary's "device" section:
+    finger_mass_kg, hand_stiffness_Npm, hand_damping_Nspm).
 
     The system is the finger (point mass m_f) and the dynamic objects. External forces on it: the hand
     F_hand = k_h (target - x) + b_h (target_v - v), gravity (counted as potential energy), the static geometry
@@ -133,7 +120,7 @@ def energy_balance(scene, device, world, finger, world_period_s, haptic_period_s
 
     e0 = float(finger_kinetic[0])
     for obj in dynamic:
-        e0 += _initial_energy_J(obj, gravity)
+        e0 += _initial_energy_J(obj, bodies[obj["name"]], gravity)
     # World step j (at world time t_j) was taken at haptic tick round((t_j - T_world) / T_haptic); steps after the
     # device log ends are left out.
     tick = np.rint((world["time_s"] - world_period_s) / haptic_period_s).astype(int)
@@ -144,7 +131,7 @@ def energy_balance(scene, device, world, finger, world_period_s, haptic_period_s
     for obj in dynamic:
         name = obj["name"]
         orientation = np.stack([world[f"{name}.q{axis}"] for axis in "wxyz"], axis=1)
-        energy = energy + object_energy_J(obj, gravity, world.vectors(f"{name}.", "_m")[rows], orientation[rows],
+        energy = energy + object_energy_J(bodies[name], gravity, world.vectors(f"{name}.", "_m")[rows], orientation[rows],
                                           world.vectors(f"{name}.v", "_mps")[rows],
                                           world.vectors(f"{name}.w", "_radps")[rows])
     excess = energy - e0 - work[tick]
@@ -152,7 +139,7 @@ def energy_balance(scene, device, world, finger, world_period_s, haptic_period_s
     if (excess > -math.inf).any():  # NaN (a non-finite log) never counts as the worst
         j = int(np.argmax(np.where(excess > -math.inf, excess, -math.inf)))
         worst = (float(excess[j]), float(times[tick[j]]), float(energy[j] - e0), float(work[tick[j]]))
-    contact = sum(mass_and_inertia(obj)[0] for obj in dynamic) * g * CONTACT_SLOP_M
+    contact = sum(mass_and_inertia(bodies[obj["name"]])[0] for obj in dynamic) * g * CONTACT_SLOP_M
     tolerance = quadrature + contact
     return {"excess_J": worst[0], "at_s": worst[1], "dE_J": worst[2], "W_J": worst[3], "tolerance_J": tolerance,
             "quadrature_J": quadrature, "contact_J": contact, "W_total_J": float(work[-1]),

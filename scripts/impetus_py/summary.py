@@ -2,8 +2,8 @@
 """summary.json, a trial's machine-readable outcome (docs/architecture.md §4), on the Python side. scripts/run.sh has
 summarize_trial.py merge it from the daemons' own summaries; every other script reads it through Summary.
 
-  {"objects": {NAME: {"position", "orientation", "velocity", "angular_velocity", "impulse_Ns",
-                      "angular_impulse_Nms"}},                      world_manager: each dynamic object at the end
+  {"objects": {NAME: {"mass_kg", "inertia_kgm2" (principal, body frame), "position", "orientation", "velocity",
+                      "angular_velocity", "impulse_Ns", "angular_impulse_Nms"}}, world_manager: each dynamic object
    "world":   {"steps", "time_s", "period_s", "cpu_per_step_mean_us", "cpu_per_step_p99_us", "cpu_per_simulated_s",
                "skipped_periods", "rejected_reports", ...},          world_manager
    "haptic":  {"rate_hz", "ticks", "max_force_N", "force_limit_N", "stiffness_Npm", "damping_Nspm", "faults",
