@@ -46,7 +46,7 @@ void check_limits(const impetus::Scene& scene) {
   FUZZ_CHECK(
       within(scene.physics.world_rate_hz, impetus::limits::kMinWorldRate_Hz, impetus::limits::kMaxWorldRate_Hz));
   FUZZ_CHECK(scene.physics.substeps <= impetus::limits::kMaxSubsteps);
-  FUZZ_CHECK(scene.physics.solver_iterations <= impetus::limits::kMaxSolverIterations);
+  FUZZ_CHECK(scene.physics.ode.solver_iterations <= impetus::limits::kMaxSolverIterations);
   for (const impetus::SceneObject& object : scene.objects) {
     FUZZ_CHECK(coordinates_ok(object.position_m));
     FUZZ_CHECK(hypot3(object.linear_velocity_mps) <= SceneLimits::kMaxSpeed_mps);
@@ -73,7 +73,7 @@ void check_scene(const impetus::Scene& scene) {
   const impetus::PhysicsParams& physics = scene.physics;
   FUZZ_CHECK(physics.world_rate_hz > 0.0 && std::isfinite(physics.world_rate_hz));
   FUZZ_CHECK(std::isfinite(physics.world_period_s()));
-  FUZZ_CHECK(physics.substeps > 0 && physics.solver_iterations > 0);
+  FUZZ_CHECK(physics.substeps > 0 && physics.ode.solver_iterations > 0);
   // ODE's ERP in [0, 1] and a finite CFM >= 0 at any substep a world can take.
   for (const double substep_s : {physics.world_period_s() / physics.substeps, 1e-7, 1.0}) {
     const double erp = physics.erp_at(substep_s), cfm = physics.cfm_at(substep_s);

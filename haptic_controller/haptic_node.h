@@ -8,6 +8,7 @@
 //
 // Owns the servo, its log and statistics; its summary is the haptic half of summary.json (docs/architecture.md §4).
 
+#include "common/contract/limits.h"
 #include "common/link/inproc/inproc_world_link.h"
 #include "common/link/world_link.h"
 #include "common/runtime/lockstep_schedule.h"
@@ -30,7 +31,7 @@
 namespace impetus {
 
 struct HapticNodeOptions {
-  double rate_hz = 1000.0;
+  double rate_hz = limits::kDefaultHapticRate_Hz;
   double stiffness_Npm = std::numeric_limits<double>::quiet_NaN();  // NaN: the scene's (servo.h)
   double damping_Nspm = std::numeric_limits<double>::quiet_NaN();
   ClockMode clock = ClockMode::realtime;

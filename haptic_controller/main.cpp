@@ -2,16 +2,13 @@
 // haptic_controller: the 1 kHz haptic servo (docs/architecture.md §1.2). Parses the flags, creates the device port,
 // opens the world link and runs a HapticNode on them; writes the haptic half of summary.json at exit.
 
-#include "common/link/dds/dds_world_link.h"
+#include "common/link/dds/open_world_link.h"
 #include "common/link/shm/shm_device_port.h"
-#include "common/link/shm/shm_world_link.h"
 #include "common/runtime/cli.h"
-#include "haptic_controller/device/finger_set.h"
-#include "haptic_controller/device/spidar_driver.h"
+#include "haptic_controller/device/device_registry.h"
 #include "haptic_controller/haptic_node.h"
 
 #include <memory>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -44,7 +41,7 @@ int main(int argc, char** argv) {
   add_link_flags(app, link_options);
   app.add_option("--world-wait", world_wait_s, "seconds to wait for the world manager's link (10)")
       ->check(positive_number(kMaxFlagSeconds));
-  app.add_option("--device", device_spec, "spidar (the built-in geometry) or spidar:FILE.json (a device file)");
+  app.add_option("--device", device_spec, "the device: " + device_forms() + " (spidar: the built-in geometry)");
   app.add_option("--fingers", fingers,
                  "fingers of the device, one endpoint of the world each, 1 to 8 (1); finger k has the device port "
                  "NAME.device (k = 0) or NAME.device<k>, and a string set of the device's geometry")
@@ -62,57 +59,37 @@ int main(int argc, char** argv) {
 
   return run_node("haptic_controller", [&] {
     options.haptic_session = new_session_id();
-    const SpidarDevice spidar = parse_device_spec(device_spec);
-    // The world link by --link, before the device ports: a device starts its motion when its port appears, and the
-    // servo can render only once the world serves it (over DDS that takes a discovery). The device ports stay in
-    // shared memory on this host either way.
-    std::unique_ptr<WorldLinkClient> world;
-    DdsWorldLinkClient* dds = nullptr;
-    if (link_options.kind == LinkKind::dds) {
-      if (!world_shm.empty()) {
-        throw std::invalid_argument("--world-shm names a shared-memory world link; with --link dds the world is "
-                                    "found by --dds-domain and --dds-partition");
-      }
-      auto client = std::make_unique<DdsWorldLinkClient>(link_options.dds, options.clock, world_wait_s, fingers);
-      dds = client.get();
-      world = std::move(client);
-    } else {
-      world = std::make_unique<ShmWorldLinkClient>(world_shm.empty() ? shm : world_shm, options.clock, world_wait_s,
-                                                   fingers);
+    const std::unique_ptr<DeviceType> device_type = parse_device(device_spec);
+    if (link_options.kind == LinkKind::dds && !world_shm.empty()) {
+      throw std::invalid_argument("--world-shm names a shared-memory world link; with --link dds the world is found "
+                                  "by --dds-domain and --dds-partition");
     }
-    // A SPIDAR string set per finger, each on its own port; one finger is the SPIDAR itself.
+    // The world link before the device ports: a device starts its motion when its port appears, and the servo can
+    // render only once the world serves it (over DDS that takes a discovery). The device ports stay in shared memory
+    // on this host either way, one per finger.
+    const std::unique_ptr<WorldLinkClient> world = open_world_link_client(
+        link_options, world_shm.empty() ? shm : world_shm, options.clock, world_wait_s, fingers);
     std::vector<std::unique_ptr<ShmDevicePortHost>> ports;
-    std::vector<std::unique_ptr<SpidarDriver>> drivers;
-    std::vector<HapticDevice*> devices;
+    std::vector<DevicePortHost*> port_list;
     for (unsigned k = 0; k < fingers; ++k) {
       ports.push_back(std::make_unique<ShmDevicePortHost>(shm, options.clock, 1.0 / options.rate_hz,
-                                                          DeviceDescription{geometry_hash(spidar.geometry),
-                                                                            spidar.source},
-                                                          k));
-      drivers.push_back(
-          std::make_unique<SpidarDriver>(spidar.geometry, *ports.back(), options.clock, options.haptic_session));
-      devices.push_back(drivers.back().get());
+                                                          device_type->description(), k));
+      port_list.push_back(ports.back().get());
     }
-    std::optional<FingerSet> finger_set;
-    if (fingers > 1) finger_set.emplace(devices);
-    HapticDevice& device = finger_set ? static_cast<HapticDevice&>(*finger_set) : *drivers[0];
-    HapticNode node(options, *world, device);
+    AssembledDevice device(*device_type, port_list, options.clock, options.haptic_session);
+    HapticNode node(options, *world, device.device());
     std::fprintf(stderr, "haptic_controller: %.0f Hz, %s clock, world at %.1f Hz, device port '%s'%s\n",
                  options.rate_hz, to_string(options.clock), world->info().world_rate_hz, ports[0]->name().c_str(),
                  fingers > 1 ? (" and " + std::to_string(fingers - 1) + " more, one per finger").c_str() : "");
     const int status = node.run();
     nlohmann::json summary = node.summary();
-    if (dds != nullptr) {
-      summary["haptic"]["dds"] = {{"domain", link_options.dds.domain_id},
-                                  {"partition", link_options.dds.partition},
-                                  {"reports_sent", dds->reports_sent()}};
-    }
+    if (nlohmann::json link = link_summary(*world, link_options); !link.is_null()) summary["haptic"]["dds"] = link;
     write_summary(summary_path, summary);
     const ServoCounters& counters = node.servo().counters();
     std::fprintf(stderr, "haptic_controller: %llu ticks, %llu faults, %llu force clamps, %llu saturations\n",
                  static_cast<unsigned long long>(counters.ticks), static_cast<unsigned long long>(counters.faults),
                  static_cast<unsigned long long>(counters.force_clamps),
-                 static_cast<unsigned long long>(device.counters().saturations));
+                 static_cast<unsigned long long>(device.device().counters().saturations));
     return status;
   });
 }

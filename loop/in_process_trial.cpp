@@ -6,12 +6,10 @@
 #include "common/runtime/cli.h"
 #include "common/runtime/lockstep_schedule.h"
 #include "common/runtime/log_paths.h"
-#include "haptic_controller/device/finger_set.h"
-#include "haptic_controller/device/spidar_driver.h"
+#include "haptic_controller/device/device_registry.h"
 #include "haptic_controller/haptic_node.h"
-#include "spidar_sim/device_node.h"
-#include "spidar_sim/trajectory.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "spidar_sim/simulated_fingers.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/world_node.h"
 
 #include <algorithm>
@@ -70,43 +68,34 @@ void check_options(const InProcessTrialOptions& options) {
 
 // One user: a haptic node and its device, a SPIDAR string set, port and simulated finger per finger.
 struct Controller {
-  Controller(const HapticNodeOptions& haptic_options, const std::vector<NamedFinger>& fingers,
-             InProcessWorldLink& world, const std::string& device_log)
-      : names(fingers), link(world.attach(static_cast<std::uint32_t>(fingers.size()))) {
-    double longest_s = 0.0;
-    for (const NamedFinger& named : fingers) longest_s = std::max(longest_s, named.trajectory.duration_s());
-    std::vector<HapticDevice*> finger_devices;
-    for (std::size_t k = 0; k < fingers.size(); ++k) {
+  Controller(const HapticNodeOptions& haptic_options, std::vector<NamedFinger> fingers, InProcessWorldLink& world,
+             const std::string& device_log)
+      : link(world.attach(static_cast<std::uint32_t>(fingers.size()))),
+        rig(std::move(fingers), SpidarGeometry{}, HardwareParams{}, FingerParams{}) {
+    // Members in this order: the nodes and drivers go before the ports they hold.
+    // The built-in SPIDAR: the simulated one beside it has the same geometry, so the ports need no description.
+    const std::unique_ptr<DeviceType> type = parse_device("spidar");
+    std::vector<DevicePortHost*> port_list;
+    for (std::size_t k = 0; k < rig.size(); ++k) {
       ports.push_back(std::make_unique<InProcessDevicePort>(1.0 / haptic_options.rate_hz));
-      drivers.push_back(std::make_unique<SpidarDriver>(SpidarGeometry{}, *ports.back(), ClockMode::lockstep,
-                                                       haptic_options.haptic_session));
-      finger_devices.push_back(drivers.back().get());
-      sims.push_back(std::make_unique<DeviceSim>(SpidarGeometry{}, HardwareParams{}, FingerParams{},
-                                                 fingers[k].trajectory.held_until(longest_s)));
-      devices.push_back(std::make_unique<DeviceNode>(*sims.back(), *ports.back(),
-                                                     endpoint_log_path(device_log, static_cast<std::uint32_t>(k)),
-                                                     1 + k));
-      ports.back()->connect(*devices.back());
+      port_list.push_back(ports.back().get());
+      ports.back()->connect(rig.attach(k, *ports.back(), device_log, 1 + k));
     }
-    if (fingers.size() > 1) finger_set.emplace(finger_devices);
-    HapticDevice& device = finger_set ? static_cast<HapticDevice&>(*finger_set) : *drivers[0];
-    haptic = std::make_unique<HapticNode>(haptic_options, link, device);
+    device = std::make_unique<AssembledDevice>(*type, port_list, ClockMode::lockstep, haptic_options.haptic_session);
+    haptic = std::make_unique<HapticNode>(haptic_options, link, device->device());
   }
 
   // The haptic and device halves of its summary (a device of several fingers lists each under "device"."fingers").
   nlohmann::json summary() const {
     nlohmann::json out = haptic->summary();
-    out.update(fingers_summary(devices, names));
+    out.update(rig.summary());
     return out;
   }
 
-  std::vector<NamedFinger> names;
   WorldLinkClient& link;
   std::vector<std::unique_ptr<InProcessDevicePort>> ports;
-  std::vector<std::unique_ptr<SpidarDriver>> drivers;
-  std::vector<std::unique_ptr<DeviceSim>> sims;
-  std::vector<std::unique_ptr<DeviceNode>> devices;
-  std::optional<FingerSet> finger_set;
+  SimulatedFingers rig;
+  std::unique_ptr<AssembledDevice> device;
   std::unique_ptr<HapticNode> haptic;
 };
 
@@ -118,7 +107,7 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   // threading implementation), so two worlds must not step at once: trials in one process take turns.
   static std::mutex one_trial_at_a_time;
   const std::lock_guard<std::mutex> turn(one_trial_at_a_time);
-  init_ode_once();
+  prepare_engines();
   WorldNodeOptions world_options;
   world_options.scene_path = options.scene_path;
   world_options.rate_hz = options.world_rate_hz;
@@ -138,9 +127,6 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
   world.connect(world_link);
   world_link.connect(world);
 
-  if (!options.fingers.empty() && !options.trajectory.empty()) {
-    throw std::invalid_argument("give trajectory or fingers, not both");
-  }
   // One controller per user: the first is the lockstep master, the others follow its ticks (docs/architecture.md §3).
   std::vector<std::unique_ptr<Controller>> users;
   const std::size_t user_count = 1 + options.followers.size();
@@ -154,18 +140,9 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
     haptic_options.duration_s = options.duration_s;
     haptic_options.haptic_session = 1 + u;
     haptic_options.followers = u == 0 ? static_cast<std::uint32_t>(options.followers.size()) : 0;
-    // Built step by step: a throwing call inside a braced list of elements is cleaned up wrongly by GCC 12
-    // (AddressSanitizer: stack-use-after-scope when the trajectory is bad).
-    std::vector<NamedFinger> fingers;
-    if (u > 0) {
-      fingers = parse_fingers(options.followers[u - 1], kMaxFingers);
-    } else if (options.fingers.empty()) {
-      Trajectory trajectory = load_trajectory(options.trajectory);
-      fingers.push_back({"finger", std::move(trajectory)});
-    } else {
-      fingers = parse_fingers(options.fingers, kMaxFingers);
-    }
-    users.push_back(std::make_unique<Controller>(haptic_options, fingers, world_link,
+    std::vector<NamedFinger> fingers = u > 0 ? parse_fingers(options.followers[u - 1], kMaxFingers)
+                                              : load_fingers(options.trajectory, options.fingers);
+    users.push_back(std::make_unique<Controller>(haptic_options, std::move(fingers), world_link,
                                                  log_path(options.out_dir, (prefix + "device.csv").c_str())));
     if (u > 0) world_link.connect_follower(users.back()->link, *users.back()->haptic);
   }

@@ -4,6 +4,7 @@
 // Python half chooses defaults, names the arguments and shapes the results.
 
 #include "loop/in_process_trial.h"
+#include "world_manager/defaults.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -105,4 +106,5 @@ PYBIND11_MODULE(_impetus, module) {
              py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("stiffness_Npm"),
              py::arg("damping_Nspm"), py::arg("link_delay_s"), py::arg("duration_s"), py::arg("out_dir"));
   module.def("read_log", &read_log, py::arg("path"));
+  module.def("defaults", [] { return impetus::defaults_document().dump(); });
 }

@@ -5,14 +5,10 @@
 
 #include "common/link/shm/shm_device_port.h"
 #include "common/runtime/cli.h"
-#include "spidar_sim/device_node.h"
-#include "spidar_sim/trajectory.h"
-#include "common/runtime/log_paths.h"
+#include "spidar_sim/simulated_fingers.h"
 
-#include <algorithm>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace {
@@ -69,44 +65,21 @@ int main(int argc, char** argv) {
   }
 
   return run_node("spidar_sim", [&] {
-    // Built step by step: a throwing call inside a braced list of elements is cleaned up wrongly by GCC 12
-    // (AddressSanitizer: stack-use-after-scope when the trajectory is bad).
-    std::vector<NamedFinger> fingers;
-    if (finger_specs.empty()) {
-      Trajectory trajectory = load_trajectory(trajectory_spec);
-      fingers.push_back({"finger", std::move(trajectory)});
-    } else {
-      fingers = parse_fingers(finger_specs, kMaxFingers);
-    }
-    double longest_s = 0.0;
-    for (const NamedFinger& named : fingers) longest_s = std::max(longest_s, named.trajectory.duration_s());
     const SpidarDevice spidar = parse_device_spec(device_spec);
-    // One SPIDAR string set, simulation and port per finger, each on its own thread (in lockstep each waits for its
-    // own turn, which the haptic controller gives in finger order).
-    std::vector<std::unique_ptr<DeviceSim>> sims;
-    std::vector<std::unique_ptr<ShmDevicePortClient>> ports;
-    std::vector<std::unique_ptr<DeviceNode>> nodes;
-    for (std::size_t k = 0; k < fingers.size(); ++k) {
-      sims.push_back(std::make_unique<DeviceSim>(spidar.geometry, hardware, finger,
-                                                 fingers[k].trajectory.held_until(longest_s)));
+    std::vector<std::unique_ptr<ShmDevicePortClient>> ports;  // declared first: they outlive the nodes that hold them
+    SimulatedFingers rig(load_fingers(trajectory_spec, finger_specs), spidar.geometry, hardware, finger);
+    for (std::size_t k = 0; k < rig.size(); ++k) {
       ports.push_back(std::make_unique<ShmDevicePortClient>(
           shm, clock, attach_timeout_s, DeviceDescription{geometry_hash(spidar.geometry), spidar.source},
           static_cast<unsigned>(k)));
-      nodes.push_back(std::make_unique<DeviceNode>(*sims.back(), *ports.back(),
-                                                   endpoint_log_path(log_path, static_cast<std::uint32_t>(k)),
-                                                   new_session_id()));
-      std::fprintf(stderr, "spidar_sim: '%s' attached to '%s' (%s), trajectory %.3f s\n", fingers[k].name.c_str(),
-                   ports.back()->name().c_str(), to_string(clock), fingers[k].trajectory.duration_s());
+      rig.attach(k, *ports.back(), log_path, new_session_id());
+      std::fprintf(stderr, "spidar_sim: '%s' attached to '%s' (%s), trajectory %.3f s\n", rig.finger(k).name.c_str(),
+                   ports.back()->name().c_str(), to_string(clock), rig.finger(k).trajectory.duration_s());
     }
-    std::vector<int> statuses(nodes.size(), 0);
-    std::vector<std::thread> threads;
-    for (std::size_t k = 1; k < nodes.size(); ++k) threads.emplace_back([&, k] { statuses[k] = nodes[k]->run(); });
-    statuses[0] = nodes[0]->run();
-    for (std::thread& thread : threads) thread.join();
-
-    write_summary(summary_path, fingers_summary(nodes, fingers));
+    const int status = rig.run();
+    write_summary(summary_path, rig.summary());
     std::fprintf(stderr, "spidar_sim: detached after %llu ticks (%.3f s simulated)\n",
-                 static_cast<unsigned long long>(nodes[0]->ticks()), sims[0]->time_s());
-    return *std::max_element(statuses.begin(), statuses.end());
+                 static_cast<unsigned long long>(rig.node(0).ticks()), rig.node(0).sim().time_s());
+    return status;
   });
 }

@@ -2,13 +2,13 @@
 // world_manager: the rigid-body world at the world rate (docs/architecture.md §1.1). Parses the flags, creates the
 // world link and runs a WorldNode on it; writes the world half of summary.json at exit.
 
-#include "common/link/dds/dds_world_link.h"
 #include "common/link/dds/dds_world_view.h"
-#include "common/link/shm/shm_world_link.h"
+#include "common/link/dds/open_world_link.h"
 #include "common/link/shm/shm_world_view.h"
 #include "common/link/world_view_tee.h"
 #include "common/runtime/cli.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/defaults.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/world_node.h"
 
 #include <memory>
@@ -46,25 +46,20 @@ int main(int argc, char** argv) {
   add_link_flags(app, link_options);
   app.add_option("--haptic-rate", options.haptic_rate_hz, "haptic rate the lockstep phase is counted in (1000)")
       ->check(number_in(limits::kMinHapticRate_Hz, limits::kMaxHapticRate_Hz));
+  app.add_flag_callback(
+      "--defaults",
+      [] {
+        std::printf("%s\n", defaults_document().dump(2).c_str());
+        throw CLI::Success();  // printed: exit 0 before the required flags are checked
+      },
+      "print the couplings, engines, shapes and scene defaults as JSON, and exit");
   CLI11_PARSE(app, argc, argv);
 
   return run_node("world_manager", [&] {
-    init_ode_once();
+    prepare_engines();
     WorldNode node(options);
     // The world link by --link; the world-state view stays in shared memory on this host either way.
-    std::unique_ptr<WorldLinkServer> link;
-    std::string link_name;
-    DdsWorldLinkServer* dds = nullptr;
-    if (link_options.kind == LinkKind::dds) {
-      auto server = std::make_unique<DdsWorldLinkServer>(link_options.dds, node.link_info());
-      dds = server.get();
-      link_name = server->name();
-      link = std::move(server);
-    } else {
-      auto server = std::make_unique<ShmWorldLinkServer>(shm, node.link_info());
-      link_name = "'" + server->name() + "'";
-      link = std::move(server);
-    }
+    const std::unique_ptr<WorldLinkServer> link = open_world_link_server(link_options, shm, node.link_info());
     node.connect(*link);
     // The world view: "<shm>.view" for viewers on this host (read-only), and over DDS too with --link dds.
     ShmWorldViewPublisher shm_view(shm);
@@ -79,17 +74,12 @@ int main(int argc, char** argv) {
     const WorldLinkInfo info = node.link_info();
     std::fprintf(stderr, "world_manager: '%s', %zu objects, %.1f Hz, %s coupling, %s clock, link %s\n",
                  options.scene_path.c_str(), node.world().scene().objects.size(), info.world_rate_hz,
-                 to_string(info.coupling), to_string(info.clock), link_name.c_str());
+                 to_string(info.coupling), to_string(info.clock), link_name(*link).c_str());
     const std::string warnings = node.warnings();
     if (!warnings.empty()) std::fprintf(stderr, "world_manager: warning: %s\n", warnings.c_str());
     const int status = node.run();
     nlohmann::json summary = node.summary();
-    if (dds != nullptr) {
-      summary["world"]["dds"] = {{"domain", link_options.dds.domain_id},
-                                 {"partition", link_options.dds.partition},
-                                 {"refused_endpoints", dds->refused_endpoints()},
-                                 {"released_slots", dds->released_slots()}};
-    }
+    if (nlohmann::json dds = link_summary(*link, link_options); !dds.is_null()) summary["world"]["dds"] = dds;
     write_summary(summary_path, summary);
     std::fprintf(stderr, "world_manager: %llu steps, %.3f s simulated\n",
                  static_cast<unsigned long long>(node.world().steps_taken()), node.world().time_s());

@@ -4,6 +4,7 @@
 #include "common/contract/limits.h"
 #include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
+#include "world_manager/engine/engine_registry.h"
 
 #include <nlohmann/json.hpp>
 
@@ -58,37 +59,31 @@ Floor parse_floor(const Node& node) {
   return floor;
 }
 
+// ODE's own keys, now in "physics": {"ode": {...}}; named where they were first given, to say where they went.
+constexpr std::string_view kOdeKeys[] = {"solver", "solver_iterations", "erp", "cfm", "max_correcting_velocity_mps"};
+
 PhysicsParams parse_physics(const Node& node) {
-  node.expect_keys(
-      {"world_rate_hz", "substeps", "solver", "solver_iterations", "contact_stiffness_Npm", "contact_damping_Nspm",
-       "erp", "cfm", "max_correcting_velocity_mps", "speculative_contacts", "auto_disable", "seed"});
+  node.expect_object();
   PhysicsParams physics;
+  if (node.has("engine")) {
+    const Node engine = node.child("engine");
+    physics.engine = engine.string();
+    if (find_engine(physics.engine) == nullptr) engine.fail("unknown engine, expected " + engine_names());
+  }
+  for (const std::string_view key : kOdeKeys) {
+    if (node.has(key)) {
+      node.child(key).fail("an engine's own setting: give it in the engine's block, \"physics\": {\"ode\": {\"" +
+                           std::string(key) + "\": ...}}");
+    }
+  }
+  const std::string_view kNeutralKeys[] = {"engine", "world_rate_hz", "substeps", "contact_stiffness_Npm",
+                                           "contact_damping_Nspm", "speculative_contacts", "auto_disable", "seed"};
+  const std::string_view block_key[] = {physics.engine};  // the chosen engine's block, and no other
+  node.expect_keys({std::span<const std::string_view>(kNeutralKeys), std::span<const std::string_view>(block_key)});
   if (node.has("world_rate_hz")) {
     physics.world_rate_hz = node.child("world_rate_hz").in_range(limits::kMinWorldRate_Hz, limits::kMaxWorldRate_Hz, " Hz");
   }
   if (node.has("substeps")) physics.substeps = node.child("substeps").positive_int(limits::kMaxSubsteps);
-  if (node.has("solver")) {
-    const Node solver = node.child("solver");
-    const std::string name = solver.string();
-    if (name == "quickstep") {
-      physics.solver = PhysicsParams::Solver::quickstep;
-    } else if (name == "direct") {
-      physics.solver = PhysicsParams::Solver::direct;
-    } else {
-      solver.fail("expected \"quickstep\" or \"direct\"");
-    }
-  }
-  if (node.has("solver_iterations")) {
-    physics.solver_iterations = node.child("solver_iterations").positive_int(limits::kMaxSolverIterations);
-  }
-  // ODE's per-substep numbers as they are, or the contact as a spring and a damper: one model or the other.
-  const bool spring = node.has("contact_stiffness_Npm") || node.has("contact_damping_Nspm");
-  for (const char* key : {"erp", "cfm"}) {
-    if (node.has(key) && spring) {
-      node.child(key).fail("give either \"erp\"/\"cfm\" (ODE's numbers per substep) or \"contact_stiffness_Npm\"/"
-                           "\"contact_damping_Nspm\" (a spring and damper at any substep), not both");
-    }
-  }
   if (node.has("contact_stiffness_Npm")) {
     physics.contact_stiffness_Npm =
         node.child("contact_stiffness_Npm")
@@ -98,12 +93,6 @@ PhysicsParams parse_physics(const Node& node) {
     physics.contact_damping_Nspm =
         node.child("contact_damping_Nspm").in_range(0.0, SceneLimits::kMaxContactDamping_Nspm, " N·s/m");
   }
-  if (node.has("erp")) physics.erp = node.child("erp").in_unit_interval();
-  if (node.has("cfm")) physics.cfm = node.child("cfm").in_range(0.0, SceneLimits::kMaxCfm, "");
-  if (node.has("max_correcting_velocity_mps")) {
-    physics.max_correcting_velocity_mps =
-        node.child("max_correcting_velocity_mps").positive_up_to(SceneLimits::kMaxSpeed_mps, " m/s");
-  }
   if (node.has("speculative_contacts")) {
     physics.speculative_contacts = node.child("speculative_contacts").boolean();
   }
@@ -112,6 +101,12 @@ PhysicsParams parse_physics(const Node& node) {
     const Node seed = node.child("seed");
     if (!seed.value().is_number_unsigned()) seed.fail("expected a non-negative integer");
     physics.seed = seed.value().get<std::uint64_t>();
+  }
+  // After the neutral keys: an engine's block may depend on them (ODE's ERP and CFM exclude the contact spring).
+  if (node.has(physics.engine)) {
+    const Node block = node.child(physics.engine);
+    block.expect_object();
+    find_engine(physics.engine)->parse_block(block, physics);
   }
   return physics;
 }
@@ -221,13 +216,13 @@ double damping_or_default(double damping_Nspm) {
 }  // namespace
 
 double PhysicsParams::erp_at(double substep_s) const {
-  if (!contact_spring()) return erp;
+  if (!contact_spring()) return ode.erp;
   const double hk = substep_s * stiffness_or_default(contact_stiffness_Npm);
   return hk / (hk + damping_or_default(contact_damping_Nspm));
 }
 
 double PhysicsParams::cfm_at(double substep_s) const {
-  if (!contact_spring()) return cfm;
+  if (!contact_spring()) return ode.cfm;
   return 1.0 / (substep_s * stiffness_or_default(contact_stiffness_Npm) + damping_or_default(contact_damping_Nspm));
 }
 

@@ -101,11 +101,8 @@ struct HapticParams {
   Material finger_material;
 };
 
-struct PhysicsParams {
-  double world_rate_hz = 20.0;  // paper §4.2.1
-  // 50 ms is too coarse for ODE's contacts: a body falls g·T² ≈ 2.5 cm into the floor in one step, half a 5 cm cube.
-  // Ten 5 ms substeps keep that under 0.25 mm for the cost of ten cheap steps.
-  int substeps = 10;
+// ODE's own settings: the scene's "physics": {"ode": {...}} (world_manager/engine/ode_params.cpp reads them).
+struct OdeParams {
   // QuickStep is ODE's fast iterative solver; it converges badly when a light body carries a much heavier one
   // (a 1000:1 stack collapses at any iteration count), where the direct solver is exact but cubic in the contacts.
   enum class Solver { quickstep, direct };
@@ -114,38 +111,49 @@ struct PhysicsParams {
   // ODE's error reduction and constraint force mixing, used as they are at every substep (ODE's own semantics): a
   // contact then acts as a spring k = ERP/(h·CFM) and a damper c = (1 − ERP)/CFM, so it stiffens as the substep h
   // shortens. ERP 0.2 is ODE's default; a CFM of 1e-5 (ODE's is 1e-10 in double) lets QuickStep settle stacks
-  // without jitter.
+  // without jitter. Not with the engine-neutral contact spring (PhysicsParams::contact_stiffness_Npm).
   double erp = 0.2;
   double cfm = 1e-5;
-  // Or every contact as a spring and a damper that stay the same at any world rate and substep count, which ODE is
-  // given per substep (ODE manual, "Joint error and the ERP" and "Soft constraint and CFM"):
-  //   ERP = h·k / (h·k + c),   CFM = 1 / (h·k + c).
-  // NaN: not given (then ERP and CFM above). A scene that gives one of the two gets the other from kDefaultContact*:
-  // ERP 0.2 and CFM 1e-5 at 5 ms substeps (20 Hz × 10), where the two models agree exactly. A 1 kg body rests m·g/k
-  // = 2.5 µm deep on one such contact (a box on four, 0.6 µm); a contact's correction time constant c/k is 20 ms.
-  static constexpr double kDefaultContactStiffness_Npm = 4e6;  // 0.2 / (0.005 s · 1e-5)
-  static constexpr double kDefaultContactDamping_Nspm = 8e4;   // 0.8 / 1e-5
-  double contact_stiffness_Npm = std::numeric_limits<double>::quiet_NaN();
-  double contact_damping_Nspm = std::numeric_limits<double>::quiet_NaN();
-  bool contact_spring() const { return !std::isnan(contact_stiffness_Npm) || !std::isnan(contact_damping_Nspm); }
-  // What ODE is given for substeps of `substep_s`: ERP and CFM as they are, or from the spring and damper.
-  double erp_at(double substep_s) const;
-  double cfm_at(double substep_s) const;
   // ERP removes a fraction of each contact's penetration per substep, as a separating speed erp·depth/h; this caps
   // that speed. An impact that penetrates (speculative contacts off) turns the correction into a bounce nobody asked
   // for, which a low cap suppresses; the cap also slows the removal of any penetration (2 mm takes 0.4 s at
   // 5 mm/s), so it is off unless a scene asks for it. Infinity: no cap (ODE's default).
   double max_correcting_velocity_mps = std::numeric_limits<double>::infinity();
+};
+
+// How the world is simulated: engine-neutral settings, and each engine's own block (docs/scene-format.md "physics").
+struct PhysicsParams {
+  // The rigid-body engine, by its name in the registry (world_manager/engine/engine_registry.h).
+  std::string engine = "ode";
+  double world_rate_hz = 20.0;  // paper §4.2.1
+  // 50 ms is too coarse for contacts: a body falls g·T² ≈ 2.5 cm into the floor in one step, half a 5 cm cube.
+  // Ten 5 ms substeps keep that under 0.25 mm for the cost of ten cheap steps.
+  int substeps = 10;
+  // Every contact as a spring and a damper that stay the same at any world rate and substep count. ODE is given them
+  // per substep as ERP = h·k / (h·k + c), CFM = 1 / (h·k + c) (ODE manual, "Joint error and the ERP" and "Soft
+  // constraint and CFM"). NaN: not given (then the engine's own contact, e.g. ODE's ERP and CFM). A scene that gives
+  // one of the two gets the other from kDefaultContact*: ODE's ERP 0.2 and CFM 1e-5 at 5 ms substeps (20 Hz × 10),
+  // where the two models agree exactly. A 1 kg body rests m·g/k = 2.5 µm deep on one such contact (a box on four,
+  // 0.6 µm); a contact's correction time constant c/k is 20 ms.
+  static constexpr double kDefaultContactStiffness_Npm = 4e6;  // 0.2 / (0.005 s · 1e-5)
+  static constexpr double kDefaultContactDamping_Nspm = 8e4;   // 0.8 / 1e-5
+  double contact_stiffness_Npm = std::numeric_limits<double>::quiet_NaN();
+  double contact_damping_Nspm = std::numeric_limits<double>::quiet_NaN();
+  bool contact_spring() const { return !std::isnan(contact_stiffness_Npm) || !std::isnan(contact_damping_Nspm); }
   // Contacts made one substep before a pair meets, which let it close the gap and no more
-  // (engine/speculative_contact.h): an impact then neither sinks v·h into the other body nor gets ERP's push-out
-  // back as a bounce. Off: ODE's contacts only once bodies overlap.
+  // (engine/speculative_contact.h): an impact then neither sinks v·h into the other body nor gets the solver's
+  // push-out back as a bounce. Off: contacts only once bodies overlap.
   bool speculative_contacts = true;
   // A body resting for half a second leaves the simulation until something pushes or touches it
   // (engine/ode_engine.h): "model only what a scene needs". The tap trial's cube ends within 60 nm of where it ends
-  // with it off (docs/sleeping.md); off keeps every body in ODE.
+  // with it off (docs/sleeping.md); off keeps every body simulated.
   bool auto_disable = true;
-  std::uint64_t seed = 1;
+  std::uint64_t seed = 1;  // the engine's random stream, so runs are bitwise reproducible
+  OdeParams ode;
 
+  // What ODE is given for substeps of `substep_s`: its ERP and CFM as they are, or from the spring and damper.
+  double erp_at(double substep_s) const;
+  double cfm_at(double substep_s) const;
   double world_period_s() const { return 1.0 / world_rate_hz; }
 };
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/world.h"
 
-#include "world_manager/engine/ode_engine.h"
+#include "world_manager/engine/engine_registry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -35,7 +35,7 @@ World::World(const Scene& scene, const WorldOptions& options)
   }
   if (options.world_session == 0) throw std::invalid_argument("world_session must be nonzero");
 
-  engine_ = std::make_unique<OdeEngine>(scene_);
+  engine_ = make_engine(scene_);
   const CouplingContext context{scene_, period_s_, scene_.physics.substeps, *engine_, states_, applied_};
   coupling_ = make_coupling(options.coupling, context, stiffness_Npm, damping_Nspm);
 

@@ -3,9 +3,9 @@
 // The virtual world of the world manager: a Scene on a rigid-body engine, stepped once per world period T_w
 // (docs/architecture.md §1.1): the report's impulses through the ledger to the coupling, engine substeps, the planes.
 //
-// Threading and ownership: a World owns its engine (ODE: engine/ode_engine.h) and its coupling strategy
-// (couplings/) and is used from one thread. The process must have called init_ode_once()
-// (world_manager/engine/ode_runtime.h) before constructing one. Runs are bitwise reproducible per World even when
+// Threading and ownership: a World owns its engine (the scene's physics.engine, engine/engine_registry.h) and its
+// coupling strategy (couplings/) and is used from one thread. The process must have called prepare_engines()
+// (engine/engine_registry.h) before constructing one. Runs are bitwise reproducible per World even when
 // several Worlds live in one process (tests).
 //
 // Units SI, world frame right-handed with z up; object ids are scene indices, the floor is scene.floor_object_id().

@@ -276,7 +276,8 @@ nlohmann::json WorldNode::summary() const {
             {"phase_ticks", options_.phase_ticks},
             {"substeps", scene_.physics.substeps},
             {"gravity_mps2", {scene_.gravity_mps2[0], scene_.gravity_mps2[1], scene_.gravity_mps2[2]}},
-            {"solver_iterations", scene_.physics.solver_iterations}}}};
+            {"engine", scene_.physics.engine},
+            {"solver_iterations", scene_.physics.ode.solver_iterations}}}};
 }
 
 }  // namespace impetus

@@ -35,7 +35,7 @@ struct WorldNodeOptions {
   std::uint64_t phase_ticks = 0;
   double duration_s = 0.0;  // 0: until stopped
   std::string log_path;     // "" : no log
-  double haptic_rate_hz = 1000.0;  // lockstep: the world period must be a whole number of haptic ticks
+  double haptic_rate_hz = limits::kDefaultHapticRate_Hz;  // lockstep: the world period must be a whole number of haptic ticks
   std::uint64_t world_session = 0;  // 0: a fresh new_session_id()
 };
 

@@ -12,6 +12,8 @@ inline constexpr double kMaxWorldRate_Hz = 10'000.0;
 // Haptic rate: 100 Hz (below it a stiff contact cannot be rendered at all) to 20 kHz (what a servo thread can hold).
 inline constexpr double kMinHapticRate_Hz = 100.0;
 inline constexpr double kMaxHapticRate_Hz = 20'000.0;
+// The haptic rate every node assumes unless told otherwise: the paper's 1 kHz (§4.2.1).
+inline constexpr double kDefaultHapticRate_Hz = 1000.0;
 // ODE substeps and QuickStep iterations per world step: 10^4 already costs ~1000× the defaults per step.
 inline constexpr int kMaxSubsteps = 10'000;
 inline constexpr int kMaxSolverIterations = 10'000;

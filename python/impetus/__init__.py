@@ -21,13 +21,21 @@ from . import _impetus
 
 __version__ = "@PROJECT_VERSION@"
 
-# The couplings (world_manager --coupling):
+
+
+def defaults():
+    """What the C++ side decides before any trial (world_manager --defaults): "couplings", "engines", "shapes",
+    "haptic_rate_hz", and "scene", what a scene's left-out keys become. A new dict each call."""
+    return json.loads(_impetus.defaults())
+
+
+# The couplings (world_manager --coupling), from the C++ side:
 #   impulse   force integration, the paper's method: the world applies the impulse the haptic side integrated since
 #             its last step;
 #   position  the paper's previous method: a penalty force from the finger sampled at the world step, held for the
 #             whole world period;
 #   local     impulse coupling plus the paper's §6.3: the haptic side moves the touched objects between world steps.
-COUPLINGS = ("impulse", "position", "local")
+COUPLINGS = tuple(defaults()["couplings"])
 
 # The logs a trial writes, by the key Trial.logs uses.
 LOG_FILES = {"world": "world.csv", "haptic": "haptic.csv", "device": "device.csv"}

@@ -3,7 +3,7 @@
 reading what a trial leaves behind.
 
   paths            the repository root and the daemons' build directory
-  daemon_defaults  the C++ defaults the scripts need that no trial output exports (finger, hand, device, rates)
+  daemon_defaults  the C++ side's defaults (couplings, rates, scene defaults), read from it (world_manager --defaults)
   scene            a scene file (scenes/*.json) with the scene parser's defaults filled in
   trial            run one lockstep trial, in this process or as three daemons (COUPLINGS: the couplings)
   parallel         run many trials at once, in worker processes

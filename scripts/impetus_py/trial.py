@@ -18,13 +18,21 @@ import sys
 from .paths import ROOT, build_dir
 from .summary import Summary
 
-# The couplings world_manager --coupling accepts (README "What runs"):
+# COUPLINGS: the couplings world_manager --coupling accepts (README "What runs"), read from the C++ side
+# (daemon_defaults) when first used:
 #   impulse   force integration, the paper's method: the world applies the impulse the haptic side integrated since
 #             its last step;
 #   position  the paper's previous method: a penalty force from the finger sampled at the world step, held for the
 #             whole world period;
 #   local     impulse coupling plus the paper's §6.3: the haptic side moves the touched objects between world steps.
-COUPLINGS = ("impulse", "position", "local")
+
+
+def __getattr__(name):  # PEP 562
+    if name == "COUPLINGS":
+        from . import daemon_defaults
+        return daemon_defaults.COUPLINGS
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 _module = None
 

@@ -8,7 +8,7 @@
 // one.
 
 #include "haptic_controller/servo.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/scene.h"
 #include "world_manager/world.h"
 
@@ -52,7 +52,7 @@ Eigen::Vector3d finger_at(double t_s) {
 }  // namespace
 
 int main() {
-  init_ode_once();
+  prepare_engines();
   const Scene scene = box_scene();
   World world(scene, WorldOptions{});
   HapticServo as_sent(ServoOptions{}, 1);

@@ -14,7 +14,7 @@
 
 #include "world_manager/scene.h"
 #include "world_manager/features/feature_extractor.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/world.h"
 
 #include <algorithm>
@@ -263,7 +263,7 @@ void bench_sleeping(bool quick) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  impetus::init_ode_once();
+  impetus::prepare_engines();
   const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
   if (argc > 1 && std::string(argv[1]) == "--sleeping") {
     bench_sleeping(false);

@@ -9,7 +9,7 @@
 #include "common/link/shm/shm_world_view.h"
 #include "common/runtime/loop_stats.h"
 #include "viewer/view_encoding.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/world.h"
 #include "world_manager/world_view.h"
 
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: bench_world_view [STEPS>0]\n");
     return 2;
   }
-  init_ode_once();
+  prepare_engines();
   std::printf("%8s %12s %12s %14s %14s %14s %12s\n", "bodies", "step us", "snapshot B", "take+pub us",
               "read us", "encode us", "message B");
   for (const int count : {2, 100, 500, 2000}) {

@@ -10,7 +10,7 @@
 
 #include "haptic_controller/servo.h"
 #include "loop/in_process_trial.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/scene.h"
 #include "world_manager/world.h"
 
@@ -68,7 +68,7 @@ struct Run {
 // The world steps at ticks phase, phase + 50, ... (the lockstep phase, docs/architecture.md §3).
 Run run(const Scene& scene, Coupling coupling, std::vector<ScriptedFinger>& fingers, double duration_s,
         int phase_ticks = 0) {
-  init_ode_once();
+  prepare_engines();
   WorldOptions options;
   options.coupling = coupling;
   options.world_session = 7;

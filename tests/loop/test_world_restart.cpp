@@ -7,7 +7,7 @@
 // of m/s).
 
 #include "haptic_controller/servo.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/scene.h"
 #include "world_manager/world.h"
 
@@ -35,7 +35,7 @@ FingerSample finger_at(double t_s) {
 }
 
 void check_restart(Coupling coupling) {
-  init_ode_once();
+  prepare_engines();
   const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json");
   WorldOptions options;
   options.coupling = coupling;

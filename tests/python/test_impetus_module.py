@@ -209,5 +209,37 @@ class Arguments(unittest.TestCase):
         self.assertTrue(np.array_equal(impetus.read_log(damaged)["force_x"], [1.0, 2.0]))
 
 
+class Defaults(unittest.TestCase):
+    """The package and the scripts take the C++ side's defaults from it, never from a copy."""
+
+    def test_the_package_and_the_daemon_give_the_same_defaults(self):
+        binary = pathlib.Path(os.environ["IMPETUS_BUILD_DIR"]) / "world_manager" / "world_manager"
+        printed = json.loads(subprocess.run([str(binary), "--defaults"], check=True, capture_output=True,
+                                            text=True).stdout)
+        self.assertEqual(impetus.defaults(), printed)
+        self.assertEqual(impetus.COUPLINGS, ("impulse", "position", "local"))
+        self.assertIn("ode", printed["engines"])
+        self.assertEqual(printed["shapes"], ["box", "sphere", "capsule", "cylinder"])
+        # A scene that leaves its haptic and physics keys out runs with what the defaults say.
+        OUT.mkdir(parents=True, exist_ok=True)
+        bare = OUT / "bare-scene.json"
+        tap = json.loads((ROOT / "scenes/tap.json").read_text())
+        bare.write_text(json.dumps({"objects": tap["objects"]}))
+        trial = impetus.run_trial(bare, "tap", "impulse", duration_s=0.5, logs=False)
+        self.assertEqual(trial.summary["haptic"]["damping_Nspm"], printed["scene"]["haptic"]["damping_Nspm"])
+        self.assertEqual(trial.summary["haptic"]["stiffness_Npm"], printed["scene"]["haptic"]["stiffness_Npm"])
+        self.assertEqual(trial.summary["haptic"]["rate_hz"], printed["haptic_rate_hz"])
+        self.assertEqual(trial.summary["config"]["substeps"], printed["scene"]["physics"]["substeps"])
+        self.assertEqual(trial.summary["config"]["engine"], printed["scene"]["physics"]["engine"])
+
+    def test_the_scripts_read_the_defaults_from_the_cpp_side(self):
+        sys.path.insert(0, str(ROOT / "scripts"))
+        from impetus_py import daemon_defaults, trial  # noqa: E402  (the scripts' package)
+        document = impetus.defaults()
+        self.assertEqual(daemon_defaults.HAPTIC_RATE_HZ, document["haptic_rate_hz"])
+        self.assertEqual(daemon_defaults.SCENE_SUBSTEPS, document["scene"]["physics"]["substeps"])
+        self.assertEqual(trial.COUPLINGS, tuple(document["couplings"]))
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)

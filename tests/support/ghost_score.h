@@ -16,7 +16,7 @@
 //   release         from the finger leaving the last object to the force falling under 0.1 N, in 1 ms ticks
 
 #include "haptic_controller/servo.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/engine/engine_registry.h"
 #include "common/shape/shape.h"
 #include "world_manager/scene.h"
 #include "world_manager/world.h"
@@ -190,7 +190,7 @@ inline Scene stream(int count, unsigned seed, const Eigen::Vector3d& velocity_mp
 //                      the truth at tick s.
 // So the ticks are rendered first and scored once the world has simulated the times they need.
 inline Score score(Scene scene, double world_rate_hz, double duration_s, Coupling coupling = Coupling::impulse) {
-  init_ode_once();
+  prepare_engines();
   scene.physics.world_rate_hz = world_rate_hz;
   std::vector<BodyPose> poses;
   for (const SceneObject& object : scene.objects) {

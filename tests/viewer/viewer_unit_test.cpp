@@ -10,7 +10,7 @@
 #include "viewer/view_protocol.h"
 #include "viewer/viewer_node.h"
 #include "viewer/web_root.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/world.h"
 #include "world_manager/world_view.h"
 
@@ -48,7 +48,7 @@ std::vector<double> values_of(const std::string& message) {
 }  // namespace
 
 TEST_CASE("the world's snapshot carries every body's pose and the finger, the shm view passes it whole") {
-  init_ode_once();
+  prepare_engines();
   const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json");
   World world(scene, WorldOptions{});
   HapticReport report{};
@@ -91,7 +91,7 @@ TEST_CASE("the world's snapshot carries every body's pose and the finger, the sh
 }
 
 TEST_CASE("over DDS a live feed shows a world publishing in its partition, every body and every plane whole") {
-  init_ode_once();
+  prepare_engines();
   const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/stack.json");
   World world(scene, WorldOptions{});
   HapticReport report{};

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/scene.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_test_support.h"
 
 #include <catch2/catch.hpp>
@@ -193,10 +194,10 @@ TEST_CASE("scene error: bad physics settings") {
   require_error(json{{"objects", json::array()}, {"physics", {{"substeps", 2.5}}}}, "/physics/substeps", "whole");
   require_error(json{{"objects", json::array()}, {"haptic", {{"stiffness_Npm", -1}}}}, "/haptic/stiffness_Npm",
                 "positive");
-  require_error(json{{"objects", json::array()}, {"physics", {{"solver", "magic"}}}}, "/physics/solver",
-                "\"quickstep\" or \"direct\"");
-  require_error(json{{"objects", json::array()}, {"physics", {{"max_correcting_velocity_mps", 0}}}},
-                "/physics/max_correcting_velocity_mps", "positive");
+  require_error(json{{"objects", json::array()}, {"physics", {{"ode", {{"solver", "magic"}}}}}},
+                "/physics/ode/solver", "\"quickstep\" or \"direct\"");
+  require_error(json{{"objects", json::array()}, {"physics", {{"ode", {{"max_correcting_velocity_mps", 0}}}}}},
+                "/physics/ode/max_correcting_velocity_mps", "positive");
   require_error(json{{"objects", json::array()}, {"physics", {{"speculative_contacts", 1}}}},
                 "/physics/speculative_contacts", "true or false");
 }
@@ -208,10 +209,10 @@ TEST_CASE("speculative contacts are on unless the scene turns them off") {
 }
 
 TEST_CASE("the penetration correction is uncapped unless the scene caps it") {
-  CHECK(std::isinf(impetus::parse_scene(json{{"objects", json::array()}}, "test.json").physics
+  CHECK(std::isinf(impetus::parse_scene(json{{"objects", json::array()}}, "test.json").physics.ode
                        .max_correcting_velocity_mps));
-  const json document{{"objects", json::array()}, {"physics", {{"max_correcting_velocity_mps", 0.005}}}};
-  CHECK(impetus::parse_scene(document, "test.json").physics.max_correcting_velocity_mps == 0.005);
+  const json document{{"objects", json::array()}, {"physics", {{"ode", {{"max_correcting_velocity_mps", 0.005}}}}}};
+  CHECK(impetus::parse_scene(document, "test.json").physics.ode.max_correcting_velocity_mps == 0.005);
 }
 
 TEST_CASE("a contact takes ODE's ERP and CFM as they are, or a spring and damper that agree with them at 5 ms") {
@@ -239,17 +240,19 @@ TEST_CASE("a contact takes ODE's ERP and CFM as they are, or a spring and damper
   const impetus::PhysicsParams rigid = impetus::parse_scene(undamped, "t.json").physics;
   CHECK(rigid.erp_at(1e-3) == 1.0);  // no damper: the whole penetration is corrected in one substep
   CHECK(rigid.cfm_at(1e-3) == Approx(1e-2));
-  const json own{{"objects", json::array()}, {"physics", {{"erp", 0.5}, {"cfm", 0.0}}}};
+  const json own{{"objects", json::array()}, {"physics", {{"ode", {{"erp", 0.5}, {"cfm", 0.0}}}}}};
   const impetus::PhysicsParams ode = impetus::parse_scene(own, "t.json").physics;
   CHECK(ode.erp_at(1e-2) == 0.5);
   CHECK(ode.cfm_at(1e-3) == 0.0);
 }
 
 TEST_CASE("scene error: both contact models at once, or a contact softer than 1 N/m") {
-  require_error(json{{"objects", json::array()}, {"physics", {{"erp", 0.2}, {"contact_stiffness_Npm", 1e6}}}},
-                "/physics/erp", "not both");
-  require_error(json{{"objects", json::array()}, {"physics", {{"cfm", 1e-5}, {"contact_damping_Nspm", 1e4}}}},
-                "/physics/cfm", "not both");
+  require_error(
+      json{{"objects", json::array()}, {"physics", {{"ode", {{"erp", 0.2}}}, {"contact_stiffness_Npm", 1e6}}}},
+      "/physics/ode/erp", "not both");
+  require_error(
+      json{{"objects", json::array()}, {"physics", {{"ode", {{"cfm", 1e-5}}}, {"contact_damping_Nspm", 1e4}}}},
+      "/physics/ode/cfm", "not both");
   require_error(json{{"objects", json::array()}, {"physics", {{"contact_stiffness_Npm", 0.5}}}},
                 "/physics/contact_stiffness_Npm", "N/m");
   require_error(json{{"objects", json::array()}, {"physics", {{"contact_damping_Nspm", -1}}}},
@@ -257,10 +260,33 @@ TEST_CASE("scene error: both contact models at once, or a contact softer than 1 
 }
 
 TEST_CASE("the direct solver is chosen by the scene and QuickStep is the default") {
-  const json document{{"objects", json::array()}, {"physics", {{"solver", "direct"}}}};
-  CHECK(impetus::parse_scene(document, "test.json").physics.solver == impetus::PhysicsParams::Solver::direct);
-  CHECK(impetus::parse_scene(json{{"objects", json::array()}}, "test.json").physics.solver ==
-        impetus::PhysicsParams::Solver::quickstep);
+  const json document{{"objects", json::array()}, {"physics", {{"ode", {{"solver", "direct"}}}}}};
+  CHECK(impetus::parse_scene(document, "test.json").physics.ode.solver == impetus::OdeParams::Solver::direct);
+  CHECK(impetus::parse_scene(json{{"objects", json::array()}}, "test.json").physics.ode.solver ==
+        impetus::OdeParams::Solver::quickstep);
+}
+
+TEST_CASE("the engine is chosen by name from the registry, ODE by default, and its own settings live in its block") {
+  CHECK(impetus::parse_scene(json{{"objects", json::array()}}, "test.json").physics.engine == "ode");
+  const json chosen{{"objects", json::array()}, {"physics", {{"engine", "ode"}, {"ode", {{"erp", 0.3}}}}}};
+  CHECK(impetus::parse_scene(chosen, "test.json").physics.ode.erp == 0.3);
+  // An unknown engine names the known ones.
+  require_error(json{{"objects", json::array()}, {"physics", {{"engine", "havok"}}}}, "/physics/engine",
+                "unknown engine, expected ode");
+  // An engine's own key at the top of the physics block says where it now goes.
+  require_error(json{{"objects", json::array()}, {"physics", {{"solver_iterations", 30}}}},
+                "/physics/solver_iterations", "\"physics\": {\"ode\": {\"solver_iterations\": ...}}");
+  // Another engine's block than the chosen one is an unknown key, and so is a key the engine does not have.
+  require_error(json{{"objects", json::array()}, {"physics", {{"bullet", json::object()}}}}, "/physics/bullet",
+                "unknown key");
+  require_error(json{{"objects", json::array()}, {"physics", {{"ode", {{"iterations", 30}}}}}},
+                "/physics/ode/iterations", "unknown key");
+  // The registry builds what the scene names, and refuses what it does not hold.
+  impetus::Scene scene = impetus::parse_scene(json{{"objects", json::array()}}, "test.json");
+  impetus::prepare_engines();
+  CHECK(impetus::make_engine(scene) != nullptr);
+  scene.physics.engine = "havok";
+  CHECK_THROWS_AS(impetus::make_engine(scene), impetus::SceneError);
 }
 
 TEST_CASE("scene error: the message echoes the offending value") {
@@ -310,11 +336,11 @@ TEST_CASE("scene error: finite values beyond what the engine can simulate name t
       {"/gravity_mps2", json{0, 0, -1e30}, "at most 1000 m/s"},
       {"/floor/height_m", 1e12, "between -10000 and 10000 m"},
       {"/physics/substeps", 1000000, "from 1 to 10000"},
-      {"/physics/solver_iterations", 1000000, "from 1 to 10000"},
+      {"/physics/ode/solver_iterations", 1000000, "from 1 to 10000"},
       {"/physics/substeps", 1e300, "whole number"},
       {"/physics/world_rate_hz", 1e30, "between 0.1 and 10000 Hz"},
       {"/physics/world_rate_hz", 1e-300, "between 0.1 and 10000 Hz"},
-      {"/physics/cfm", 1e30, "between 0 and 1"},
+      {"/physics/ode/cfm", 1e30, "between 0 and 1"},
       {"/haptic/stiffness_Npm", 1e30, "at most 1e+06 N/m"},
       {"/haptic/reach_radius_m", 1e30, "at most 10 m"},
   };

@@ -27,7 +27,7 @@ namespace {
 Scene stack_and_ball(double ball_gap_m, double ball_speed_mps) {
   Scene scene = impetus::load_scene(impetus::test::scene_path("stack.json"));
   scene.physics.auto_disable = true;
-  scene.physics.solver = impetus::PhysicsParams::Solver::direct;
+  scene.physics.ode.solver = impetus::OdeParams::Solver::direct;
   const double radius_m = 0.02;
   impetus::SceneObject ball;
   ball.name = "ball";

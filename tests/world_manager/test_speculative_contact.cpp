@@ -145,7 +145,7 @@ TEST_CASE("speculative contacts: a fast ball wakes the sleeping box it is about 
 }
 
 TEST_CASE("speculative_contacts: the gap a sphere closes on a plane, and the body put back exactly") {
-  init_ode_once();
+  prepare_engines();
   dWorldID world = dWorldCreate();
   dGeomID plane = dCreatePlane(nullptr, 0.0, 0.0, 1.0, 0.0);
   dGeomID sphere = dCreateSphere(nullptr, 0.02);

@@ -281,7 +281,7 @@ TEST_CASE("a finger that comes back after its device stalled meets the face it w
   // without a finger) for 5 world steps while the finger goes on moving, and comes back with its proxy 1 cm past the
   // cube's centre. The world must still give the −x face (the one the proxy went in by): the far face would put the
   // proxy outside through the +x side and pull the finger on through.
-  impetus::init_ode_once();
+  impetus::prepare_engines();
   const impetus::Scene scene = impetus::load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json");
   impetus::World world(scene, impetus::WorldOptions{});
   HapticReport report = make_report(7, 1, {0.006, 0.0, 0.025}, true);

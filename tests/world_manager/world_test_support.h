@@ -5,7 +5,7 @@
 
 #include "common/link/shm/wire_frames.h"
 #include "world_manager/scene.h"
-#include "world_manager/engine/ode_runtime.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/world.h"
 
 #include <nlohmann/json.hpp>
@@ -17,7 +17,7 @@
 namespace impetus::test {
 
 inline std::unique_ptr<World> make_world(const Scene& scene, const WorldOptions& options = {}) {
-  init_ode_once();
+  prepare_engines();
   return std::make_unique<World>(scene, options);
 }
 

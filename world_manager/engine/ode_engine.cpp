@@ -524,10 +524,10 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
     ode.displacement.assign(scene.objects.size(), Eigen::Vector3d::Zero());
   }
   dWorldSetGravity(ode.world, scene.gravity_mps2[0], scene.gravity_mps2[1], scene.gravity_mps2[2]);
-  if (std::isfinite(scene.physics.max_correcting_velocity_mps)) {
-    dWorldSetContactMaxCorrectingVel(ode.world, scene.physics.max_correcting_velocity_mps);
+  if (std::isfinite(scene.physics.ode.max_correcting_velocity_mps)) {
+    dWorldSetContactMaxCorrectingVel(ode.world, scene.physics.ode.max_correcting_velocity_mps);
   }
-  dWorldSetQuickStepNumIterations(ode.world, scene.physics.solver_iterations);
+  dWorldSetQuickStepNumIterations(ode.world, scene.physics.ode.solver_iterations);
   dWorldSetAutoDisableFlag(ode.world, scene.physics.auto_disable ? 1 : 0);
   if (ode.sleeping) {
     dWorldSetAutoDisableLinearThreshold(ode.world, kSleepSpeed_mps);
@@ -727,7 +727,7 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
       ode.feedback.resize(ode.recorded.size());
       for (std::size_t c = 0; c < ode.recorded.size(); ++c) dJointSetFeedback(ode.recorded[c].joint, &ode.feedback[c]);
     }
-    if (scene.physics.solver == PhysicsParams::Solver::direct) {
+    if (scene.physics.ode.solver == OdeParams::Solver::direct) {
       dWorldStep(ode.world, substep_s);
     } else {
       dWorldQuickStep(ode.world, substep_s);

@@ -22,6 +22,11 @@
 
 namespace impetus {
 
+class JsonNode;
+
+// Reads ODE's block of a scene's physics (PhysicsParams::ode; engine_registry.h); throws SceneError.
+void parse_ode_block(const JsonNode& block, PhysicsParams& physics);
+
 class OdeEngine final : public RigidBodyEngine {
  public:
   // Builds the scene's bodies and geoms and seeds the generator with scene.physics.seed. Keeps a reference to

@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "haptic_controller/device/device_registry.h"
+
+#include "common/spidar/geometry.h"
+#include "haptic_controller/device/spidar_driver.h"
+
+#include <stdexcept>
+
+namespace impetus {
+namespace {
+
+// The SPIDAR: four strings per finger from alternate corners of a cube (common/spidar/geometry.h); its argument is a
+// device file, the built-in geometry without one.
+class SpidarType final : public DeviceType {
+ public:
+  explicit SpidarType(SpidarDevice spidar)
+      : spidar_(std::move(spidar)), description_{geometry_hash(spidar_.geometry), spidar_.source} {}
+  const DeviceDescription& description() const override { return description_; }
+  std::unique_ptr<HapticDevice> make_finger(DevicePortHost& port, ClockMode clock,
+                                            std::uint64_t haptic_session) const override {
+    return std::make_unique<SpidarDriver>(spidar_.geometry, port, clock, haptic_session);
+  }
+
+ private:
+  SpidarDevice spidar_;
+  DeviceDescription description_;
+};
+
+std::unique_ptr<DeviceType> parse_spidar(const std::string& argument) {
+  return std::make_unique<SpidarType>(parse_device_spec(argument.empty() ? "spidar" : "spidar:" + argument));
+}
+
+constexpr DeviceEntry kDevices[] = {
+    {"spidar", "FILE.json", parse_spidar},
+};
+
+}  // namespace
+
+std::string device_forms() {
+  std::string forms;
+  const std::size_t count = std::size(kDevices);
+  for (std::size_t k = 0; k < count; ++k) {
+    if (k > 0) forms += k + 1 == count ? " or " : ", ";
+    forms += kDevices[k].name;
+    if (!kDevices[k].argument.empty()) {
+      forms += " or " + std::string(kDevices[k].name) + ":" + std::string(kDevices[k].argument);
+    }
+  }
+  return forms;
+}
+
+std::unique_ptr<DeviceType> parse_device(const std::string& spec) {
+  const std::size_t colon = spec.find(':');
+  const std::string name = spec.substr(0, colon);
+  const std::string argument = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  for (const DeviceEntry& entry : kDevices) {
+    if (entry.name != name) continue;
+    if (colon != std::string::npos && (argument.empty() || entry.argument.empty())) break;  // "NAME:" or no argument
+    return entry.parse(argument);
+  }
+  throw std::invalid_argument("--device must be " + device_forms() + ", not '" + spec + "'");
+}
+
+AssembledDevice::AssembledDevice(const DeviceType& type, std::span<DevicePortHost* const> ports, ClockMode clock,
+                                 std::uint64_t haptic_session) {
+  if (ports.empty()) throw std::invalid_argument("a device needs at least one port");
+  std::vector<HapticDevice*> fingers;
+  for (DevicePortHost* port : ports) {
+    fingers_.push_back(type.make_finger(*port, clock, haptic_session));
+    fingers.push_back(fingers_.back().get());
+  }
+  if (fingers_.size() > 1) set_.emplace(fingers);
+}
+
+}  // namespace impetus
