@@ -36,6 +36,12 @@ def main():
 
     world = logs.read_log(args.dir / logs.WORLD)
     haptic = logs.read_log(args.dir / logs.HAPTIC)
+    # One clock: the finger's. The world's steps are moved onto it (a world started before the finger, as the demo's
+    # --view-wait does, runs ahead by the wait), and steps before the finger came are left out.
+    world_time_s = world["time_s"] - logs.world_clock_offset_s(world)
+    start_s = haptic["time_s"][0] - (world["time_s"][1] - world["time_s"][0] if len(world) > 1 else 0.0)
+    world = world.rows(world_time_s >= start_s)
+    world_time_s = world_time_s[world_time_s >= start_s]
     objects = sorted(world.object_names())
     # A box's −x face is what the finger strikes: plot it instead of the centre when the scene says the size.
     half_x = box_half_x_m(args.dir)
@@ -47,10 +53,10 @@ def main():
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
     for name in objects:
         if name in half_x:
-            top.plot(world["time_s"], world[f"{name}.x_m"] - half_x[name], lw=2, drawstyle="steps-post",
+            top.plot(world_time_s, world[f"{name}.x_m"] - half_x[name], lw=2, drawstyle="steps-post",
                      label=f"{name} −x face (world steps)")
         else:
-            top.plot(world["time_s"], world[f"{name}.x_m"], lw=2, drawstyle="steps-post", label=f"{name} x")
+            top.plot(world_time_s, world[f"{name}.x_m"], lw=2, drawstyle="steps-post", label=f"{name} x")
     top.plot(haptic["time_s"], finger_x, lw=1, label="finger x (device)")
     top.plot(haptic["time_s"], proxy_x, lw=1, ls="--", label="proxy x (god-object)")
     top.set_ylabel("x (m)")
@@ -58,7 +64,7 @@ def main():
     top.grid(alpha=0.3)
     bottom.plot(haptic["time_s"], haptic["force_x"], lw=1, label="force on finger, x")
     bottom.plot(haptic["time_s"], haptic["force_z"], lw=1, label="force on finger, z")
-    bottom.set_xlabel("time (s)")
+    bottom.set_xlabel("time since the finger started (s)")
     bottom.set_ylabel("force (N)")
     bottom.legend(fontsize=8)
     bottom.grid(alpha=0.3)

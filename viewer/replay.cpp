@@ -39,6 +39,27 @@ std::vector<std::string> split(const std::string& line) {
   return fields;
 }
 
+// How far the world's clock runs ahead of the haptic side's, s: the median over the steps of (the world time a step
+// started at) − (the haptic time of the report it applied), the world log's haptic_time_s (scripts/impetus_py/logs.py
+// world_clock_offset_s says the same). 0 for a log without that column or before any report.
+double world_clock_offset_s(const CsvTable& world, int time_column) {
+  const int haptic_column = world.column("haptic_time_s");
+  if (haptic_column < 0 || world.rows.size() < 2) return 0.0;
+  std::vector<double> steps, offsets;
+  for (std::size_t r = 1; r < world.rows.size(); ++r) {
+    steps.push_back(world.rows[r][time_column] - world.rows[r - 1][time_column]);
+  }
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  const double period_s = steps[steps.size() / 2];
+  for (const std::vector<double>& row : world.rows) {
+    const double offset_s = row[time_column] - period_s - row[haptic_column];
+    if (std::isfinite(offset_s)) offsets.push_back(offset_s);
+  }
+  if (offsets.empty()) return 0.0;
+  std::nth_element(offsets.begin(), offsets.begin() + offsets.size() / 2, offsets.end());
+  return offsets[offsets.size() / 2];
+}
+
 CsvTable read_csv(const fs::path& path) {
   std::ifstream in(path);
   if (!in) throw ReplayError("cannot read " + path.string());
@@ -158,7 +179,8 @@ Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<View
   }
 
   // Each endpoint's finger at each step's time: the last row at or before it of its haptic log (haptic.csv, then
-  // haptic.endpoint1.csv, ... for a device of several fingers).
+  // haptic.endpoint1.csv, ... for a device of several fingers), on the haptic side's clock.
+  const double world_ahead_s = world_clock_offset_s(world, time_column);
   for (std::uint32_t e = 0; e < kMaxViewEndpoints; ++e) {
     const fs::path haptic_path = folder / (e == 0 ? std::string("haptic.csv") : "haptic.endpoint" + std::to_string(e) + ".csv");
     std::error_code missing;
@@ -175,7 +197,7 @@ Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<View
     std::vector<ViewEndpoint>& track = endpoints_.emplace_back(times_s_.size());
     std::size_t next = 0;
     for (std::size_t f = 0; f < times_s_.size(); ++f) {
-      while (next + 1 < haptic.rows.size() && haptic.rows[next + 1][hc[0]] <= times_s_[f]) ++next;
+      while (next + 1 < haptic.rows.size() && haptic.rows[next + 1][hc[0]] <= times_s_[f] - world_ahead_s) ++next;
       const std::vector<double>& row = haptic.rows[next];
       ViewEndpoint& endpoint = track[f];
       endpoint.endpoint = e;
@@ -184,7 +206,9 @@ Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<View
       endpoint.force_N = {row[hc[7]], row[hc[8]], row[hc[9]]};
       endpoint.finger_valid =
           all_finite(endpoint.finger_m) && all_finite(endpoint.proxy_m) && all_finite(endpoint.force_N);
-      if (!endpoint.finger_valid) endpoint = ViewEndpoint{};
+      // Before the finger's first tick (a world started before the finger) there is no finger yet.
+      const bool started = row[hc[0]] <= times_s_[f] - world_ahead_s;
+      if (!endpoint.finger_valid || !started) endpoint = ViewEndpoint{};
     }
   }
 }

@@ -65,6 +65,13 @@ class World {
   Coupling coupling() const { return options_.coupling; }
   double world_period_s() const { return period_s_; }
   double time_s() const { return time_s_; }
+  // The haptic session time (the haptic side's clock) of the newest report that endpoint slot 0 applied, at the start
+  // of the last step; NaN before any. Paired with time_s() − T_w, the world time that step started at, it puts the
+  // world and the finger on one clock (the world log's haptic_time_s; scripts/impetus_py/logs.py).
+  double last_report_haptic_time_s() const {
+    return endpoints_.empty() || endpoints_[0].last_report_session == 0 ? std::numeric_limits<double>::quiet_NaN()
+                                                                         : endpoints_[0].last_report_time_s;
+  }
   std::uint64_t steps_taken() const { return steps_taken_; }
   // The frame of endpoint slot `slot` after the last step (slot 0 before any step: the frame header alone).
   const PlaneFrame& frame(std::size_t slot = 0) const { return frames_[slot]; }

@@ -57,6 +57,7 @@ std::string WorldLog::header(const Scene& scene) {
     out << ',' << n << ".jx_total_Ns," << n << ".jy_total_Ns," << n << ".jz_total_Ns";
   }
   out << ",static.jx_total_Ns,static.jy_total_Ns,static.jz_total_Ns";
+  out << ",haptic_time_s";
   return out.str();
 }
 
@@ -86,6 +87,7 @@ void WorldLog::record() {
   WorldLogRecord& statics = row_[next++];
   statics.part = WorldLogRecord::Part::statics;
   put(statics.values, 0, world_.total_static_impulse_Ns());
+  statics.values[3] = world_.last_report_haptic_time_s();
   // The row goes in whole, so the writer never flushes half a line.
   log_.push_all(row_);
 }
@@ -104,7 +106,7 @@ void WorldLog::format(std::ostream& out, const WorldLogRecord& record) {
     }
     case WorldLogRecord::Part::statics: {
       CsvLine line(out, CsvLine::Part::last);
-      line.number(record.values[0]).number(record.values[1]).number(record.values[2]);
+      line.number(record.values[0]).number(record.values[1]).number(record.values[2]).number(record.values[3]);
       break;
     }
   }

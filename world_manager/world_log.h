@@ -2,8 +2,9 @@
 #pragma once
 // The world log (docs/architecture.md §4 "Logs"): a CSV with a header row and one row per world step, time first, then
 // for every dynamic object its pose, velocity and the impulse the world applied to it (this step and since the start),
-// then the cumulative reaction into static geometry. Column names carry units: `cube.x_m`, `cube.jx_Ns`,
-// `cube.jx_total_Ns`.
+// then the cumulative reaction into static geometry, and last the haptic clock's time of the report the step applied
+// (World::last_report_haptic_time_s; NaN before any), which puts the world's rows on the finger's clock. Column names
+// carry units: `cube.x_m`, `cube.jx_Ns`, `cube.jx_total_Ns`, `haptic_time_s`.
 //
 // Written out of the world's turn: a step only copies its numbers into a preallocated ring (common/runtime/rt_log.h),
 // and the log's own thread formats and writes them, so in lockstep the haptic side does not wait on the world's CSV.

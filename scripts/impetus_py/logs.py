@@ -2,7 +2,8 @@
 """The daemons' CSV logs of one trial (docs/architecture.md §4: a header row, time first, units in the column names):
 
   world.csv   world_manager: one row per world step, the state after it; per object NAME.x_m .. NAME.z_m,
-              NAME.qw .. NAME.qz, NAME.vx_mps .., NAME.wx_radps .., and the impulses NAME.jx_Ns .., NAME.jx_total_Ns ..
+              NAME.qw .. NAME.qz, NAME.vx_mps .., NAME.wx_radps .., and the impulses NAME.jx_Ns .., NAME.jx_total_Ns ..;
+              haptic_time_s: the haptic clock's time of the report the step applied (NaN before the first)
   haptic.csv  haptic_controller: one row per tick: finger_x .., proxy_x .., force_x .. (N, on the finger),
               active_planes, flags (bit 0: a device is attached, bit 1: the force was clamped), ...
   device.csv  spidar_sim: one row per device tick: target_x_m .., finger_x_m .., finger_vx_mps .., tensions, counts
@@ -32,8 +33,9 @@ class Log:
 
     @property
     def finite(self):
-        """Whether every value is a finite number (no NaN or Inf)."""
-        return all(np.isfinite(values).all() for values in self.columns.values())
+        """Whether every value is a finite number (no NaN or Inf). The world log's haptic_time_s is left out: it is
+        NaN, "none yet", until the world applies its first report."""
+        return all(np.isfinite(values).all() for name, values in self.columns.items() if name != "haptic_time_s")
 
     def vectors(self, prefix, suffix=""):
         """The columns PREFIX{x,y,z}SUFFIX as one row per log row: vectors("finger_") for haptic.csv's finger,
@@ -49,6 +51,21 @@ class Log:
         log = Log.__new__(Log)
         log.columns = {name: values[selected] for name, values in self.columns.items()}
         return log
+
+
+def world_clock_offset_s(world):
+    """How far the world's clock (world.csv's time_s) runs ahead of the haptic side's (haptic.csv's time_s), s: the
+    median over the world's steps of (the world time the step started at) − (the haptic time of the report it applied).
+    A world started before the finger (run.sh --view-wait) is ahead by the wait; in lockstep the offset is the world
+    clock's phase, −phase ticks. Subtract it from world times to put the world on the finger's clock. 0 for a log
+    without haptic_time_s or before any report."""
+    if "haptic_time_s" not in world.columns or len(world) < 2:
+        return 0.0
+    times = world["time_s"]
+    period_s = float(np.median(np.diff(times)))
+    offsets = (times - period_s) - world["haptic_time_s"]
+    offsets = offsets[np.isfinite(offsets)]
+    return float(np.median(offsets)) if len(offsets) else 0.0
 
 
 def read_log(path, keep_time_s=None):
