@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/engine/ode_engine.h"
 
+#include "world_manager/engine/escape_guard.h"
 #include "world_manager/engine/speculative_contact.h"
 #include "world_manager/features/spatial_grid.h"
 
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -64,7 +66,7 @@ Eigen::Matrix3d ode_inertia(const dMass& mass) {
 
 }  // namespace
 
-struct OdeEngine::Handles {
+struct OdeEngine::Handles final : EscapeGuard::Engine {
   const Scene* scene = nullptr;
   dWorldID world = nullptr;
   dSpaceID space = nullptr;  // with sleeping: the awake geoms only
@@ -86,8 +88,7 @@ struct OdeEngine::Handles {
   };
   std::vector<RecordedContact> recorded;
   std::vector<dJointFeedback> feedback;  // one per recorded contact; sized before the step so the addresses hold
-  std::vector<std::size_t> escaped;      // objects taken out of the simulation (park_escaped)
-  std::vector<bool> is_escaped;          // per object
+  EscapeGuard escape_guard{0};           // objects taken out of the simulation (park_escaped)
   std::vector<std::size_t> moved;        // RigidBodyEngine::moved()
 
   // Speculative contacts (speculative_contact.h, scene physics.speculative_contacts).
@@ -169,7 +170,7 @@ struct OdeEngine::Handles {
     wake_queue.assign(awake.begin(), awake.end());
     for (std::size_t i = 0; i < wake_queue.size(); ++i) {
       const std::size_t id = wake_queue[i];
-      if (is_escaped[id]) continue;
+      if (escape_guard.escaped(id)) continue;
       dGeomID geom = geoms[id];
       Eigen::AlignedBox3d bounds = geom_bounds(geom);
       if (speculative) {
@@ -198,7 +199,7 @@ struct OdeEngine::Handles {
   void collide_awake() {
     dSpaceCollide(space, this, &Handles::near_callback);
     for (const std::size_t id : awake) {
-      if (is_escaped[id]) continue;
+      if (escape_guard.escaped(id)) continue;
       dGeomID geom = geoms[id];
       if (floor != nullptr) near_callback(this, geom, floor);
       const Eigen::AlignedBox3d bounds = geom_bounds(geom);
@@ -214,7 +215,7 @@ struct OdeEngine::Handles {
   void put_rested_to_sleep() {
     std::size_t kept = 0;
     for (const std::size_t id : awake) {
-      if (is_escaped[id]) continue;
+      if (escape_guard.escaped(id)) continue;
       if (dBodyIsEnabled(bodies[id]) == 0) {
         fall_asleep(id);
         continue;
@@ -224,43 +225,37 @@ struct OdeEngine::Handles {
     awake.resize(kept);
   }
 
-  // Takes every body the solver has thrown beyond kEscapeDistance_m, or whose state is no longer finite, out of the
-  // simulation before the broadphase sees it: ODE's hash space asserts on coordinates it cannot store in its cells.
-  // The body stops, its geom collides with nothing, and a non-finite position is replaced by the escape distance on
-  // the ray it left along (or on +x), so every state the world reads stays finite.
+  // Takes every body the solver has thrown out of range out of the simulation before the broadphase sees it (ODE's
+  // hash space asserts on coordinates it cannot store in its cells): escape_guard.h decides, park() does.
   void park_escaped() {
     if (sleeping) {
-      for (const std::size_t id : awake) park_if_escaped(id);
+      escape_guard.check(awake, *this);
       return;
     }
-    for (std::size_t id = 0; id < bodies.size(); ++id) park_if_escaped(id);
+    escape_guard.check_all(*this);
   }
-  void park_if_escaped(std::size_t id) {
+  std::optional<EscapeGuard::BodyState> escape_state(std::size_t id) const override {
     dBodyID body = bodies[id];
-    {
-      if (body == nullptr || is_escaped[id]) return;
-      const dReal* p = dBodyGetPosition(body);
-      const dReal* v = dBodyGetLinearVel(body);
-      const dReal* w = dBodyGetAngularVel(body);
-      const Eigen::Vector3d position(p[0], p[1], p[2]);
-      const bool finite = position.allFinite() && std::isfinite(v[0] + v[1] + v[2]) && std::isfinite(w[0] + w[1] + w[2]);
-      if (finite && position.lpNorm<Eigen::Infinity>() <= kEscapeDistance_m) return;
-      Eigen::Vector3d parked = position;
-      if (!parked.allFinite()) parked = Eigen::Vector3d(kEscapeDistance_m, 0.0, 0.0);
-      const dReal* q = dBodyGetQuaternion(body);
-      if (!std::isfinite(q[0] + q[1] + q[2] + q[3])) {
-        const dQuaternion identity{1.0, 0.0, 0.0, 0.0};
-        dBodySetQuaternion(body, identity);
-      }
-      dBodySetPosition(body, parked.x(), parked.y(), parked.z());
-      dBodySetLinearVel(body, 0.0, 0.0, 0.0);
-      dBodySetAngularVel(body, 0.0, 0.0, 0.0);
-      dBodySetGravityMode(body, 0);
-      dBodyDisable(body);
-      dGeomDisable(geoms[id]);
-      is_escaped[id] = true;
-      escaped.push_back(id);
+    if (body == nullptr) return std::nullopt;
+    const dReal* p = dBodyGetPosition(body);
+    const dReal* v = dBodyGetLinearVel(body);
+    const dReal* w = dBodyGetAngularVel(body);
+    const dReal* q = dBodyGetQuaternion(body);  // w, x, y, z
+    return EscapeGuard::BodyState{Eigen::Vector3d(p[0], p[1], p[2]), Eigen::Vector3d(v[0], v[1], v[2]),
+                                  Eigen::Vector3d(w[0], w[1], w[2]), Eigen::Vector4d(q[0], q[1], q[2], q[3])};
+  }
+  void park(std::size_t id, const Eigen::Vector3d& position_m, bool reset_orientation) override {
+    dBodyID body = bodies[id];
+    if (reset_orientation) {
+      const dQuaternion identity{1.0, 0.0, 0.0, 0.0};
+      dBodySetQuaternion(body, identity);
     }
+    dBodySetPosition(body, position_m.x(), position_m.y(), position_m.z());
+    dBodySetLinearVel(body, 0.0, 0.0, 0.0);
+    dBodySetAngularVel(body, 0.0, 0.0, 0.0);
+    dBodySetGravityMode(body, 0);
+    dBodyDisable(body);
+    dGeomDisable(geoms[id]);
   }
 
   ~Handles() {
@@ -434,7 +429,7 @@ struct OdeEngine::Handles {
   // Every moving body's free displacement for the coming substep.
   void predict_displacements(double h) {
     auto predict = [&](std::size_t id) {
-      if (bodies[id] == nullptr || is_escaped[id] || dBodyIsEnabled(bodies[id]) == 0) return;
+      if (bodies[id] == nullptr || escape_guard.escaped(id) || dBodyIsEnabled(bodies[id]) == 0) return;
       displacement[id] = free_displacement(id, h);
     };
     if (sleeping) {
@@ -446,7 +441,7 @@ struct OdeEngine::Handles {
 
   // The displacement of whatever carries geom `id` this substep: zero for fixed geometry, the floor and sleepers.
   Eigen::Vector3d displacement_of(std::size_t id) const {
-    if (id >= bodies.size() || bodies[id] == nullptr || is_escaped[id] || dBodyIsEnabled(bodies[id]) == 0) {
+    if (id >= bodies.size() || bodies[id] == nullptr || escape_guard.escaped(id) || dBodyIsEnabled(bodies[id]) == 0) {
       return Eigen::Vector3d::Zero();
     }
     return displacement[id];
@@ -466,7 +461,7 @@ struct OdeEngine::Handles {
     std::sort(touching.begin(), touching.end());
     sweeps.clear();
     auto add_sweep = [&](std::size_t id) {
-      if (bodies[id] == nullptr || is_escaped[id] || dBodyIsEnabled(bodies[id]) == 0) return;
+      if (bodies[id] == nullptr || escape_guard.escaped(id) || dBodyIsEnabled(bodies[id]) == 0) return;
       sweeps.push_back({id, swept_bounds(id)});
     };
     if (sleeping) {
@@ -539,7 +534,7 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   ode.bodies.assign(scene.objects.size(), nullptr);
   ode.contact_graph.reset(scene.objects.size());
   ode.geoms.assign(scene.objects.size(), nullptr);
-  ode.is_escaped.assign(scene.objects.size(), false);
+  ode.escape_guard = EscapeGuard(scene.objects.size());
   ode.inverse_inertia_body.assign(scene.objects.size(), Eigen::Matrix3d::Zero());
   if (ode.sleeping) {
     ode.kind.assign(scene.objects.size(), Handles::Kind::fixed);
@@ -744,6 +739,6 @@ const std::vector<std::size_t>& OdeEngine::moved() const { return ode_->moved; }
 
 ContactGraph& OdeEngine::contacts() { return ode_->contact_graph; }
 
-const std::vector<std::size_t>& OdeEngine::escaped() const { return ode_->escaped; }
+const std::vector<std::size_t>& OdeEngine::escaped() const { return ode_->escape_guard.escaped(); }
 
 }  // namespace impetus

@@ -57,7 +57,8 @@ class RigidBodyEngine {
   // The contacts recorded by the last step that recorded them (a sleeping body keeps those it fell asleep with).
   virtual ContactGraph& contacts() = 0;
   // Objects taken out of the simulation because the solver threw them beyond kEscapeDistance_m (scene.h) or made their
-  // state non-finite; they stay where they were taken out, at rest, and collide with nothing. In order of escape.
+  // state non-finite (engine/escape_guard.h, which every engine asks); they stay where they were taken out, at rest,
+  // and collide with nothing. In order of escape.
   virtual const std::vector<std::size_t>& escaped() const = 0;
 };
 
