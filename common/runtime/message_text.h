@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace impetus {
 
@@ -20,6 +21,16 @@ inline std::string readable(double value) {
 inline std::string excerpt(std::string_view text, std::size_t max_chars = 160) {
   if (text.size() <= max_chars) return std::string(text);
   return std::string(text.substr(0, max_chars)) + "... (" + std::to_string(text.size()) + " characters)";
+}
+
+// The choices an error message offers: "a", "a or b", "a, b or c".
+inline std::string one_of(const std::vector<std::string>& choices) {
+  std::string text;
+  for (std::size_t k = 0; k < choices.size(); ++k) {
+    if (k > 0) text += k + 1 == choices.size() ? " or " : ", ";
+    text += choices[k];
+  }
+  return text;
 }
 
 }  // namespace impetus

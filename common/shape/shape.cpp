@@ -4,6 +4,7 @@
 #include "common/shape/shape.h"
 
 #include "common/runtime/json_node.h"
+#include "common/runtime/message_text.h"
 #include "common/shape/shape_kind.h"
 
 #include <cmath>
@@ -67,12 +68,9 @@ bool shape_kind_from_string(std::string_view name, ShapeKind& kind) {
 }
 
 std::string shape_kind_names() {
-  std::string names;
-  for (std::uint32_t k = 1; k < kShapeKindCount; ++k) {
-    if (k > 1) names += k + 1 == kShapeKindCount ? " or " : ", ";
-    names += kKinds[k]->name;
-  }
-  return names;
+  std::vector<std::string> names;
+  for (std::uint32_t k = 1; k < kShapeKindCount; ++k) names.emplace_back(kKinds[k]->name);
+  return one_of(names);
 }
 
 const ShapeTraits& traits(ShapeKind kind) { return ops(kind).traits; }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/device/device_registry.h"
 
+#include "common/runtime/message_text.h"
 #include "common/spidar/geometry.h"
 #include "haptic_controller/device/spidar_driver.h"
 
@@ -37,16 +38,12 @@ constexpr DeviceEntry kDevices[] = {
 }  // namespace
 
 std::string device_forms() {
-  std::string forms;
-  const std::size_t count = std::size(kDevices);
-  for (std::size_t k = 0; k < count; ++k) {
-    if (k > 0) forms += k + 1 == count ? " or " : ", ";
-    forms += kDevices[k].name;
-    if (!kDevices[k].argument.empty()) {
-      forms += " or " + std::string(kDevices[k].name) + ":" + std::string(kDevices[k].argument);
-    }
+  std::vector<std::string> forms;
+  for (const DeviceEntry& entry : kDevices) {
+    forms.emplace_back(entry.name);
+    if (!entry.argument.empty()) forms.push_back(std::string(entry.name) + ":" + std::string(entry.argument));
   }
-  return forms;
+  return one_of(forms);
 }
 
 std::unique_ptr<DeviceType> parse_device(const std::string& spec) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/engine/engine_registry.h"
 
+#include "common/runtime/message_text.h"
 #include "world_manager/engine/ode_engine.h"
 #include "world_manager/engine/ode_runtime.h"
 #include "world_manager/scene.h"
@@ -27,13 +28,9 @@ const EngineEntry* find_engine(std::string_view name) {
 }
 
 std::string engine_names() {
-  std::string names;
-  const std::size_t count = std::size(kEngines);
-  for (std::size_t k = 0; k < count; ++k) {
-    if (k > 0) names += k + 1 == count ? " or " : ", ";
-    names += kEngines[k].name;
-  }
-  return names;
+  std::vector<std::string> names;
+  for (const EngineEntry& entry : kEngines) names.emplace_back(entry.name);
+  return one_of(names);
 }
 
 std::unique_ptr<RigidBodyEngine> make_engine(const Scene& scene) {
