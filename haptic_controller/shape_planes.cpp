@@ -6,13 +6,6 @@
 namespace impetus {
 namespace {
 
-// A proxy this close to a surface is on it: the god-object puts a proxy that slides up to an edge on it only to
-// rounding (~1e-17 m). The way from the proxy enters a body only past this margin, so a proxy on the surface that
-// leaves it does not count as entering.
-constexpr double kOnSurface_m = 1e-9;
-
-void retake(ContactPlane& plane, const Eigen::Vector3d& around_m) { retake_plane(plane, around_m); }
-
 bool in_front(const ContactPlane& plane, const Eigen::Vector3d& x_m) {
   return plane.normal.dot(x_m - plane.point_m) >= -kOnSurface_m;
 }
@@ -24,7 +17,7 @@ ContactPlane nearest_to_way(const ContactPlane& as_sent, const Eigen::Vector3d& 
   auto at = [&](double t, ContactPlane& plane) {
     plane = as_sent;
     const Eigen::Vector3d x_m = from_m + t * (to_m - from_m);
-    retake(plane, x_m);
+    retake_plane(plane, x_m);
     return plane.normal.dot(x_m - plane.point_m);
   };
   constexpr double kGolden = 0.6180339887498949;  // (√5 − 1)/2
@@ -46,12 +39,10 @@ ContactPlane nearest_to_way(const ContactPlane& as_sent, const Eigen::Vector3d& 
   return d1 < d2 ? plane1 : plane2;
 }
 
-bool carries_shape(const ContactPlane& plane) { return plane.shaped(); }
-
 }  // namespace
 
 void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m) {
-  for (std::uint32_t k = 0; k < planes.count; ++k) retake(planes.planes[k], around_m);
+  for (std::uint32_t k = 0; k < planes.count; ++k) retake_plane(planes.planes[k], around_m);
 }
 
 void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& finger_m) {
@@ -67,10 +58,10 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const
   bool finger_held = false;
   for (std::uint32_t k = 0; k < planes.count; ++k) {
     ContactPlane& plane = planes.planes[k];
-    if (!carries_shape(plane)) continue;
+    if (!plane.shaped()) continue;
     sent_point_m[k] = plane.point_m;
     sent_normal[k] = plane.normal;
-    retake(plane, proxy_m);
+    retake_plane(plane, proxy_m);
     finger_held = finger_held || !in_front(plane, finger_m);
   }
   if (!finger_held) return;
@@ -78,7 +69,7 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const
   // and the proxy then slides along that body, where the others may meet it: only a way clear of all lets it go.
   for (std::uint32_t k = 0; k < planes.count; ++k) {
     const ContactPlane& plane = planes.planes[k];
-    const bool enters = carries_shape(plane) ? segment_enters(plane, proxy_m, finger_m, kOnSurface_m)
+    const bool enters = plane.shaped() ? segment_enters(plane, proxy_m, finger_m, kOnSurface_m)
                                              : !in_front(plane, proxy_m) || !in_front(plane, finger_m);
     if (enters) return;
   }
@@ -87,10 +78,10 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const
   // point nearest the way.
   for (std::uint32_t k = 0; k < planes.count; ++k) {
     ContactPlane& plane = planes.planes[k];
-    if (!carries_shape(plane) || in_front(plane, finger_m)) continue;
+    if (!plane.shaped() || in_front(plane, finger_m)) continue;
     const ContactPlane sent = as_sent(k);
     ContactPlane at_finger = sent;
-    retake(at_finger, finger_m);
+    retake_plane(at_finger, finger_m);
     plane = in_front(at_finger, proxy_m) ? at_finger : nearest_to_way(sent, proxy_m, finger_m);
   }
 }

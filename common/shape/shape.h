@@ -30,6 +30,11 @@ namespace impetus {
 
 class JsonNode;
 
+// A point this close to a surface is on it: the god-object puts a proxy that slides up to an edge on it only to
+// rounding (~1e-17 m), and a point on the surface has no direction to take a normal from. Retaking a plane treats a
+// proxy within it of a rim as on the rim, and a way from the proxy enters a body only past it.
+inline constexpr double kOnSurface_m = 1e-9;
+
 // What the code outside a kind's file may know about it, instead of its name.
 struct ShapeTraits {
   // Its planes carry the body's axes, so the haptic side can retake them from the shape (a sphere needs none: its

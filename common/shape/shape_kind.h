@@ -44,9 +44,6 @@ extern const ShapeKindOps kCylinderOps;
 
 // Shared by the kind files.
 
-// A proxy this close to a rim is still on the surface: the god-object puts a proxy that slides up to an edge on it
-// only to rounding (~1e-17 m), and a point on the surface has no direction to take a normal from.
-inline constexpr double kOnSurface_m = 1e-9;
 // Below this distance from a centre (or axis) the direction to a query point is numerically meaningless (1 nm, far
 // under any modelled feature), so a fixed fallback direction is used instead.
 inline constexpr double kDegenerateDistance_m = 1e-9;
