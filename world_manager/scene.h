@@ -141,11 +141,11 @@ struct PhysicsParams {
   double contact_damping_Nspm = std::numeric_limits<double>::quiet_NaN();
   bool contact_spring() const { return !std::isnan(contact_stiffness_Npm) || !std::isnan(contact_damping_Nspm); }
   // Contacts made one substep before a pair meets, which let it close the gap and no more
-  // (engine/speculative_contact.h): an impact then neither sinks v·h into the other body nor gets the solver's
+  // (engine/speculative_contacts.h): an impact then neither sinks v·h into the other body nor gets the solver's
   // push-out back as a bounce. Off: contacts only once bodies overlap.
   bool speculative_contacts = true;
   // A body resting for half a second leaves the simulation until something pushes or touches it
-  // (engine/ode_engine.h): "model only what a scene needs". The tap trial's cube ends within 60 nm of where it ends
+  // (engine/sleeping_bodies.h): "model only what a scene needs". The tap trial's cube ends within 60 nm of where it ends
   // with it off (docs/sleeping.md); off keeps every body simulated.
   bool auto_disable = true;
   std::uint64_t seed = 1;  // the engine's random stream, so runs are bitwise reproducible

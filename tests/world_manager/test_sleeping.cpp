@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Sleeping bodies (scene physics.auto_disable, engine/ode_engine.h): a body at rest leaves the simulation, a step
+// Sleeping bodies (scene physics.auto_disable, engine/sleeping_bodies.h): a body at rest leaves the simulation, a step
 // costs what is awake, and a sleeping body wakes, exactly where it slept, when it is pushed or touched.
 
 #include "world_test_support.h"

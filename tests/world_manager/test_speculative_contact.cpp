@@ -1,15 +1,16 @@
 // SPDX-License-Identifier: Apache-2.0
-// Speculative contacts (engine/speculative_contact.h, scene physics.speculative_contacts): a pair that meets within a
+// Speculative contacts (engine/speculative_contacts.h, scene physics.speculative_contacts): a pair that meets within a
 // substep closes its gap and no more, so an impact neither sinks into the other body nor bounces off the penetration
 // correction. Each world test runs with them off too, where the fault they remove must show.
-#include "world_manager/engine/speculative_contact.h"
+#include "world_manager/engine/speculative_contacts.h"
+#include "world_manager/scene.h"
 
 #include "world_test_support.h"
 
 #include <catch2/catch.hpp>
 
 #include <algorithm>
-#include <cstring>
+#include <optional>
 #include <span>
 
 namespace impetus {
@@ -144,35 +145,117 @@ TEST_CASE("speculative contacts: a fast ball wakes the sleeping box it is about 
   CHECK(deepest_m < 0.1e-3);
 }
 
-TEST_CASE("speculative_contacts: the gap a sphere closes on a plane, and the body put back exactly") {
-  prepare_engines();
-  dWorldID world = dWorldCreate();
-  dGeomID plane = dCreatePlane(nullptr, 0.0, 0.0, 1.0, 0.0);
-  dGeomID sphere = dCreateSphere(nullptr, 0.02);
-  dBodyID body = dBodyCreate(world);
-  dGeomSetBody(sphere, body);
-  dBodySetPosition(body, 0.1, 0.2, 0.021234);  // 1.234 mm above the plane
-  const dReal before[3] = {dBodyGetPosition(body)[0], dBodyGetPosition(body)[1], dBodyGetPosition(body)[2]};
-  dContact out[4];
+namespace {
 
-  // Reaches: one contact, 1.234 mm apart, midway across the gap below the centre.
-  REQUIRE(speculative_contacts(sphere, body, plane, {0.0, 0.0, -0.003}, out, 4) == 1);
-  CHECK(out[0].geom.depth == Approx(-0.001234).margin(1e-12));
-  CHECK(out[0].geom.normal[2] == Approx(1.0));
-  CHECK(out[0].geom.pos[0] == Approx(0.1));
-  CHECK(out[0].geom.pos[2] == Approx(0.000617).margin(1e-12));
-  CHECK(std::memcmp(before, dBodyGetPosition(body), sizeof before) == 0);
-  // Falls short, or moves along the plane: nothing.
-  CHECK(speculative_contacts(sphere, body, plane, {0.0, 0.0, -0.001}, out, 4) == 0);
-  CHECK(speculative_contacts(sphere, body, plane, {0.01, 0.0, 0.0}, out, 4) == 0);
-  // Already in: the overlap, positive.
-  dBodySetPosition(body, 0.1, 0.2, 0.019);
-  REQUIRE(speculative_contacts(sphere, body, plane, {0.0, 0.0, -0.001}, out, 4) == 1);
-  CHECK(out[0].geom.depth == Approx(0.001).margin(1e-12));
+// An engine of one ball above a floor (id 1 with one object), colliding analytically: enough to check what the
+// service decides without any physics engine.
+class BallOverFloor final : public SpeculativeContacts::Engine {
+ public:
+  Eigen::Vector3d centre_m{0.1, 0.2, 0.021234};  // 1.234 mm above the floor
+  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
+  double radius_m = 0.02;
+  std::vector<SpeculativeContacts::Row> rows;
+  int ordinary_pairs = 0;
 
-  dGeomDestroy(sphere);
-  dGeomDestroy(plane);
-  dWorldDestroy(world);
+  std::optional<SpeculativeContacts::Motion> motion(std::size_t id) const override {
+    if (id != 0) return std::nullopt;
+    return SpeculativeContacts::Motion{centre_m, velocity_mps, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                       0.1, true, false};
+  }
+  Eigen::AlignedBox3d bounds(std::size_t id) const override {
+    if (id != 0) return Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 0));
+    return Eigen::AlignedBox3d(centre_m.array() - radius_m, centre_m.array() + radius_m);
+  }
+  int collide_displaced(std::size_t id, std::size_t other, const Eigen::Vector3d& displacement_m,
+                        SpeculativeContacts::Point* out) override {
+    REQUIRE(id == 0);
+    REQUIRE(other == 1);
+    const Eigen::Vector3d at = centre_m + displacement_m;
+    const double depth_m = radius_m - at.z();
+    if (depth_m < 0.0) return 0;
+    out[0] = {at - radius_m * Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ(), depth_m};  // the ball's lowest point
+    return 1;
+  }
+  void add_row(std::size_t, std::size_t, const SpeculativeContacts::Row& row) override { rows.push_back(row); }
+  void add_ordinary_contacts(std::size_t, std::size_t) override { ++ordinary_pairs; }
+};
+
+}  // namespace
+
+TEST_CASE("speculative contacts service: the gap a ball closes on the floor, over any engine that collides") {
+  const std::vector<Material> materials(2);  // the ball's and the floor's; no restitution
+  const EscapeGuard guard(1);
+  const Eigen::Vector3d no_gravity = Eigen::Vector3d::Zero();
+  SpeculativeContacts service(1, true, no_gravity, materials, guard, nullptr);
+  BallOverFloor engine;
+  const std::vector<std::size_t> movers{0};
+  constexpr double kSubstep_s = 0.005;
+
+  // Falling 3 mm in the substep: reaches. One row, 1.234 mm apart, midway across the gap below the centre, asking
+  // the pair to close at most the gap in the substep.
+  engine.velocity_mps = {0.0, 0.0, -0.003 / kSubstep_s};
+  service.begin_substep(kSubstep_s);
+  service.predict(movers, engine);
+  service.speculate(movers, engine);
+  REQUIRE(engine.rows.size() == 1);
+  const SpeculativeContacts::Row& row = engine.rows[0];
+  CHECK(row.speculative);
+  CHECK(row.point.depth_m == 0.0);
+  CHECK(row.normal_speed_mps == Approx(-0.001234 / kSubstep_s).epsilon(1e-9));
+  CHECK(row.point.normal == Eigen::Vector3d::UnitZ());
+  CHECK(row.point.position_m.x() == Approx(0.1));
+  CHECK(row.point.position_m.z() == Approx(0.000617).margin(1e-12));
+
+  // Falling 1 mm: falls short, nothing. Moving along the floor: nothing.
+  for (const Eigen::Vector3d& velocity_mps : {Eigen::Vector3d(0.0, 0.0, -0.001 / kSubstep_s),
+                                             Eigen::Vector3d(0.01 / kSubstep_s, 0.0, 0.0)}) {
+    engine.rows.clear();
+    engine.velocity_mps = velocity_mps;
+    service.begin_substep(kSubstep_s);
+    service.predict(movers, engine);
+    service.speculate(movers, engine);
+    CHECK(engine.rows.empty());
+  }
+
+  // Already touching and closing fast: the engine is told to leave the pair to the service, which gives it the
+  // contact of where it will be (an ordinary row: it overlaps) instead of the engine's own.
+  engine.rows.clear();
+  engine.centre_m.z() = 0.019;
+  engine.velocity_mps = {0.0, 0.0, -0.2};
+  service.begin_substep(kSubstep_s);
+  service.predict(movers, engine);
+  const SpeculativeContacts::Point touch{Eigen::Vector3d(0.1, 0.2, -0.0005), Eigen::Vector3d::UnitZ(), 0.001};
+  CHECK(service.defer_touching(0, 1, touch, engine));
+  service.add_closing_contacts(engine);
+  service.speculate(movers, engine);  // a touching pair is not speculated on again
+  REQUIRE(engine.rows.size() == 1);
+  CHECK_FALSE(engine.rows[0].speculative);
+  CHECK(engine.rows[0].point.depth_m == Approx(0.001).margin(1e-12));  // the overlap now, carried back
+  CHECK(engine.ordinary_pairs == 0);
+  // Resting on it: the engine keeps its own contacts.
+  engine.velocity_mps.setZero();
+  service.begin_substep(kSubstep_s);
+  CHECK_FALSE(service.defer_touching(0, 1, touch, engine));
+
+  // A parked ball is never tested.
+  EscapeGuard parked(1);
+  class ParkAll final : public EscapeGuard::Engine {
+   public:
+    std::optional<EscapeGuard::BodyState> escape_state(std::size_t) const override {
+      return EscapeGuard::BodyState{Eigen::Vector3d(2.0 * kEscapeDistance_m, 0, 0), Eigen::Vector3d::Zero(),
+                                    Eigen::Vector3d::Zero(), Eigen::Vector4d(1, 0, 0, 0)};
+    }
+    void park(std::size_t, const Eigen::Vector3d&, bool) override {}
+  } park_all;
+  parked.check_all(park_all);
+  SpeculativeContacts after_escape(1, true, no_gravity, materials, parked, nullptr);
+  engine.rows.clear();
+  engine.centre_m.z() = 0.021234;
+  engine.velocity_mps = {0.0, 0.0, -0.003 / kSubstep_s};
+  after_escape.begin_substep(kSubstep_s);
+  after_escape.predict(movers, engine);
+  after_escape.speculate(movers, engine);
+  CHECK(engine.rows.empty());
 }
 
 }  // namespace impetus

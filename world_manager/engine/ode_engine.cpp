@@ -2,8 +2,8 @@
 #include "world_manager/engine/ode_engine.h"
 
 #include "world_manager/engine/escape_guard.h"
-#include "world_manager/engine/speculative_contact.h"
-#include "world_manager/features/spatial_grid.h"
+#include "world_manager/engine/sleeping_bodies.h"
+#include "world_manager/engine/speculative_contacts.h"
 
 #include <ode/ode.h>
 
@@ -17,27 +17,13 @@
 namespace impetus {
 namespace {
 
-// Contact points ODE may return per geom pair: box–box needs up to 8 for a face resting on a face.
-constexpr int kMaxContactsPerPair = 8;
-// Below this approach speed a contact does not bounce: resting and sliding objects would otherwise chatter on every
-// substep's tiny penetration-correction velocity (ERP pushes at a few mm/s).
-constexpr double kBounceThreshold_mps = 0.05;
-
-// Sleeping (ode_engine.h): a body sleeps once its speeds have stayed under these for kRestBeforeSleep_s. ODE's own
-// defaults for the speeds (0.01 m/s, 0.01 rad/s: a 5 cm cube's corner moves 0.25 mm/s) are far below anything the
-// haptic side renders. Half a second is ten 20 Hz world periods: a body bouncing or rocking to rest is not frozen
-// mid-motion, and one that a finger keeps pushing is woken by each push (RigidBodyEngine::wake).
-constexpr double kSleepSpeed_mps = 0.01;
-constexpr double kSleepAngularSpeed_radps = 0.01;
-constexpr double kRestBeforeSleep_s = 0.5;
-
 Eigen::AlignedBox3d geom_bounds(dGeomID geom) {
   dReal aabb[6];
   dGeomGetAABB(geom, aabb);  // ODE's order: min x, max x, min y, max y, min z, max z
   return Eigen::AlignedBox3d(Eigen::Vector3d(aabb[0], aabb[2], aabb[4]), Eigen::Vector3d(aabb[1], aabb[3], aabb[5]));
 }
 
-// The median object extent: a grid cell then holds a few objects and an object spans a few cells.
+// The median object extent: a sleeping grid's cell then holds a few objects and an object spans a few cells.
 double grid_cell_size_m(const Scene& scene) {
   std::vector<double> extents_m;
   for (const SceneObject& object : scene.objects) extents_m.push_back(largest_extent_m(object.shape));
@@ -45,11 +31,6 @@ double grid_cell_size_m(const Scene& scene) {
   auto middle = extents_m.begin() + static_cast<std::ptrdiff_t>(extents_m.size() / 2);
   std::nth_element(extents_m.begin(), middle, extents_m.end());
   return *middle;
-}
-
-// A geom pair as one key, the lower id first (the floor's id is the object count).
-std::uint64_t pair_key(std::size_t a, std::size_t b) {
-  return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint64_t>(std::max(a, b));
 }
 
 void* id_to_data(std::size_t id) { return reinterpret_cast<void*>(static_cast<std::uintptr_t>(id)); }
@@ -66,7 +47,9 @@ Eigen::Matrix3d ode_inertia(const dMass& mass) {
 
 }  // namespace
 
-struct OdeEngine::Handles final : EscapeGuard::Engine {
+struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, SpeculativeContacts::Engine {
+  using Point = SpeculativeContacts::Point;
+
   const Scene* scene = nullptr;
   dWorldID world = nullptr;
   dSpaceID space = nullptr;  // with sleeping: the awake geoms only
@@ -75,6 +58,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine {
   std::vector<dGeomID> geoms;       // per object
   std::vector<Material> materials;  // per id, the floor last
   std::vector<Eigen::Matrix3d> inverse_inertia_body;  // per object; zero for static ones
+  std::vector<std::size_t> dynamic_ids;               // ascending
   unsigned long random_state = 0;   // ODE's generator state between this engine's steps
   bool record_contacts = false;
   ContactGraph contact_graph;
@@ -89,41 +73,42 @@ struct OdeEngine::Handles final : EscapeGuard::Engine {
   std::vector<RecordedContact> recorded;
   std::vector<dJointFeedback> feedback;  // one per recorded contact; sized before the step so the addresses hold
   EscapeGuard escape_guard{0};           // objects taken out of the simulation (park_escaped)
-  std::vector<std::size_t> moved;        // RigidBodyEngine::moved()
 
-  // Speculative contacts (speculative_contact.h, scene physics.speculative_contacts).
-  bool speculative = false;
-  std::vector<Eigen::Vector3d> displacement;   // per object: its free displacement in this substep (awake bodies)
-  double substep_s = 0.0;                      // the substep being made
-  std::vector<std::uint64_t> touching;         // pair_key of every pair with ordinary contacts in this substep
-  struct Sweep {
-    std::size_t id;
-    Eigen::AlignedBox3d bounds;
-  };
-  std::vector<Sweep> sweeps;                   // scratch: the moving bodies' swept bounds
-  std::vector<std::pair<std::size_t, Eigen::AlignedBox3d>> fixed_bounds;  // without sleeping: fixed objects' geoms
-  std::vector<std::pair<dGeomID, dGeomID>> closing;  // touching pairs still closing fast (near_callback)
-
-  // Sleeping (ode_engine.h). The awake list is in the order bodies woke; `moved` is sorted at the end of each step.
-  bool sleeping = false;
-  dSpaceID resting_space = nullptr;  // owns the geoms of static objects, sleeping bodies and the floor
-  dGeomID floor = nullptr;                    // in resting_space with sleeping, else in space
-  enum class Kind : std::uint8_t { fixed, awake, asleep };
-  std::vector<Kind> kind;                     // per object
-  std::vector<std::size_t> awake;             // ids of the awake dynamic bodies (not escaped)
-  std::vector<dMass> masses;                  // per object, to rebuild a body that wakes
+  // The engine-neutral services over this engine; each absent when the scene turns it off.
+  std::unique_ptr<SleepingBodies> sleeping;          // physics.auto_disable
+  std::unique_ptr<SpeculativeContacts> speculative;  // physics.speculative_contacts
+  dSpaceID resting_space = nullptr;  // with sleeping: owns the geoms of static objects, sleeping bodies and the floor
+  dGeomID floor = nullptr;           // in resting_space with sleeping, else in space
   struct RestingPose {
     dVector3 position;
     dQuaternion orientation;
   };
-  std::vector<RestingPose> resting_pose;      // per object, while it sleeps
-  std::vector<Eigen::AlignedBox3d> resting_bounds;  // per object in the grid: its geom's box
-  std::unique_ptr<SpatialGrid> grid;          // fixed geometry and sleeping bodies
-  std::vector<std::size_t> wake_queue;        // scratch
-  std::vector<std::int32_t> nearby;           // scratch
+  std::vector<RestingPose> resting_pose;  // per object, while it sleeps
+  std::vector<dMass> masses;              // per object, to rebuild a body that wakes
+  std::vector<std::size_t> nearby;        // scratch
 
-  // Puts dynamic object `id`, which ODE has disabled, to sleep: out of ODE, its geom fixed where the body rests.
-  void fall_asleep(std::size_t id) {
+  dGeomID geom_of(std::size_t id) const { return id < geoms.size() ? geoms[id] : floor; }
+
+  // The bodies whose motion the services look at: the awake ones with sleeping, else every dynamic one.
+  const std::vector<std::size_t>& movers() const { return sleeping ? sleeping->awake() : dynamic_ids; }
+
+  // SleepingBodies::Engine
+  Eigen::AlignedBox3d bounds(std::size_t id) const override { return geom_bounds(geom_of(id)); }
+  Eigen::AlignedBox3d reach_bounds(std::size_t id, double substep_s) override {
+    Eigen::AlignedBox3d reach = bounds(id);
+    if (speculative) {
+      speculative->remember(id, speculative->free_displacement(id, substep_s, *this));
+      reach = speculative->swept_bounds(id, *this);
+    }
+    return reach;
+  }
+  bool reaches(std::size_t id, std::size_t other) override {
+    dContactGeom touch;
+    if (dCollide(geoms[id], geoms[other], 1, &touch, sizeof(dContactGeom)) > 0) return true;
+    return speculative && speculative->meets(id, other, *this);
+  }
+  bool rested(std::size_t id) const override { return dBodyIsEnabled(bodies[id]) == 0; }
+  void leave_solver(std::size_t id) override {
     dBodyID body = bodies[id];
     dGeomID geom = geoms[id];
     RestingPose& pose = resting_pose[id];
@@ -138,14 +123,8 @@ struct OdeEngine::Handles final : EscapeGuard::Engine {
     bodies[id] = nullptr;
     dSpaceRemove(space, geom);
     dSpaceAdd(resting_space, geom);
-    kind[id] = Kind::asleep;
-    resting_bounds[id] = geom_bounds(geom);
-    grid->update(static_cast<std::int32_t>(id), resting_bounds[id]);
-    contact_graph.rest(static_cast<std::int32_t>(id));
   }
-
-  // Wakes sleeping object `id`: a new body with its mass, at its resting pose, at rest.
-  void wake_up(std::size_t id) {
+  void enter_solver(std::size_t id) override {
     dGeomID geom = geoms[id];
     const RestingPose& pose = resting_pose[id];
     dBodyID body = dBodyCreate(world);
@@ -154,82 +133,83 @@ struct OdeEngine::Handles final : EscapeGuard::Engine {
     dBodySetQuaternion(body, pose.orientation);
     dGeomSetBody(geom, body);
     bodies[id] = body;
-    grid->remove(static_cast<std::int32_t>(id));
     dSpaceRemove(resting_space, geom);
     dSpaceAdd(space, geom);
-    kind[id] = Kind::awake;
-    awake.push_back(id);
-    const auto at = std::lower_bound(moved.begin(), moved.end(), id);
-    if (at == moved.end() || *at != id) moved.insert(at, id);
-    contact_graph.wake(static_cast<std::int32_t>(id));
   }
 
-  // Wakes every sleeping body an awake one touches, and those they touch in turn (ODE's islands would). With
-  // speculative contacts also those an awake body would reach within the substep of h, so that they meet as bodies.
-  void wake_touched(double h) {
-    wake_queue.assign(awake.begin(), awake.end());
-    for (std::size_t i = 0; i < wake_queue.size(); ++i) {
-      const std::size_t id = wake_queue[i];
-      if (escape_guard.escaped(id)) continue;
-      dGeomID geom = geoms[id];
-      Eigen::AlignedBox3d bounds = geom_bounds(geom);
-      if (speculative) {
-        displacement[id] = free_displacement(id, h);
-        Eigen::AlignedBox3d moved_bounds = bounds;
-        bounds.extend(moved_bounds.translate(displacement[id]));
-      }
-      grid->query(bounds, nearby);
-      for (const std::int32_t other : nearby) {
-        const auto o = static_cast<std::size_t>(other);
-        if (kind[o] != Kind::asleep || !bounds.intersects(resting_bounds[o])) continue;
-        dContact touch[kMaxContactsPerPair];
-        if (dCollide(geom, geoms[o], 1, &touch[0].geom, sizeof(dContact)) == 0 &&
-            !(speculative && speculative_contacts(geom, bodies[id], geoms[o], displacement[id], touch,
-                                                  kMaxContactsPerPair) > 0)) {
-          continue;
-        }
-        wake_up(o);
-        wake_queue.push_back(o);
-      }
+  // SpeculativeContacts::Engine
+  std::optional<SpeculativeContacts::Motion> motion(std::size_t id) const override {
+    dBodyID body = bodies[id];
+    if (body == nullptr) return std::nullopt;
+    dMass mass;
+    dBodyGetMass(body, &mass);
+    const dReal* p = dBodyGetPosition(body);
+    const dReal* v = dBodyGetLinearVel(body);
+    const dReal* w = dBodyGetAngularVel(body);
+    const dReal* f = dBodyGetForce(body);
+    return SpeculativeContacts::Motion{Eigen::Vector3d(p[0], p[1], p[2]), Eigen::Vector3d(v[0], v[1], v[2]),
+                                       Eigen::Vector3d(w[0], w[1], w[2]), Eigen::Vector3d(f[0], f[1], f[2]),
+                                       mass.mass, dBodyGetGravityMode(body) != 0, dBodyIsEnabled(body) == 0};
+  }
+  int collide_displaced(std::size_t id, std::size_t other, const Eigen::Vector3d& displacement_m,
+                        Point* out) override {
+    dBodyID body = bodies[id];
+    const dReal* p = dBodyGetPosition(body);
+    const dReal start[3] = {p[0], p[1], p[2]};
+    dBodySetPosition(body, start[0] + displacement_m.x(), start[1] + displacement_m.y(), start[2] + displacement_m.z());
+    dContactGeom found[kMaxContactsPerPair];
+    const int count = dCollide(geoms[id], geom_of(other), kMaxContactsPerPair, found, sizeof(dContactGeom));
+    dBodySetPosition(body, start[0], start[1], start[2]);
+    for (int i = 0; i < count; ++i) out[i] = point_of(found[i]);
+    return count;
+  }
+  void add_row(std::size_t a, std::size_t b, const SpeculativeContacts::Row& row) override {
+    dContact contact{};
+    contact.geom.g1 = geoms[a];
+    contact.geom.g2 = geom_of(b);
+    for (int k = 0; k < 3; ++k) {
+      contact.geom.pos[k] = row.point.position_m[k];
+      contact.geom.normal[k] = row.point.normal[k];
     }
+    contact.geom.depth = row.point.depth_m;
+    set_surface(contact.surface, materials[a], materials[b]);
+    if (row.speculative) {
+      contact.surface.mode |= dContactMotionN;
+      contact.surface.mode &= ~dContactBounce;
+      contact.surface.motionN = row.normal_speed_mps;
+    }
+    add_contact(contact, geoms[a], geom_of(b), row.speculative);
+  }
+  void add_ordinary_contacts(std::size_t a, std::size_t b) override {
+    dGeomID ga = geom_of(a);
+    dGeomID gb = geom_of(b);
+    dContact found[kMaxContactsPerPair];
+    add_contacts(found, dCollide(ga, gb, kMaxContactsPerPair, &found[0].geom, sizeof(dContact)), ga, gb);
+  }
+
+  static Point point_of(const dContactGeom& geom) {
+    return Point{Eigen::Vector3d(geom.pos[0], geom.pos[1], geom.pos[2]),
+                 Eigen::Vector3d(geom.normal[0], geom.normal[1], geom.normal[2]), geom.depth};
   }
 
   // Contacts of the awake geoms: among themselves (the space), with the floor and with fixed geometry (the grid).
-  // Sleeping bodies an awake one touches were woken first (wake_touched), so none is met here.
+  // Sleeping bodies an awake one touches were woken first (SleepingBodies::wake_touched), so none is met here.
   void collide_awake() {
     dSpaceCollide(space, this, &Handles::near_callback);
-    for (const std::size_t id : awake) {
+    for (const std::size_t id : sleeping->awake()) {
       if (escape_guard.escaped(id)) continue;
       dGeomID geom = geoms[id];
       if (floor != nullptr) near_callback(this, geom, floor);
-      const Eigen::AlignedBox3d bounds = geom_bounds(geom);
-      grid->query(bounds, nearby);
-      for (const std::int32_t other : nearby) {
-        const auto o = static_cast<std::size_t>(other);
-        if (kind[o] == Kind::fixed && bounds.intersects(resting_bounds[o])) near_callback(this, geom, geoms[o]);
-      }
+      sleeping->fixed_near(geom_bounds(geom), nearby);
+      for (const std::size_t o : nearby) near_callback(this, geom, geoms[o]);
     }
-  }
-
-  // After a step: the bodies ODE disabled go to sleep.
-  void put_rested_to_sleep() {
-    std::size_t kept = 0;
-    for (const std::size_t id : awake) {
-      if (escape_guard.escaped(id)) continue;
-      if (dBodyIsEnabled(bodies[id]) == 0) {
-        fall_asleep(id);
-        continue;
-      }
-      awake[kept++] = id;
-    }
-    awake.resize(kept);
   }
 
   // Takes every body the solver has thrown out of range out of the simulation before the broadphase sees it (ODE's
   // hash space asserts on coordinates it cannot store in its cells): escape_guard.h decides, park() does.
   void park_escaped() {
     if (sleeping) {
-      escape_guard.check(awake, *this);
+      escape_guard.check(sleeping->awake(), *this);
       return;
     }
     escape_guard.check_all(*this);
@@ -258,7 +238,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine {
     dGeomDisable(geoms[id]);
   }
 
-  ~Handles() {
+  ~Handles() override {
     if (contacts != nullptr) dJointGroupDestroy(contacts);
     if (resting_space != nullptr) dSpaceDestroy(resting_space);
     if (space != nullptr) dSpaceDestroy(space);  // destroys the geoms it holds (cleanup mode on)
@@ -315,190 +295,30 @@ struct OdeEngine::Handles final : EscapeGuard::Engine {
     recorded.push_back({joint, id_a, id_b, normal, contact.surface.mu, speculative_contact});
   }
 
-  // ODE's near callback: contact joints with the two materials combined. With speculative contacts a pair that is
-  // still closing fast is given the contacts of where it will be (add_swept_contacts): it has only just met, and
-  // ODE's contacts of a pair touching by a hair are any subset of its corners (two bottom corners of a face: a torque
-  // that pitches both boxes).
+  // ODE's near callback: contact joints with the two materials combined. With speculative contacts a pair still
+  // closing fast is left to the service (SpeculativeContacts::defer_touching): the body is moved for its test, which
+  // the locked space forbids here.
   static void near_callback(void* data, dGeomID a, dGeomID b) {
     auto* self = static_cast<Handles*>(data);
     if (dGeomGetBody(a) == nullptr && dGeomGetBody(b) == nullptr) return;  // static against static never moves
-    dContact contacts[kMaxContactsPerPair];
-    const int count = dCollide(a, b, kMaxContactsPerPair, &contacts[0].geom, sizeof(dContact));
-    if (count == 0) return;
-    const std::size_t id_a = data_to_id(dGeomGetData(a));
-    const std::size_t id_b = data_to_id(dGeomGetData(b));
-    if (self->speculative) {
-      self->touching.push_back(pair_key(id_a, id_b));
-      if (self->closing_fast(id_a, id_b, contacts[0].geom)) {
-        self->closing.push_back({a, b});  // the body is moved for the test, which the locked space forbids here
-        return;
-      }
-    }
-    self->add_contacts(contacts, count, a, b);
-  }
-
-  void add_contacts(dContact* contacts, int count, dGeomID a, dGeomID b) {
-    const std::size_t id_a = data_to_id(dGeomGetData(a));
-    const std::size_t id_b = data_to_id(dGeomGetData(b));
-    for (int i = 0; i < count; ++i) {
-      set_surface(contacts[i].surface, materials[id_a], materials[id_b]);
-      add_contact(contacts[i], a, b, false);
-    }
-  }
-
-  // The pairs the near callback found closing fast, once the space is unlocked: the contacts of where they will be,
-  // or their ordinary ones if the displacements part them.
-  void add_closing_contacts() {
-    for (const auto& [a, b] : closing) {
-      if (add_swept_contacts(a, b)) continue;
-      dContact contacts[kMaxContactsPerPair];
-      add_contacts(contacts, dCollide(a, b, kMaxContactsPerPair, &contacts[0].geom, sizeof(dContact)), a, b);
-    }
-    closing.clear();
-  }
-
-  // Whether the pair's contact `touch` closes faster than a resting contact ever does (kBounceThreshold_mps, with the
-  // velocities as they are, before this substep's gravity and forces).
-  bool closing_fast(std::size_t id_a, std::size_t id_b, const dContactGeom& touch) const {
-    const Eigen::Vector3d at(touch.pos[0], touch.pos[1], touch.pos[2]);
-    const Eigen::Vector3d normal(touch.normal[0], touch.normal[1], touch.normal[2]);
-    return -normal.dot(point_velocity(id_a, at) - point_velocity(id_b, at)) > kBounceThreshold_mps;
-  }
-
-  // The velocity of the point `at` on what carries geom `id` (zero for fixed geometry and the floor).
-  Eigen::Vector3d point_velocity(std::size_t id, const Eigen::Vector3d& at) const {
-    if (id >= bodies.size() || bodies[id] == nullptr) return Eigen::Vector3d::Zero();
-    const dReal* p = dBodyGetPosition(bodies[id]);
-    const dReal* v = dBodyGetLinearVel(bodies[id]);
-    const dReal* w = dBodyGetAngularVel(bodies[id]);
-    return Eigen::Vector3d(v[0], v[1], v[2]) +
-           Eigen::Vector3d(w[0], w[1], w[2]).cross(at - Eigen::Vector3d(p[0], p[1], p[2]));
-  }
-
-  // The contacts the pair makes within this substep (speculative_contact.h), moving the one with a body (the lower id
-  // if both have) by their relative free displacement; false if they do not meet. Where the pair is still apart by
-  // gap the row lets it close the gap and no more (relative normal speed ≥ −gap/h; ERP adds nothing at zero depth);
-  // a bouncing pair (restitution e, closing faster than the bounce threshold) leaves at e times its closing speed
-  // from there, as ODE's bounce would one substep later from inside. Where it already overlaps, an ordinary contact.
-  bool add_swept_contacts(dGeomID a, dGeomID b) {
-    std::size_t id_a = data_to_id(dGeomGetData(a));
-    std::size_t id_b = data_to_id(dGeomGetData(b));
-    if (dGeomGetBody(a) == nullptr || (dGeomGetBody(b) != nullptr && id_b < id_a)) {
-      std::swap(a, b);
-      std::swap(id_a, id_b);
-    }
-    const Eigen::Vector3d relative_m = displacement_of(id_a) - displacement_of(id_b);
-    if (!(relative_m.squaredNorm() > 0.0)) return false;
     dContact found[kMaxContactsPerPair];
-    const int count = speculative_contacts(a, bodies[id_a], b, relative_m, found, kMaxContactsPerPair);
+    const int count = dCollide(a, b, kMaxContactsPerPair, &found[0].geom, sizeof(dContact));
+    if (count == 0) return;
+    if (self->speculative &&
+        self->speculative->defer_touching(data_to_id(dGeomGetData(a)), data_to_id(dGeomGetData(b)),
+                                          point_of(found[0].geom), *self)) {
+      return;
+    }
+    self->add_contacts(found, count, a, b);
+  }
+
+  void add_contacts(dContact* found, int count, dGeomID a, dGeomID b) {
+    const std::size_t id_a = data_to_id(dGeomGetData(a));
+    const std::size_t id_b = data_to_id(dGeomGetData(b));
     for (int i = 0; i < count; ++i) {
-      dContact& contact = found[i];
-      set_surface(contact.surface, materials[id_a], materials[id_b]);
-      const double gap_m = -contact.geom.depth;
-      const bool apart = gap_m > 0.0;
-      if (apart) {
-        contact.geom.depth = 0.0;
-        contact.surface.mode |= dContactMotionN;
-        contact.surface.motionN = -gap_m / substep_s;
-        if ((contact.surface.mode & dContactBounce) != 0) {
-          contact.surface.mode &= ~dContactBounce;
-          const Eigen::Vector3d at(contact.geom.pos[0], contact.geom.pos[1], contact.geom.pos[2]);
-          const Eigen::Vector3d normal(contact.geom.normal[0], contact.geom.normal[1], contact.geom.normal[2]);
-          const double closing_mps = -normal.dot(point_velocity(id_a, at) - point_velocity(id_b, at));
-          if (closing_mps > contact.surface.bounce_vel) contact.surface.motionN = contact.surface.bounce * closing_mps;
-        }
-      }
-      add_contact(contact, a, b, apart);
+      set_surface(found[i].surface, materials[id_a], materials[id_b]);
+      add_contact(found[i], a, b, false);
     }
-    return count > 0;
-  }
-
-  // The displacement body `id` makes in a substep of h if nothing touches it: semi-implicit Euler, as ODE steps,
-  // with gravity and the forces applied so far (the couplings add theirs before the substep).
-  Eigen::Vector3d free_displacement(std::size_t id, double h) const {
-    dBodyID body = bodies[id];
-    dMass mass;
-    dBodyGetMass(body, &mass);
-    const dReal* v = dBodyGetLinearVel(body);
-    const dReal* f = dBodyGetForce(body);
-    Eigen::Vector3d acceleration = Eigen::Vector3d(f[0], f[1], f[2]) / mass.mass;
-    if (dBodyGetGravityMode(body) != 0) acceleration += Eigen::Vector3d(scene->gravity_mps2.data());
-    return h * (Eigen::Vector3d(v[0], v[1], v[2]) + h * acceleration);
-  }
-
-  // Every moving body's free displacement for the coming substep.
-  void predict_displacements(double h) {
-    auto predict = [&](std::size_t id) {
-      if (bodies[id] == nullptr || escape_guard.escaped(id) || dBodyIsEnabled(bodies[id]) == 0) return;
-      displacement[id] = free_displacement(id, h);
-    };
-    if (sleeping) {
-      for (const std::size_t id : awake) predict(id);
-    } else {
-      for (std::size_t id = 0; id < bodies.size(); ++id) predict(id);
-    }
-  }
-
-  // The displacement of whatever carries geom `id` this substep: zero for fixed geometry, the floor and sleepers.
-  Eigen::Vector3d displacement_of(std::size_t id) const {
-    if (id >= bodies.size() || bodies[id] == nullptr || escape_guard.escaped(id) || dBodyIsEnabled(bodies[id]) == 0) {
-      return Eigen::Vector3d::Zero();
-    }
-    return displacement[id];
-  }
-
-  // The bounds `id`'s geom sweeps in the substep.
-  Eigen::AlignedBox3d swept_bounds(std::size_t id) const {
-    Eigen::AlignedBox3d bounds = geom_bounds(geoms[id]);
-    Eigen::AlignedBox3d moved_bounds = bounds;
-    return bounds.extend(moved_bounds.translate(displacement[id]));
-  }
-
-  // Speculative contacts (speculative_contact.h) of every moving body with what it would reach in this substep and
-  // does not touch yet. Moving pairs by sweep and prune over their swept bounds along x (O(n log n) in the bodies
-  // that move); fixed geometry from the grid (with sleeping) or the list of it, and the floor.
-  void speculate() {
-    std::sort(touching.begin(), touching.end());
-    sweeps.clear();
-    auto add_sweep = [&](std::size_t id) {
-      if (bodies[id] == nullptr || escape_guard.escaped(id) || dBodyIsEnabled(bodies[id]) == 0) return;
-      sweeps.push_back({id, swept_bounds(id)});
-    };
-    if (sleeping) {
-      for (const std::size_t id : awake) add_sweep(id);
-    } else {
-      for (std::size_t id = 0; id < bodies.size(); ++id) add_sweep(id);
-    }
-    std::sort(sweeps.begin(), sweeps.end(),
-              [](const Sweep& a, const Sweep& b) { return a.bounds.min().x() < b.bounds.min().x(); });
-    for (std::size_t i = 0; i < sweeps.size(); ++i) {
-      const Sweep& a = sweeps[i];
-      for (std::size_t j = i + 1; j < sweeps.size() && sweeps[j].bounds.min().x() <= a.bounds.max().x(); ++j) {
-        if (!a.bounds.intersects(sweeps[j].bounds)) continue;
-        const std::size_t low = std::min(a.id, sweeps[j].id), high = std::max(a.id, sweeps[j].id);
-        speculate_pair(low, geoms[high]);
-      }
-      if (floor != nullptr) speculate_pair(a.id, floor);
-      if (sleeping) {
-        grid->query(a.bounds, nearby);
-        for (const std::int32_t other : nearby) {
-          const auto o = static_cast<std::size_t>(other);
-          if (kind[o] == Kind::fixed && a.bounds.intersects(resting_bounds[o])) speculate_pair(a.id, geoms[o]);
-        }
-      } else {
-        for (const auto& [o, bounds] : fixed_bounds) {
-          if (a.bounds.intersects(bounds)) speculate_pair(a.id, geoms[o]);
-        }
-      }
-    }
-  }
-
-  // Body `id` against `other` (fixed, the floor, or a body of higher id), unless they touch already.
-  void speculate_pair(std::size_t id, dGeomID other) {
-    if (dGeomIsEnabled(other) == 0) return;
-    const std::size_t other_id = data_to_id(dGeomGetData(other));
-    if (std::binary_search(touching.begin(), touching.end(), pair_key(id, other_id))) return;
-    add_swept_contacts(geoms[id], other);
   }
 };
 
@@ -506,45 +326,48 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   Handles& ode = *ode_;
   ode.scene = &scene;
   ode.world = dWorldCreate();
-  ode.sleeping = scene.physics.auto_disable;
+  const bool sleeping = scene.physics.auto_disable;
   // ODE's hash space keeps an n×n bit matrix of the pairs it has tested, cleared at every collide: 1.25 GB per substep
   // at 100 k geoms (12.5 MB at 10 k). With sleeping every body is awake at the start, so the awake space sweeps and
   // prunes instead (sorted along x, then y: scenes spread over a floor), O(n log n). Without sleeping the hash space
   // stays, whose contact order the published figures were made with.
-  ode.space = ode.sleeping ? dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ) : dHashSpaceCreate(nullptr);
-  if (ode.sleeping) ode.resting_space = dSimpleSpaceCreate(nullptr);  // never collided as a whole: it only owns
+  ode.space = sleeping ? dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ) : dHashSpaceCreate(nullptr);
+  if (sleeping) ode.resting_space = dSimpleSpaceCreate(nullptr);  // never collided as a whole: it only owns
   ode.contacts = dJointGroupCreate(0);
-  ode.speculative = scene.physics.speculative_contacts;
-  if (ode.speculative) {
-    ode.displacement.assign(scene.objects.size(), Eigen::Vector3d::Zero());
-  }
   dWorldSetGravity(ode.world, scene.gravity_mps2[0], scene.gravity_mps2[1], scene.gravity_mps2[2]);
   if (std::isfinite(scene.physics.ode.max_correcting_velocity_mps)) {
     dWorldSetContactMaxCorrectingVel(ode.world, scene.physics.ode.max_correcting_velocity_mps);
   }
   dWorldSetQuickStepNumIterations(ode.world, scene.physics.ode.solver_iterations);
-  dWorldSetAutoDisableFlag(ode.world, scene.physics.auto_disable ? 1 : 0);
-  if (ode.sleeping) {
-    dWorldSetAutoDisableLinearThreshold(ode.world, kSleepSpeed_mps);
-    dWorldSetAutoDisableAngularThreshold(ode.world, kSleepAngularSpeed_radps);
+  // The rest rule (sleeping_bodies.h) as ODE's auto-disable: it stops a body whose speeds stayed under the thresholds
+  // for the rest time (and wakes one an enabled body touches); SleepingBodies then takes it out of ODE.
+  dWorldSetAutoDisableFlag(ode.world, sleeping ? 1 : 0);
+  if (sleeping) {
+    dWorldSetAutoDisableLinearThreshold(ode.world, SleepingBodies::kSleepSpeed_mps);
+    dWorldSetAutoDisableAngularThreshold(ode.world, SleepingBodies::kSleepAngularSpeed_radps);
     dWorldSetAutoDisableSteps(ode.world, 0);
-    dWorldSetAutoDisableTime(ode.world, kRestBeforeSleep_s);
+    dWorldSetAutoDisableTime(ode.world, SleepingBodies::kRestBeforeSleep_s);
   }
 
-  ode.bodies.assign(scene.objects.size(), nullptr);
-  ode.contact_graph.reset(scene.objects.size());
-  ode.geoms.assign(scene.objects.size(), nullptr);
-  ode.escape_guard = EscapeGuard(scene.objects.size());
-  ode.inverse_inertia_body.assign(scene.objects.size(), Eigen::Matrix3d::Zero());
-  if (ode.sleeping) {
-    ode.kind.assign(scene.objects.size(), Handles::Kind::fixed);
-    ode.masses.resize(scene.objects.size());
-    ode.resting_pose.resize(scene.objects.size());
-    ode.resting_bounds.resize(scene.objects.size());
-    ode.grid = std::make_unique<SpatialGrid>(grid_cell_size_m(scene));
-    ode.grid->reset(scene.objects.size());
+  const std::size_t count = scene.objects.size();
+  ode.bodies.assign(count, nullptr);
+  ode.contact_graph.reset(count);
+  ode.geoms.assign(count, nullptr);
+  ode.escape_guard = EscapeGuard(count);
+  ode.inverse_inertia_body.assign(count, Eigen::Matrix3d::Zero());
+  for (const SceneObject& object : scene.objects) ode.materials.push_back(object.material);
+  ode.materials.push_back(scene.floor.material);
+  if (sleeping) {
+    ode.masses.resize(count);
+    ode.resting_pose.resize(count);
+    ode.sleeping = std::make_unique<SleepingBodies>(count, grid_cell_size_m(scene), ode.escape_guard, ode.contact_graph);
   }
-  for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+  if (scene.physics.speculative_contacts) {
+    ode.speculative = std::make_unique<SpeculativeContacts>(count, scene.floor.present,
+                                                            Eigen::Vector3d(scene.gravity_mps2.data()), ode.materials,
+                                                            ode.escape_guard, ode.sleeping.get());
+  }
+  for (std::size_t id = 0; id < count; ++id) {
     const SceneObject& object = scene.objects[id];
     const Shape& shape = object.shape;
     dGeomID geom = nullptr;
@@ -552,7 +375,7 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
     dMassSetZero(&mass);
     constexpr int kAxisZ = 3;  // ODE's direction code for the body z axis
     // With sleeping, fixed geometry is never collided as a whole, only looked up in the grid around awake bodies.
-    dSpaceID home = ode.sleeping && !object.dynamic ? ode.resting_space : ode.space;
+    dSpaceID home = sleeping && !object.dynamic ? ode.resting_space : ode.space;
     switch (shape.kind) {
       case ShapeKind::box:
         geom = dCreateBox(home, shape.box_size_m[0], shape.box_size_m[1], shape.box_size_m[2]);
@@ -592,28 +415,24 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
                          object.angular_velocity_radps[2]);
       ode.bodies[id] = body;
       ode.inverse_inertia_body[id] = ode_inertia(mass).inverse();
-      ode.moved.push_back(id);
-      if (ode.sleeping) {
-        ode.kind[id] = Handles::Kind::awake;
+      ode.dynamic_ids.push_back(id);
+      if (sleeping) {
         ode.masses[id] = mass;
-        ode.awake.push_back(id);
+        ode.sleeping->add_awake(id);
       }
     } else {
       dGeomSetPosition(geom, object.position_m[0], object.position_m[1], object.position_m[2]);
       dGeomSetQuaternion(geom, orientation);
-      if (ode.sleeping) {
-        ode.resting_bounds[id] = geom_bounds(geom);
-        ode.grid->update(static_cast<std::int32_t>(id), ode.resting_bounds[id]);
+      if (sleeping) {
+        ode.sleeping->add_fixed(id, geom_bounds(geom));
       } else if (ode.speculative) {
-        ode.fixed_bounds.emplace_back(id, geom_bounds(geom));
+        ode.speculative->add_fixed(id, geom_bounds(geom));
       }
     }
-    ode.materials.push_back(object.material);
   }
-  ode.materials.push_back(scene.floor.material);
   if (scene.floor.present) {
-    dGeomID floor = dCreatePlane(ode.sleeping ? ode.resting_space : ode.space, 0.0, 0.0, 1.0, scene.floor.height_m);
-    dGeomSetData(floor, id_to_data(scene.objects.size()));
+    dGeomID floor = dCreatePlane(sleeping ? ode.resting_space : ode.space, 0.0, 0.0, 1.0, scene.floor.height_m);
+    dGeomSetData(floor, id_to_data(count));
     ode.floor = floor;
   }
 
@@ -667,12 +486,12 @@ void OdeEngine::set_velocity(std::size_t id, const Eigen::Vector3d& velocity_mps
 }
 
 void OdeEngine::wake(std::size_t id) {
-  if (asleep(id)) ode_->wake_up(id);
+  if (asleep(id)) ode_->sleeping->wake(id, *ode_);
   dBodyEnable(ode_->bodies[id]);  // also restarts ODE's count of the time the body has rested
 }
 
 bool OdeEngine::asleep(std::size_t id) const {
-  return ode_->sleeping && ode_->kind[id] == Handles::Kind::asleep;
+  return ode_->sleeping && ode_->sleeping->asleep(id);
 }
 
 void OdeEngine::add_force(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm) {
@@ -694,28 +513,24 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
   // The contact's spring and damper as ODE's numbers for this substep (scene.h PhysicsParams).
   dWorldSetERP(ode.world, scene.physics.erp_at(substep_s));
   dWorldSetCFM(ode.world, scene.physics.cfm_at(substep_s));
-  if (ode.sleeping) {
-    ode.moved.assign(ode.awake.begin(), ode.awake.end());
-    std::sort(ode.moved.begin(), ode.moved.end());
-  }
+  if (ode.sleeping) ode.sleeping->begin_step();
   for (int substep = 0; substep < substeps; ++substep) {
     hook.before_substep(substep);
     ode.record_contacts = record_contacts && substep + 1 == substeps;
     const bool recording = ode.record_contacts;
     if (recording) ode.recorded.clear();
     ode.park_escaped();
-    ode.touching.clear();
-    ode.substep_s = substep_s;
-    if (ode.sleeping) ode.wake_touched(substep_s);
-    if (ode.speculative) ode.predict_displacements(substep_s);
+    if (ode.speculative) ode.speculative->begin_substep(substep_s);
+    if (ode.sleeping) ode.sleeping->wake_touched(substep_s, ode);
+    if (ode.speculative) ode.speculative->predict(ode.movers(), ode);
     if (ode.sleeping) {
       ode.collide_awake();
     } else {
       dSpaceCollide(ode.space, &ode, &Handles::near_callback);
     }
     if (ode.speculative) {
-      ode.add_closing_contacts();
-      ode.speculate();
+      ode.speculative->add_closing_contacts(ode);
+      ode.speculative->speculate(ode.movers(), ode);
     }
     ode.record_contacts = false;
     if (recording) {
@@ -731,11 +546,13 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
     dJointGroupEmpty(ode.contacts);
   }
   ode.park_escaped();  // the world reads the state next
-  if (ode.sleeping) ode.put_rested_to_sleep();
+  if (ode.sleeping) ode.sleeping->put_rested_to_sleep(ode);
   ode.random_state = dRandGetSeed();
 }
 
-const std::vector<std::size_t>& OdeEngine::moved() const { return ode_->moved; }
+const std::vector<std::size_t>& OdeEngine::moved() const {
+  return ode_->sleeping ? ode_->sleeping->moved() : ode_->dynamic_ids;
+}
 
 ContactGraph& OdeEngine::contacts() { return ode_->contact_graph; }
 

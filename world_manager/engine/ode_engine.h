@@ -3,13 +3,10 @@
 // The ODE implementation of RigidBodyEngine: a hash space, contact joints with the two materials combined
 // (scene.h combine_*), QuickStep or the direct solver as the scene asks.
 //
-// Sleeping (scene physics.auto_disable): ODE's auto-disable decides when a body rests; such a body is then taken out
-// of ODE altogether, its geom left in place as fixed geometry in a grid (features/spatial_grid.h). ODE walks every
-// body of its world in every substep, disabled or not, and a hash space collides every geom it holds; so a resting
-// body left in ODE would still cost per substep. Each substep the awake geoms are tested against the grid: a sleeping
-// body an awake one touches wakes (a new ODE body with the same mass, pose and zero velocity) before the contacts are
-// made, as ODE's own islands would wake it, and its contacts then join the step. A step costs what is awake and what
-// it touches, not what exists. Without auto_disable every body stays in ODE and nothing here applies.
+// The engine-neutral services run over it: escape handling (escape_guard.h), sleeping (sleeping_bodies.h: ODE's
+// auto-disable is the rest rule; a sleeping body leaves ODE, whose solver walks every body it holds in every substep,
+// disabled or not) and speculative contacts (speculative_contacts.h: rows with ODE's motionN). This file makes ODE's
+// bodies, geoms and contact joints and answers what the services ask.
 //
 // The process must have called init_ode_once() (ode_runtime.h) first. Each engine keeps its own stream of ODE's
 // global random generator (saved and restored around its steps), so runs are bitwise reproducible per engine even

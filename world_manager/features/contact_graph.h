@@ -17,7 +17,7 @@
 // errs toward "does not hold", i.e. toward a model that gives way more than the world does, which is the passive
 // error (local_dynamics.h, frame boundaries).
 //
-// Sleeping bodies (the engine stops simulating a body at rest, ode_engine.h): a body put to sleep keeps the contacts it
+// Sleeping bodies (the engine stops simulating a body at rest, engine/sleeping_bodies.h): a body put to sleep keeps the contacts it
 // had in its last simulated substep (`rest`) until it wakes (`wake`), so the local model sees a resting body on its
 // support whether or not the engine simulated it this step. The cost of a step's graph grows with the contacts of the
 // bodies simulated, not with the number of bodies.
