@@ -300,6 +300,7 @@ nlohmann::json HapticNode::endpoint_summary(const Endpoint& endpoint) const {
           {"infeasible_contacts", counters.infeasible_contacts},
           {"stale_world_ticks", counters.stale_world_ticks},
           {"no_device_ticks", counters.no_device_ticks},
+          {"servo_stalls", counters.servo_stalls},
           {"dropped_impulse_shares", counters.dropped_impulse_shares},
           {"abandoned_impulse_Ns", {abandoned.x(), abandoned.y(), abandoned.z()}},
           {"contact_frame_boundaries", counters.contact_frame_boundaries},

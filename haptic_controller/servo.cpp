@@ -116,6 +116,14 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
     idle_tick(finger != nullptr);
     return result_;
   }
+  // A servo that did not run for longer than the device's command watchdog (common/runtime/staleness.h) finds the
+  // device at minimum output and the hand where it went meanwhile, possibly deep in an object: a new finger session,
+  // so the finger is not kicked out (god_object.h), and the hold of this tick's command is the watchdog's at most.
+  if (finger_known_ && command_stale(dt_s)) {
+    ++counters_.servo_stalls;
+    finger_known_ = false;
+  }
+  const double hold_s = std::min(dt_s, kCommandStale_s);
   const Eigen::Vector3d finger_m = finger->position_m;
   const Eigen::Vector3d finger_velocity_mps =
       finger_known_ && dt_s > 0.0 ? Eigen::Vector3d((finger_m - finger_m_) / dt_s) : Eigen::Vector3d::Zero();
@@ -186,7 +194,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   report.force_N = result_.force_N;
 
   // 5. The reaction −f_j·Δt, shared among the touched objects (§3.4).
-  accumulator_.add(planes_, contact.contact, force_N, dt_s > 0.0 && std::isfinite(dt_s) ? dt_s : 0.0,
+  accumulator_.add(planes_, contact.contact, force_N, hold_s > 0.0 && std::isfinite(hold_s) ? hold_s : 0.0,
                    counters_.ticks);
   counters_.dropped_impulse_shares = accumulator_.dropped_shares();
   // The objects give way at the haptic rate (local coupling, paper §6.3): this tick's shares move the model.

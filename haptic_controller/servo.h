@@ -58,6 +58,7 @@ struct ServoCounters {
   std::uint64_t infeasible_contacts = 0;  // pinch: no point outside all planes
   std::uint64_t stale_world_ticks = 0;
   std::uint64_t no_device_ticks = 0;
+  std::uint64_t servo_stalls = 0;      // ticks that came longer than kCommandStale_s after the last (a stalled servo)
   std::uint64_t dropped_impulse_shares = 0;  // reaction shares that found no report entry
   // Frame-boundary continuity, any coupling. At the first tick after a world frame, for every plane that
   // held the proxy in the tick before: the second difference of the plane's signed distance at that proxy over the

@@ -31,11 +31,13 @@ DeviceNode::DeviceNode(DeviceSim& sim, DevicePortClient& port, const std::string
 }
 
 void DeviceNode::tick(double dt_s) {
-  // Minimum tensions until a command arrives: what a haptic side that sends nothing means (the strings stay taut).
+  // Minimum tensions until a command arrives, and while the last one is stale (command_watchdog.h): what a haptic
+  // side that sends nothing means (the strings stay taut).
   std::array<double, kStringCount> tensions{};
   tensions.fill(sim_.hardware().geometry().tension_min_N);
   DeviceCommand command;
-  if (port_.latest_command(command)) tensions = command.tension_N;
+  const bool received = port_.latest_command(command);
+  if (watchdog_.applies(received ? &command : nullptr, sim_.time_s())) tensions = command.tension_N;
   DeviceState state = sim_.tick(tensions, dt_s);
   state.device_session = session_;
   port_.publish_state(state);
@@ -129,6 +131,7 @@ nlohmann::json DeviceNode::summary() const {
            {{"ticks", ticks_},
             {"time_s", sim_.time_s()},
             {"rejected_commands", port_.rejected_commands()},
+            {"stale_command_ticks", watchdog_.stale_ticks()},
             {"channel_repairs", port_.channel_repairs()},
             {"finger_mass_kg", finger.mass_kg},
             {"hand_stiffness_Npm", finger.hand_stiffness_Npm},

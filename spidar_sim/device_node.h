@@ -10,6 +10,7 @@
 #include "common/runtime/rt_log.h"
 #include "common/link/device_port.h"
 #include "common/link/inproc/inproc_device_port.h"
+#include "spidar_sim/command_watchdog.h"
 #include "spidar_sim/device_sim.h"
 
 #include <nlohmann/json.hpp>
@@ -46,6 +47,7 @@ class DeviceNode final : public DeviceStepper {
   DeviceSim& sim_;
   DevicePortClient& port_;
   std::uint64_t session_;
+  CommandWatchdog watchdog_;             // a stalled servo's last command is not applied for long
   // Rows leave the tick as copies and are formatted and written by the log's own thread (rt_log.h): lockstep waits
   // for room (a complete log), real time drops and counts.
   std::optional<RtLog<DeviceLogRow>> log_;

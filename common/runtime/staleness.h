@@ -4,6 +4,8 @@
 //
 //   a world silent for kWorldStalePeriods world periods  → the haptic side keeps its last planes, no extrapolation;
 //   a device silent for kDeviceStale_s                   → the driver commands minimum output;
+//   a servo silent for kCommandStale_s                   → the device outputs its minimum (its own watchdog), and
+//                                                           the servo, when it runs again, starts a new finger session;
 //   an endpoint silent for endpoint_stale_s(T_w)         → the world stops applying its finger.
 
 #include <algorithm>
@@ -17,6 +19,10 @@ inline constexpr double kWorldStalePeriods = 3.0;
 // leave the strings pulling for a perceptible time.
 inline constexpr double kDeviceStale_s = 0.05;
 
+// The other direction, as an amplifier's watchdog: a servo that has sent no new command for this long is not in
+// control, so the device stops applying its last one. The same slack as kDeviceStale_s: 50 ticks of the 1 kHz servo.
+inline constexpr double kCommandStale_s = 0.05;
+
 // Three world periods without a report, and at least 100 ms (several host stalls), is a haptic side gone.
 inline constexpr double kEndpointStaleMin_s = 0.1;
 inline double endpoint_stale_s(double world_period_s) {
@@ -28,5 +34,7 @@ inline bool world_stale(double frame_age_s, double world_period_s) {
 }
 
 inline bool device_stale(double state_age_s) { return state_age_s > kDeviceStale_s; }
+
+inline bool command_stale(double command_age_s) { return command_age_s > kCommandStale_s; }
 
 }  // namespace impetus

@@ -4,6 +4,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -206,6 +208,50 @@ TEST_CASE("creators racing for one name: exactly one wins, every time") {
     REQUIRE(winners.load() == 1);
     REQUIRE(other_errors.load() == 0);
   }
+}
+
+TEST_CASE("a segment's name never names a file its creator has not locked yet") {
+  // The window two creators once both won through: a name that exists before its creator holds the lock lets a second
+  // creator lock the file, call it stale and take the name. A watcher that keeps opening the name and trying the lock
+  // while a creator creates and destroys the segment must never get the lock on a file that still has the name.
+  const std::string name = test::unique_segment_name("window");
+  const std::string path = shm_path(name);
+  constexpr int kRounds = 2000;
+  std::atomic<bool> done{false};
+  std::atomic<int> unlocked_while_named{0};
+  std::atomic<int> looks{0};
+  std::thread watcher([&] {
+    while (!done.load()) {
+      const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+      if (fd < 0) continue;
+      looks.fetch_add(1);
+      if (flock(fd, LOCK_EX | LOCK_NB) == 0) {
+        struct stat opened {};
+        struct stat named {};
+        if (fstat(fd, &opened) == 0 && stat(path.c_str(), &named) == 0 && opened.st_ino == named.st_ino) {
+          unlocked_while_named.fetch_add(1);
+        }
+      }
+      ::close(fd);  // releases the lock if it was taken
+    }
+  });
+  int created = 0;
+  int refused = 0;  // only possible when the watcher held the lock at the wrong moment
+  for (int round = 0; round < kRounds; ++round) {
+    try {
+      auto segment = Segment<SmallLayout>::create(name);
+      ++created;
+    } catch (const SegmentError&) {
+      ++refused;
+    }
+  }
+  done.store(true);
+  watcher.join();
+  INFO(created << " created, " << refused << " refused, the watcher looked " << looks.load() << " times");
+  CHECK(looks.load() > 0);
+  CHECK(unlocked_while_named.load() == 0);
+  CHECK(refused == 0);
+  CHECK(created == kRounds);
 }
 
 TEST_CASE("an owner never removes a name that no longer names its own segment") {

@@ -142,3 +142,30 @@ TEST_CASE("servo: a finger that appears inside an object is not kicked out until
   REQUIRE(reattached.active_planes == 0);
   REQUIRE(Eigen::Vector3d(to_eigen(reattached.force_N)) == Vector3d::Zero());
 }
+
+TEST_CASE("servo: after a stall longer than the device's watchdog, a finger that sank into an object is not kicked") {
+  // The servo presses 2 mm into the cube, then does not run for 2 s (SIGSTOP): the device's watchdog has let go of
+  // the hand (spidar_sim/command_watchdog.h), which sank 9 mm into the cube. The first tick after must not render
+  // k·9 mm at once, and the impulse of that tick is held for the watchdog's time at most, not the 2 s.
+  ServoOptions options;
+  HapticServo servo(options, 5);
+  const SpidarKinematics kinematics(SpidarGeometry{});
+  servo.on_plane_frame(cube_on_floor(0), 0.0);
+  const FingerSample above = test::finger_at(kinematics, Vector3d(0.0, 0.0, 0.052));
+  const FingerSample pressing = test::finger_at(kinematics, Vector3d(0.0, 0.0, 0.048));
+  const FingerSample sunk = test::finger_at(kinematics, Vector3d(0.0, 0.0, 0.041));
+  servo.tick(&above, 0.001, 1e-3);
+  double pressed_N = 0.0;
+  for (int tick = 2; tick <= 10; ++tick) pressed_N = servo.tick(&pressing, tick * 1e-3, 1e-3).force_N[2];
+  REQUIRE(pressed_N > 3.0);  // 2000 N/m × 2 mm
+  const TickResult& resumed = servo.tick(&sunk, 2.010, 2.0);
+  CHECK(resumed.force_N[2] < pressed_N);  // no kick: at most what was felt before the stall
+  CHECK(servo.counters().servo_stalls == 1);
+  // Coming out of the cube and pressing again renders normally.
+  servo.tick(&above, 2.011, 1e-3);
+  const TickResult& again = servo.tick(&pressing, 2.012, 1e-3);
+  CHECK(again.force_N[2] > 3.0);
+  // A late tick within the watchdog's time is not a stall.
+  servo.tick(&pressing, 2.040, 0.028);
+  CHECK(servo.counters().servo_stalls == 1);
+}

@@ -133,6 +133,65 @@ TEST_CASE("a world restarted mid-press applies only what was rendered after it a
   }
 }
 
+TEST_CASE("a haptic controller stopped mid-press: the device lets go within its watchdog, and resuming does not kick") {
+  const Daemons daemons = make_daemons("stophaptic");
+  const pid_t world = daemons.world("");
+  const pid_t haptic = daemons.haptic("");
+  const pid_t device = test::spawn({test::binary("spidar_sim"), "--shm", daemons.shm, "--trajectory", kPress + "4",
+                                    "--log", (daemons.dir / "device.csv").string(), "--summary",
+                                    (daemons.dir / "device.json").string()},
+                                   daemons.dir / "device.out");
+  sleep_s(1.2);  // pressing the cube for ~0.8 s
+  kill(haptic, SIGSTOP);
+  sleep_s(2.0);
+  kill(haptic, SIGCONT);
+  CHECK(test::wait_for(device, 30.0) == 0);
+  stop_like_a_user(haptic, world);
+  INFO(test::read_text(daemons.dir / "haptic.out") << test::read_text(daemons.dir / "device.out"));
+
+  // The device went to minimum output once the commands stopped coming: for most of the 2 s (its watchdog lets go
+  // after 50 ms; a stalled VM may shorten what the device itself ran), at the minimum tension on every string while
+  // the hand pushed the finger into the cube.
+  const auto device_summary = test::read_json(daemons.dir / "device.json")["device"];
+  CHECK(device_summary["stale_command_ticks"].get<int>() > 1000);
+  const auto device_log = test::read_csv_columns(daemons.dir / "device.csv");
+  const double tension_min_N = device_summary["tension_min_N"].get<double>();
+  std::size_t longest_run = 0;
+  std::size_t run = 0;
+  for (std::size_t k = 0; k < device_log.at("time_s").size(); ++k) {
+    bool at_minimum = device_log.at("finger_z_m")[k] < 0.05;
+    for (int string = 0; string < 4; ++string) {
+      at_minimum = at_minimum && device_log.at("tension_" + std::to_string(string) + "_N")[k] == tension_min_N;
+    }
+    run = at_minimum ? run + 1 : 0;
+    longest_run = std::max(longest_run, run);
+  }
+  CHECK(longest_run > 1000);
+
+  // The controller noticed its own stall and started a new finger session: the finger, sunk into the cube meanwhile,
+  // is not kicked out. No force after the gap exceeds what was felt before it.
+  const auto summary = test::read_json(daemons.dir / "haptic.json")["haptic"];
+  CHECK(summary["servo_stalls"].get<int>() >= 1);
+  const auto haptic_log = test::read_csv_columns(daemons.dir / "haptic.csv");
+  const auto& time_s = haptic_log.at("time_s");
+  std::size_t gap = 0;
+  for (std::size_t k = 1; k < time_s.size(); ++k) {
+    if (time_s[k] - time_s[k - 1] > 1.0) gap = k;
+  }
+  REQUIRE(gap > 0);
+  const auto force_N = [&](std::size_t k) {
+    return std::sqrt(std::pow(haptic_log.at("force_x")[k], 2) + std::pow(haptic_log.at("force_y")[k], 2) +
+                     std::pow(haptic_log.at("force_z")[k], 2));
+  };
+  double before_N = 0.0;
+  double after_N = 0.0;
+  for (std::size_t k = gap > 200 ? gap - 200 : 0; k < gap; ++k) before_N = std::max(before_N, force_N(k));
+  for (std::size_t k = gap; k < std::min(gap + 200, time_s.size()); ++k) after_N = std::max(after_N, force_N(k));
+  INFO("largest force in the 200 ticks before the stall " << before_N << " N, after it " << after_N << " N");
+  CHECK(before_N > 1.0);
+  CHECK(after_N <= before_N);
+}
+
 TEST_CASE("killing the haptic controller: the world keeps stepping and a restarted controller causes no burst") {
   const Daemons daemons = make_daemons("killhaptic");
   const pid_t world = daemons.world("");

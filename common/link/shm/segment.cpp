@@ -6,6 +6,7 @@
 #include <boost/interprocess/shared_memory_object.hpp>
 
 #include <signal.h>
+#include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -75,6 +76,13 @@ struct SegmentMapping::Impl {
   bip::shared_memory_object object;
   bip::mapped_region region;
   bool locked = false;  // this process holds the creator's lock on `object`
+  int lock_fd = -1;     // a creator: the descriptor it made the file with, which holds the lock for its life
+  Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+  ~Impl() {
+    if (lock_fd >= 0) close(lock_fd);
+  }
 };
 
 namespace {
@@ -198,6 +206,38 @@ OpenProblem stale_reason(SegmentMapping::Impl& impl) {
   return {};
 }
 
+
+// A new file for a segment of `size_bytes`, with no name yet, locked (the creator's lock) and sized: -1 with errno set
+// if the system refuses. Nobody can open a file without a name, so nobody sees it before it is locked and sized.
+int make_locked_file(std::size_t size_bytes) {
+  const int fd = open("/dev/shm", O_TMPFILE | O_RDWR | O_CLOEXEC, kSegmentPermissions);
+  if (fd < 0) return -1;
+  // O_TMPFILE applies the umask; a segment is 0600 whatever the umask.
+  if (fchmod(fd, kSegmentPermissions) != 0 || flock(fd, LOCK_EX | LOCK_NB) != 0 ||
+      ftruncate(fd, static_cast<off_t>(size_bytes)) != 0) {
+    const int error = errno;
+    close(fd);
+    errno = error;
+    return -1;
+  }
+  return fd;
+}
+
+// Gives the file `fd` the segment name `name`, atomically and only if the name is free (EEXIST otherwise): a name
+// therefore always names a file its creator has already locked.
+bool publish_name(int fd, const std::string& name) {
+  const std::string self = "/proc/self/fd/" + std::to_string(fd);
+  return linkat(AT_FDCWD, self.c_str(), AT_FDCWD, segment_path(name).c_str(), AT_SYMLINK_FOLLOW) == 0;
+}
+
+// Whether the descriptors `a` and `b` are the same file.
+bool same_file(int a, int b) {
+  struct stat first {};
+  struct stat second {};
+  return fstat(a, &first) == 0 && fstat(b, &second) == 0 && first.st_dev == second.st_dev &&
+         first.st_ino == second.st_ino;
+}
+
 }  // namespace
 
 SegmentMapping::SegmentMapping(const std::string& name, SegmentKind kind, std::size_t size_bytes,
@@ -217,19 +257,20 @@ SegmentMapping::SegmentMapping(const std::string& name, SegmentKind kind, std::s
       }
       return;
     }
-    bip::permissions permissions;
-    permissions.set_permissions(kSegmentPermissions);
-    const auto create_exclusive = [&] {
-      try {
-        impl_->object = bip::shared_memory_object(bip::create_only, name.c_str(), bip::read_write, permissions);
-        return true;
-      } catch (const bip::interprocess_exception& error) {
-        if (error.get_error_code() != bip::already_exists_error) throw;
-        return false;
-      }
-    };
+    // The file is made without a name, locked and sized, and only then given the name (make_locked_file,
+    // publish_name): so a segment whose lock is free is never one still being created, and of several creators
+    // started at once exactly one names its file.
+    const int fd = make_locked_file(size_bytes);
+    if (fd < 0) {
+      refuse({SegmentProblem::system, std::string("cannot make its file in /dev/shm: ") + std::strerror(errno)},
+             "create");
+    }
+    impl_->lock_fd = fd;
     const OpenProblem racing{SegmentProblem::in_use, "another process is creating it at the same moment"};
-    if (!create_exclusive()) {
+    if (!publish_name(fd, name)) {
+      if (errno != EEXIST) {
+        refuse({SegmentProblem::system, "cannot name " + segment_path(name) + ": " + std::strerror(errno)}, "create");
+      }
       // The name exists. Take it over only if nobody holds its creator's lock and it is ours and stale.
       Impl existing;
       if (OpenProblem problem = open_existing(existing, name); !problem.reason.empty()) {
@@ -249,13 +290,13 @@ SegmentMapping::SegmentMapping(const std::string& name, SegmentKind kind, std::s
       }
       // Holding the lock, we are the only process that may remove this file's name.
       if (names_our_file(existing, name)) bip::shared_memory_object::remove(name.c_str());
-      if (!create_exclusive()) refuse(racing, "create");
+      if (!publish_name(fd, name)) refuse(racing, "create");
     }
-    // Between our exclusive creation and this lock another creator may have found the new file unlocked and taken it
-    // over; then it is theirs.
-    if (!take_creator_lock(*impl_)) refuse(racing, "create");
     owner_ = true;
-    impl_->object.truncate(static_cast<bip::offset_t>(size_bytes));
+    impl_->object = bip::shared_memory_object(bip::open_only, name.c_str(), bip::read_write);
+    // Only the holder of our lock removes our name, so the name still names our file.
+    if (!same_file(descriptor(*impl_), fd)) refuse(racing, "create");
+    impl_->locked = true;
     impl_->region = bip::mapped_region(impl_->object, bip::read_write);
     std::memset(impl_->region.get_address(), 0, size_bytes);
   } catch (const bip::interprocess_exception& error) {

@@ -9,8 +9,10 @@
 //
 // Ownership: exactly one process creates a segment (the world manager the world link, the haptic controller the device
 // port) and removes its name when it exits. Other processes open it. The creator holds an exclusive flock on the file
-// for its whole life (the kernel drops it when the process dies, however it dies), so of several creators started at
-// once exactly one wins, and a segment whose lock is free is stale: the next creator takes it over.
+// for its whole life (the kernel drops it when the process dies, however it dies). It makes the file without a name,
+// locks and sizes it, and only then links it to the name, which fails if the name exists: so a name always names a
+// locked file while its creator lives, of several creators started at once exactly one wins, and a segment whose lock
+// is free is stale: the next creator takes it over.
 //
 // Nothing that is not ours is used or removed: every open checks, on the descriptor, that the file is a regular file
 // owned by this user with no access for others (0600); a symbolic link at the name is never followed; a file without
