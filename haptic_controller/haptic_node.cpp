@@ -136,7 +136,7 @@ void HapticNode::log_tick(Endpoint& endpoint, std::uint64_t tick, double now_s, 
 }
 
 bool HapticNode::lockstep_tick(std::uint64_t t) {
-  if (t >= max_ticks() || g_stop_requested.load() || !device_.wait_attached()) return false;
+  if (t >= max_ticks() || stop_requested() || !device_.wait_attached()) return false;
   // Exactly t·T: interpolation weights are then tick counts over n, the same in every run.
   const double now_s = static_cast<double>(t) * period_s_;
   tick(t, now_s, period_s_, 0);
@@ -188,7 +188,7 @@ void HapticNode::run_lockstep() {
 
 bool HapticNode::follow_tick(std::uint64_t t) {
   if (t > 0) receive_frames(static_cast<double>(t - 1) * period_s_);
-  if (g_stop_requested.load() || !device_.wait_attached()) return false;
+  if (stop_requested() || !device_.wait_attached()) return false;
   tick(t, static_cast<double>(t) * period_s_, period_s_, 0);
   if (t % kStatsEveryTicks == 0) publish_stats(nullptr);
   return true;
@@ -202,7 +202,7 @@ void HapticNode::run_follower() {
     std::uint64_t t = 0;
     const TurnResult result = world_.wait_follower_turn(t);
     if (result != TurnResult::ok) {
-      master_lost = result != TurnResult::shutdown && !g_stop_requested.load();
+      master_lost = result != TurnResult::shutdown && !stop_requested();
       if (master_lost) {
         std::fprintf(stderr, "haptic_controller: error: the lockstep master went away mid-trial: %s\n",
                      to_string(result));
@@ -233,7 +233,7 @@ void HapticNode::run_realtime() {
   });
   RealtimeClock clock(period_s_);
   const std::uint64_t ticks = max_ticks();
-  while (!g_stop_requested.load() && clock.ticks() < ticks) {
+  while (!stop_requested() && clock.ticks() < ticks) {
     const TickTiming timing = clock.wait_next();
     receive_frames(timing.now_s);
     tick(timing.index, timing.now_s, timing.elapsed_s, timing.lateness_ns);

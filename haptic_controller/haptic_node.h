@@ -14,6 +14,7 @@
 #include "common/runtime/lockstep_schedule.h"
 #include "common/runtime/log_paths.h"
 #include "common/runtime/loop_stats.h"
+#include "common/runtime/process.h"
 #include "common/runtime/rt_log.h"
 #include "haptic_controller/device/haptic_device.h"
 #include "haptic_controller/servo.h"
@@ -21,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <limits>
@@ -41,6 +43,9 @@ struct HapticNodeOptions {
   std::uint64_t haptic_session = 1;  // nonzero; the nodes' mains pass new_session_id() (common/runtime/process.h)
   // Lockstep master: other controllers (users) to wait for before the first tick; they then follow its ticks.
   std::uint32_t followers = 0;
+  // Besides the process's stop request (g_stop_requested): a flag its owner sets to end the trial between two ticks
+  // (an in-process trial interrupted from Python). Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // One row of the haptic log (the ring holds these; formatted by the drain thread).
@@ -84,6 +89,9 @@ class HapticNode final : public FollowerStepper {
   std::uint32_t endpoint_count() const { return static_cast<std::uint32_t>(endpoints_.size()); }
 
  private:
+  bool stop_requested() const {
+    return g_stop_requested.load() || (options_.stop != nullptr && options_.stop->load());
+  }
   // One finger's servo and what the node records about it.
   struct Endpoint {
     Endpoint(const ServoOptions& options, std::uint64_t session, EndpointId id) : servo(options, session, id) {}

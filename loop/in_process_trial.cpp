@@ -139,6 +139,7 @@ nlohmann::json run_in_process_trial(const InProcessTrialOptions& options) {
     haptic_options.damping_Nspm = options.damping_Nspm;
     haptic_options.duration_s = options.duration_s;
     haptic_options.haptic_session = 1 + u;
+    haptic_options.stop = options.stop;
     haptic_options.followers = u == 0 ? static_cast<std::uint32_t>(options.followers.size()) : 0;
     std::vector<NamedFinger> fingers = u > 0 ? parse_fingers(options.followers[u - 1], kMaxFingers)
                                               : load_fingers(options.trajectory, options.fingers);

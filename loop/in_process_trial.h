@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -49,6 +50,9 @@ struct InProcessTrialOptions {
   double link_delay_s = 0.0;
   // world.csv, haptic.csv and device.csv are written here when it is not empty; nothing is written otherwise.
   std::filesystem::path out_dir;
+  // Set by another thread to end the trial between two ticks (Ctrl-C in Python); the summary then covers what ran.
+  // Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // Runs the trial to the end of its trajectory; returns the world, haptic and device halves of summary.json merged,

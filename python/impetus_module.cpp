@@ -10,12 +10,18 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <condition_variable>
 #include <cstdlib>
+#include <exception>
 #include <fstream>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace py = pybind11;
@@ -50,12 +56,46 @@ std::string run_trial(const std::string& scene, const std::string& trajectory, c
   options.link_delay_s = link_delay_s;
   options.duration_s = duration_s;
   options.out_dir = out_dir;
+  // The trial runs on a thread of its own and touches no Python object, so other Python threads run meanwhile. This
+  // thread waits for it with the GIL released and, every kSignalCheck, takes the GIL to let Python run its signal
+  // handlers: Ctrl-C in the main thread ends the trial between two ticks and raises KeyboardInterrupt here, however
+  // long the trial would have run.
+  constexpr auto kSignalCheck = std::chrono::milliseconds(50);
+  std::atomic<bool> stop{false};
+  options.stop = &stop;
   std::string text;
-  {
-    // The trial touches no Python object; other Python threads run meanwhile.
-    py::gil_scoped_release release;
-    text = impetus::run_in_process_trial(options).dump();
+  std::exception_ptr failure;
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false;
+  std::thread trial([&] {
+    try {
+      text = impetus::run_in_process_trial(options).dump();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    const std::lock_guard<std::mutex> lock(mutex);
+    done = true;
+    finished.notify_one();
+  });
+  bool interrupted = false;
+  for (;;) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(mutex);
+      if (finished.wait_for(lock, kSignalCheck, [&] { return done; })) break;
+    }
+    if (!interrupted && PyErr_CheckSignals() != 0) {
+      interrupted = true;  // the handler's exception is set; it is raised once the trial has stopped
+      stop.store(true);
+    }
   }
+  {
+    py::gil_scoped_release release;
+    trial.join();
+  }
+  if (interrupted) throw py::error_already_set();
+  if (failure) std::rethrow_exception(failure);
   return text;
 }
 
@@ -101,6 +141,12 @@ py::tuple read_log(const std::string& path) {
 
 PYBIND11_MODULE(_impetus, module) {
   module.doc() = "Impetus' compiled core; use the impetus package, not this module.";
+  // numpy's C API is looked up once, here, while Python imports this module on one thread. Looked up later, on first
+  // use (pybind11 does it under a function-local static while holding the GIL), threads calling read_log at once
+  // deadlock: one holds the static's guard and waits for the GIL in numpy's import, another holds the GIL and waits
+  // for the guard.
+  py::module_::import("numpy");
+  (void)py::dtype::of<double>();
   module.def("run_trial", &run_trial, py::arg("scene"), py::arg("trajectory"), py::arg("fingers"), py::arg("followers"),
              py::arg("coupling"),
              py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("stiffness_Npm"),

@@ -19,6 +19,10 @@ int main(int argc, char** argv) {
   app.add_option("--listen", options.listen, "HOST:PORT to serve the page on (port 0: any free port)")
       ->capture_default_str();
   app.add_flag("--allow-remote", options.allow_remote, "allow a --listen address other than loopback");
+  app.add_option("--allow-host", options.allow_hosts,
+                 "with --allow-remote: a DNS name the page may be opened by, besides IP addresses and this machine's "
+                 "name (any other Host is refused: DNS rebinding)")
+      ->needs("--allow-remote");
   app.add_option("--web", web_dir, "folder with the page (default: the installed or source viewer/web)")
       ->check(CLI::ExistingDirectory);
   app.add_option("--duration", options.duration_s, "seconds to serve (default: until stopped)")

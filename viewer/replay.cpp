@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "viewer/replay.h"
 
+#include "common/runtime/message_text.h"
+
 #include "world_manager/scene.h"
 #include "world_manager/world_view.h"
 
@@ -23,6 +25,7 @@ namespace fs = std::filesystem;
 struct CsvTable {
   std::vector<std::string> columns;
   std::vector<std::vector<double>> rows;
+  std::vector<std::size_t> line_numbers;  // per row: its line in the file (empty lines are skipped)
 
   int column(const std::string& name) const {
     const auto found = std::find(columns.begin(), columns.end(), name);
@@ -81,12 +84,27 @@ CsvTable read_csv(const fs::path& path) {
       const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), row[c]);
       if (error != std::errc() || end != text.data() + text.size()) {
         throw ReplayError(path.string() + ":" + std::to_string(number) + ": column " + std::to_string(c + 1) + " ('" +
-                          table.columns[c] + "') is not a number: '" + text + "'");
+                          excerpt(table.columns[c], 40) + "') is not a number: '" + excerpt(text, 40) + "'");
       }
     }
     table.rows.push_back(std::move(row));
+    table.line_numbers.push_back(number);
   }
   return table;
+}
+
+// A log's clock must be finite and never run backwards: a replay seeks in it by time.
+void check_times(const CsvTable& table, int column, const fs::path& path) {
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const double time_s = table.rows[r][static_cast<std::size_t>(column)];
+    const std::string where = path.string() + ":" + std::to_string(table.line_numbers[r]) + ": " +
+                              table.columns[static_cast<std::size_t>(column)];
+    if (!std::isfinite(time_s)) throw ReplayError(where + " is not a finite time");
+    if (r > 0 && time_s < table.rows[r - 1][static_cast<std::size_t>(column)]) {
+      throw ReplayError(where + " " + std::to_string(time_s) + " is before the row above's (a log's time never " +
+                        "runs backwards)");
+    }
+  }
 }
 
 nlohmann::json read_json(const fs::path& path) {
@@ -150,6 +168,7 @@ Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<View
   if (world.rows.empty()) throw ReplayError(world_path.string() + ": no steps were logged");
   const int time_column = world.column("time_s");
   if (time_column < 0) throw ReplayError(world_path.string() + ": no time_s column");
+  check_times(world, time_column, world_path);
   const std::size_t bodies = scene_->body_count;
   std::vector<std::array<int, 7>> columns(bodies);
   static const char* const kSuffix[7] = {".x_m", ".y_m", ".z_m", ".qw", ".qx", ".qy", ".qz"};
@@ -194,6 +213,7 @@ Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<View
       if (hc[v] < 0) throw ReplayError(haptic_path.string() + ": no column '" + kHapticColumns[v] + "'");
     }
     if (haptic.rows.empty()) break;
+    check_times(haptic, hc[0], haptic_path);
     std::vector<ViewEndpoint>& track = endpoints_.emplace_back(times_s_.size());
     std::size_t next = 0;
     for (std::size_t f = 0; f < times_s_.size(); ++f) {

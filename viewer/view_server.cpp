@@ -11,6 +11,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
+
+#include <cctype>
 #include <chrono>
 #include <optional>
 
@@ -155,8 +158,9 @@ namespace {
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
   HttpSession(tcp::socket socket, const WebRoot& web, ViewFeed& feed, ConnectionToken token,
-              std::vector<std::weak_ptr<WsSession>>& pages)
-      : stream_(std::move(socket)), web_(web), feed_(feed), token_(std::move(token)), pages_(pages) {}
+              std::vector<std::weak_ptr<WsSession>>& pages, const HostRule& host_rule)
+      : stream_(std::move(socket)), web_(web), feed_(feed), token_(std::move(token)), pages_(pages),
+        host_rule_(host_rule) {}
 
   void read() {
     parser_.emplace();
@@ -181,6 +185,18 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     ++token_.counters().http_requests;
     http::request<http::string_body> request = parser_->release();
     const std::string target(request.target());
+    // Another site's page (DNS rebinding, or a cross-site WebSocket) is refused before anything is served.
+    const auto header = [&](http::field field) {
+      const beast::string_view value = request[field];
+      return std::string_view(value.data(), value.size());
+    };
+    const std::string_view host = header(http::field::host);
+    std::string problem = host_problem(host, host_rule_);
+    if (problem.empty()) problem = origin_problem(header(http::field::origin), host);
+    if (!problem.empty()) {
+      ++token_.counters().foreign_requests;
+      return answer(http::status::forbidden, problem + "\n", false);
+    }
     if (websocket::is_upgrade(request)) {
       if (target != "/ws") return answer(http::status::not_found, "no WebSocket at " + target + " (use /ws)\n", false);
       stream_.expires_never();  // the WebSocket keeps its own timeouts
@@ -243,18 +259,29 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   ViewFeed& feed_;
   ConnectionToken token_;
   std::vector<std::weak_ptr<WsSession>>& pages_;
+  HostRule host_rule_;  // a copy: a session may outlive the server
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
 };
 
 }  // namespace
 
-ViewServer::ViewServer(asio::io_context& io, const tcp::endpoint& endpoint, const WebRoot& web, ViewFeed& feed)
+ViewServer::ViewServer(asio::io_context& io, const tcp::endpoint& endpoint, const WebRoot& web, ViewFeed& feed,
+                       std::vector<std::string> host_names)
     : io_(io), acceptor_(io), timer_(io), web_(web), feed_(feed), counters_(std::make_shared<ServerCounters>()) {
   acceptor_.open(endpoint.protocol());
   acceptor_.set_option(asio::socket_base::reuse_address(true));
   acceptor_.bind(endpoint);
   acceptor_.listen(asio::socket_base::max_listen_connections);
+  host_rule_.port = acceptor_.local_endpoint().port();
+  host_rule_.loopback_only = endpoint.address().is_loopback();
+  host_rule_.names = std::move(host_names);
+  char machine[256] = {};
+  if (gethostname(machine, sizeof machine - 1) == 0 && machine[0] != '\0') {
+    std::string name(machine);
+    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    host_rule_.names.push_back(name);
+  }
 }
 
 ViewServer::~ViewServer() = default;
@@ -285,7 +312,8 @@ void ViewServer::accept() {
         beast::error_code ignored;
         socket.close(ignored);
       } else {
-        std::make_shared<HttpSession>(std::move(socket), web_, feed_, ConnectionToken(counters_), pages_)->read();
+        std::make_shared<HttpSession>(std::move(socket), web_, feed_, ConnectionToken(counters_), pages_, host_rule_)
+            ->read();
       }
     }
     accept();  // also after an error (e.g. out of descriptors): the next connection may succeed

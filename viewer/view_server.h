@@ -8,6 +8,7 @@
 // kMaxConnections connections new ones are closed at once. None of this can reach the world: the feed reads it
 // through a read-only mapping.
 
+#include "viewer/request_check.h"
 #include "viewer/view_feed.h"
 #include "viewer/web_root.h"
 
@@ -26,6 +27,7 @@ class WsSession;
 struct ServerCounters {
   std::uint64_t http_requests = 0;
   std::uint64_t http_errors = 0;       // 4xx answers
+  std::uint64_t foreign_requests = 0;  // refused for their Host or Origin (another site's page)
   std::uint64_t pages = 0;             // WebSocket connections accepted
   std::uint64_t refused = 0;           // connections closed at once: too many open
   std::uint64_t frames_sent = 0;
@@ -39,8 +41,11 @@ class ViewServer {
   static constexpr std::size_t kMaxConnections = 64;
 
   // Binds and listens on `endpoint` (port 0: any free port); throws boost::system::system_error if it cannot.
+  // Requests are answered only with a Host header naming this server and, if they carry one, the Origin of its own
+  // page (request_check.h); `host_names` are DNS names accepted beside the loopback names, the IP literals of a
+  // non-loopback listen address and this machine's host name (lower case).
   ViewServer(boost::asio::io_context& io, const boost::asio::ip::tcp::endpoint& endpoint, const WebRoot& web,
-             ViewFeed& feed);
+             ViewFeed& feed, std::vector<std::string> host_names = {});
   ~ViewServer();
 
   boost::asio::ip::tcp::endpoint local_endpoint() const { return acceptor_.local_endpoint(); }
@@ -60,6 +65,7 @@ class ViewServer {
   boost::asio::steady_timer timer_;
   const WebRoot& web_;
   ViewFeed& feed_;
+  HostRule host_rule_;
   // Shared with the sessions: a session may outlive the server by the handlers io_context still holds.
   std::shared_ptr<ServerCounters> counters_;
   std::vector<std::weak_ptr<WsSession>> pages_;

@@ -17,11 +17,23 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <cctype>
 #include <stdexcept>
 
 namespace impetus::view {
 
 namespace asio = boost::asio;
+
+namespace {
+
+std::vector<std::string> lower_case(std::vector<std::string> names) {
+  for (std::string& name : names) {
+    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  return names;
+}
+
+}  // namespace
 
 ListenAddress parse_listen(const std::string& text, bool allow_remote) {
   const std::size_t colon = text.rfind(':');
@@ -83,7 +95,7 @@ int ViewerNode::run() {
   try {
     server_owner = std::make_unique<ViewServer>(io, asio::ip::tcp::endpoint{asio::ip::make_address(address.host),
                                                                             address.port},
-                                                web, *feed);
+                                                web, *feed, lower_case(options_.allow_hosts));
   } catch (const boost::system::system_error& error) {
     throw std::runtime_error("--listen " + options_.listen + ": cannot serve there: " + error.code().message() +
                              (error.code() == boost::asio::error::address_in_use
@@ -124,11 +136,11 @@ int ViewerNode::run() {
   const ServerCounters& c = server.counters();
   std::fprintf(stderr,
                "viewer: %llu pages, %llu frames sent (%llu dropped for slow pages), %.1f MB, %llu requests, %llu "
-               "answered with an error, %llu connections refused",
+               "answered with an error (%llu of them another site's), %llu connections refused",
                static_cast<unsigned long long>(c.pages), static_cast<unsigned long long>(c.frames_sent),
                static_cast<unsigned long long>(c.frames_dropped), static_cast<double>(c.bytes_sent) * 1e-6,
                static_cast<unsigned long long>(c.http_requests), static_cast<unsigned long long>(c.http_errors),
-               static_cast<unsigned long long>(c.refused));
+               static_cast<unsigned long long>(c.foreign_requests), static_cast<unsigned long long>(c.refused));
   if (live != nullptr) {
     std::fprintf(stderr, ", %llu snapshots read, %llu rejected", static_cast<unsigned long long>(live->snapshots_read()),
                  static_cast<unsigned long long>(live->rejected()));

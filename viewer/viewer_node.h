@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace impetus::view {
 
@@ -18,6 +19,7 @@ struct ViewerOptions {
   std::string replay_dir;        // replay: a trial folder (run.sh --out); takes precedence over shm
   std::string listen = "127.0.0.1:8080";
   bool allow_remote = false;     // serve on an address other than loopback
+  std::vector<std::string> allow_hosts;  // with allow_remote: DNS names the page may be reached by (Host header)
   std::filesystem::path web_dir; // the page's files; empty: WebRoot::find_default
   double duration_s = 0.0;       // 0: until stopped
 };

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "common/runtime/cli.h"
 
+#include "common/link/shm/names.h"
 #include "common/runtime/message_text.h"
 
 #include <unistd.h>
@@ -95,7 +96,8 @@ void add_clock_flag(CLI::App& app, ClockMode& clock) {
 }
 
 void add_shm_flag(CLI::App& app, std::string& shm) {
-  app.add_option("--shm", shm, "shared-memory name of the link (default impetus)");
+  app.add_option("--shm", shm, "shared-memory name of the link (default impetus)")
+      ->check([](const std::string& name) { return shm_name_problem(name); });
 }
 
 void add_link_flags(CLI::App& app, LinkOptions& link) {

@@ -11,8 +11,10 @@ A trial is the world, haptic and device nodes of the three daemons, run in this 
 bitwise the same outcome as `scripts/run.sh --clock lockstep` with the same arguments, and no process is started.
 The call releases the GIL while the trial runs. Trials in one process take turns (the physics engine's state is
 process-wide), so calls from several threads are safe but not parallel: a process pool runs several at once.
+Ctrl-C (SIGINT in the main thread) ends a running trial between two ticks and raises KeyboardInterrupt.
 """
 import json
+import numbers
 import pathlib
 import tempfile
 import time
@@ -98,6 +100,23 @@ def read_log(path):
     return {name: table[:, i] for i, name in enumerate(header)}
 
 
+def _real(name, value, optional=False):
+    """`value` as a finite float, or None if it is None and `optional`; ValueError naming `name` otherwise (the C++
+    side then checks its range). NaN is refused: it would otherwise read as "not given"."""
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name}: must be a number{' or None' if optional else ''}, not {value!r}")
+    try:
+        number = float(value)
+    except OverflowError:
+        number = float("inf")
+    if number != number or number in (float("inf"), float("-inf")):
+        shown = value if isinstance(value, float) or abs(value) < 10**20 else f"an integer of {len(str(value))} digits"
+        raise ValueError(f"{name}: must be a finite number, not {shown}")
+    return number
+
+
 def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, phase_ticks=0, substeps=None,
               stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, duration_s=60.0, out_dir=None, logs=True):
     """Runs one trial and returns its Trial.
@@ -134,8 +153,21 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
         raise ValueError(f"coupling: must be one of {', '.join(COUPLINGS)}, not {coupling!r}")
     if isinstance(users, (str, dict)) or not all(isinstance(user, (str, dict, pathlib.Path)) for user in users):
         raise ValueError(f"users: must be a list of trajectories or {{name: trajectory}} dicts, not {users!r}")
-    if isinstance(phase_ticks, bool) or not isinstance(phase_ticks, int) or phase_ticks < 0:
+    if isinstance(phase_ticks, bool) or not isinstance(phase_ticks, numbers.Integral) or not 0 <= phase_ticks < 2**64:
         raise ValueError(f"phase_ticks: must be a whole number of ticks, 0 or more, not {phase_ticks!r}")
+    phase_ticks = int(phase_ticks)
+    if substeps is not None:
+        if isinstance(substeps, bool) or not isinstance(substeps, numbers.Integral) or substeps < 1:
+            raise ValueError(f"substeps: must be a whole number, 1 or more, or None, not {substeps!r}")
+        if substeps >= 2**31:
+            raise ValueError(f"substeps: {substeps} is beyond the world's range (world_manager --help states it)")
+        substeps = int(substeps)
+        substeps = int(substeps)
+    rate_hz = _real("rate_hz", rate_hz, optional=True)
+    stiffness_Npm = _real("stiffness_Npm", stiffness_Npm, optional=True)
+    damping_Nspm = _real("damping_Nspm", damping_Nspm, optional=True)
+    link_delay_s = _real("link_delay_s", link_delay_s)
+    duration_s = _real("duration_s", duration_s)
     scene = pathlib.Path(scene)
     if not scene.is_file():
         raise FileNotFoundError(f"scene: no such file '{scene}'")

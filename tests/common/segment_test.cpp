@@ -210,6 +210,15 @@ TEST_CASE("creators racing for one name: exactly one wins, every time") {
   }
 }
 
+TEST_CASE("a segment file shorter than its header says is reported with the file's own size") {
+  const std::string name = test::unique_segment_name("short");
+  auto segment = Segment<SmallLayout>::create(name);
+  REQUIRE(truncate(shm_path(name).c_str(), sizeof(SegmentHeader)) == 0);
+  CHECK_THROWS_WITH(Segment<SmallLayout>::open(name),
+                    Catch::Contains("the file is " + std::to_string(sizeof(SegmentHeader)) + " bytes") &&
+                        Catch::Contains("shorter than the " + std::to_string(sizeof(SmallLayout))));
+}
+
 TEST_CASE("a segment's name never names a file its creator has not locked yet") {
   // The window two creators once both won through: a name that exists before its creator holds the lock lets a second
   // creator lock the file, call it stale and take the name. A watcher that keeps opening the name and trying the lock

@@ -86,6 +86,10 @@ TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment 
       {world + "--scene scenes/tap.json --substeps 99999999999999999999", "whole number from 1 to 10000"},
       // The world link's transport: DDS is real time only, and a controller names where it looked.
       {world + "--scene scenes/tap.json --link carrier-pigeon", "carrier-pigeon"},
+      // Segment names: never hidden files, never a path.
+      {test::binary("world_manager") + " --scene scenes/tap.json --shm ''", "--shm: must not be empty"},
+      {test::binary("world_manager") + " --scene scenes/tap.json --shm .hidden", "must not start with '.'"},
+      {test::binary("haptic_controller") + " --shm a/b", "may hold only letters"},
       {world + "--scene scenes/tap.json --link dds --clock lockstep", "real time only"},
       {world + "--scene scenes/tap.json --link dds --dds-domain 233", "from 0 to 232, not 233"},
       {world + "--scene scenes/tap.json --link dds --dds-partition ''", "must not be empty"},

@@ -146,7 +146,12 @@ class Arguments(unittest.TestCase):
             impetus.run_trial(impetus.shipped_scene("tap"), "tap", users="tap")
 
     def test_out_of_range_values_name_the_argument(self):
-        cases = [(dict(rate_hz=1e300), "world_rate_hz"), (dict(rate_hz=math.nan), "world_rate_hz"),
+        cases = [(dict(rate_hz=1e300), "rate_hz"), (dict(rate_hz=math.nan), "rate_hz"),
+                 # Too large for any C type, or not finite: named by Python, never a TypeError listing signatures.
+                 (dict(phase_ticks=2**70), "phase_ticks"), (dict(substeps=2**40), "substeps"),
+                 (dict(stiffness_Npm=10**400), "stiffness_Npm"), (dict(stiffness_Npm=math.nan), "stiffness_Npm"),
+                 (dict(damping_Nspm=-math.inf), "damping_Nspm"), (dict(duration_s="5"), "duration_s"),
+                 (dict(rate_hz=True), "rate_hz"),
                  (dict(substeps=0), "substeps"), (dict(stiffness_Npm=-5.0), "stiffness_Npm"),
                  (dict(damping_Nspm=1e9), "damping_Nspm"), (dict(duration_s=math.inf), "duration_s"),
                  (dict(phase_ticks=50), "phase"), (dict(phase_ticks=-1), "phase_ticks"),
@@ -196,6 +201,53 @@ class Arguments(unittest.TestCase):
         self.assertEqual(len(outcomes), 12)
         for outcome in outcomes:
             self.assertEqual(outcome, reference)
+
+    def test_numpy_numbers_are_numbers(self):
+        trial = impetus.run_trial(self.scene(), "tap", logs=False, rate_hz=np.float64(25.0), substeps=np.int64(4),
+                                  phase_ticks=np.uint8(3), duration_s=np.float32(0.5))
+        self.assertEqual(trial.summary["config"]["world_rate_hz"], 25.0)
+        self.assertEqual(trial.summary["config"]["substeps"], 4)
+
+    def test_threads_in_a_fresh_interpreter_do_not_deadlock(self):
+        # Four threads whose first trial reads its logs into numpy arrays at once, in an interpreter that had not
+        # imported numpy before: numpy's C API used to be looked up on first use under a lock, while holding the GIL.
+        code = ("import sys, threading, impetus\n"
+                "errors = []\n"
+                "def run():\n"
+                "    try:\n"
+                "        impetus.run_trial(impetus.shipped_scene('tap'), 'tap', duration_s=0.5)\n"
+                "    except Exception as error:\n"
+                "        errors.append(error)\n"
+                "threads = [threading.Thread(target=run) for _ in range(4)]\n"
+                "[t.start() for t in threads]\n"
+                "[t.join() for t in threads]\n"
+                "print('errors', errors)\n")
+        result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                                env=dict(os.environ))
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("errors []", result.stdout)
+
+    def test_ctrl_c_ends_a_long_trial(self):
+        # A trial of 10^4 s of pressing (minutes of work) and SIGINT a second after it starts: the trial stops between
+        # two ticks and KeyboardInterrupt reaches the caller, long before the trial would have ended.
+        code = ("import time, impetus\n"
+                "start = time.monotonic()\n"
+                "try:\n"
+                "    impetus.run_trial(impetus.shipped_scene('tap'), 'press:hold=10000', duration_s=10000, logs=False)\n"
+                "    print('ran to the end')\n"
+                "except KeyboardInterrupt:\n"
+                "    print(f'interrupted after {time.monotonic() - start:.2f} s')\n")
+        child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                 text=True, env=dict(os.environ))
+        threading.Event().wait(3.0)  # the import and the trial's start
+        child.send_signal(2)  # SIGINT, as Ctrl-C in a terminal
+        try:
+            out, err = child.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            self.fail("the trial went on after Ctrl-C")
+        print(f"  {out.strip()}")
+        self.assertIn("interrupted after", out, err)
 
     def test_read_log_refuses_a_damaged_file(self):
         damaged = OUT / "damaged.csv"

@@ -275,6 +275,44 @@ async function badInput(procs, browser) {
   check(await status("/", { method: "POST", body: "x".repeat(100000) }) === 413, "a 100 kB request body is 413");
   check(await status("/", { method: "DELETE" }) === 405, "DELETE is 405");
 
+  // Another site's page: by DNS rebinding (its own name in Host) or by opening a WebSocket to the viewer (its own
+  // Origin). Both are refused before anything is served.
+  const port = Number(new URL(viewer.url).port);
+  const statusLine = (request) => new Promise((resolve) => {
+    const socket = net.connect(port, "127.0.0.1");
+    let data = "";
+    const done = () => { socket.destroy(); resolve(data.split("\r\n")[0]); };
+    socket.on("data", (chunk) => { data += chunk; });
+    socket.on("end", done);
+    socket.on("error", done);
+    setTimeout(done, 5000);
+    socket.write(request);
+  });
+  const upgrade = "Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n" +
+    "Sec-WebSocket-Version: 13\r\n";
+  const rebound = await statusLine(`GET / HTTP/1.1\r\nHost: evil.example:${port}\r\n\r\n`);
+  check(rebound.includes(" 403 "), `a request naming another host (DNS rebinding) is refused (${rebound})`);
+  const reboundWs = await statusLine(`GET /ws HTTP/1.1\r\nHost: evil.example:${port}\r\n${upgrade}\r\n`);
+  check(reboundWs.includes(" 403 "), `so is its WebSocket (${reboundWs})`);
+  const crossSite = await statusLine(`GET /ws HTTP/1.1\r\nHost: 127.0.0.1:${port}\r\n${upgrade}` +
+    "Origin: http://evil.example\r\n\r\n");
+  check(crossSite.includes(" 403 "), `a WebSocket with another site's Origin is refused (${crossSite})`);
+  const own = await statusLine(`GET /ws HTTP/1.1\r\nHost: 127.0.0.1:${port}\r\n${upgrade}` +
+    `Origin: http://127.0.0.1:${port}\r\n\r\n`);
+  check(own.includes(" 101 "), `one with the viewer's own Origin is accepted (${own})`);
+  const evil = await browser.newPage();
+  await evil.route("http://evil.example/", (route) => route.fulfill({ contentType: "text/html", body: "<p>elsewhere</p>" }));
+  await evil.goto("http://evil.example/");
+  const fromEvil = await evil.evaluate((url) => new Promise((resolve) => {
+    const socket = new WebSocket(url);
+    socket.onmessage = () => resolve("read the world");
+    socket.onerror = () => resolve("refused");
+    socket.onclose = () => resolve("refused");
+    setTimeout(() => resolve("no answer"), 5000);
+  }), `ws://127.0.0.1:${port}/ws`);
+  check(fromEvil === "refused", `a page of another site opening the viewer's WebSocket in the browser is refused (${fromEvil})`);
+  await evil.close();
+
   const page = await openPage(browser, viewer.url);
   await waitFor("frames on the page", async () => (await view(page))?.framesReceived > 0);
   const closed = await page.evaluate(() => new Promise((resolve) => {

@@ -5,6 +5,7 @@
 #include "common/link/dds/dds_world_view.h"
 #include "common/link/shm/shm_world_view.h"
 #include "viewer/replay.h"
+#include "viewer/request_check.h"
 #include "viewer/view_feed.h"
 #include "viewer/view_encoding.h"
 #include "viewer/view_protocol.h"
@@ -260,6 +261,30 @@ TEST_CASE("a replay reads a trial's scene and logs (every finger's), a malformed
   std::ofstream(dir / "world.csv") << header << "0.05,0.03,0,0.025,1,0,0,0\n0.1,0.04,oops,0.025,1,0,0,0\n";
   CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("world.csv:3") && Catch::Contains("column 3") &&
                                                     Catch::Contains("cube.y_m"));
+  // A huge token is quoted short; a time that is not finite or runs backwards is named with its line.
+  std::ofstream(dir / "world.csv") << header << "0.05,0.03,0,0.025,1,0,0,0\n0.1," << std::string(20'000'000, '7')
+                                   << "x,0,0.025,1,0,0,0\n";
+  try {
+    view::Replay{dir.string()};
+    FAIL("a 20 MB token was accepted");
+  } catch (const view::ReplayError& error) {
+    CHECK(std::string(error.what()).size() < 400);
+    CHECK_THAT(error.what(), Catch::Contains("world.csv:3") && Catch::Contains("20000001 characters"));
+  }
+  for (const char* times : {"0.05,nan", "0.1,0.05", "0.05,inf"}) {
+    INFO(times);
+    const std::string first(times, std::strchr(times, ','));
+    const std::string second(std::strchr(times, ',') + 1);
+    std::ofstream(dir / "world.csv") << header << first << ",0.03,0,0.025,1,0,0,0\n" << second
+                                     << ",0.04,0,0.025,1,0,0,0\n";
+    CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("world.csv:3: time_s"));
+  }
+  std::ofstream(dir / "world.csv") << header << "0.05,0.03,0,0.025,1,0,0,0\n0.1,0.04,0,0.025,1,0,0,0\n";
+  std::ofstream(dir / "haptic.csv")
+      << "time_s,finger_x,finger_y,finger_z,proxy_x,proxy_y,proxy_z,force_x,force_y,force_z\n"
+      << "0.09,-0.01,0,0.025,-0.01,0,0.025,0,0,0\n0.0,0.01,0,0.025,0.005,0,0.025,10,0,0\n";
+  CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("haptic.csv:3: time_s") &&
+                                                    Catch::Contains("runs backwards"));
   std::ofstream(dir / "world.csv") << "time_s,other.x_m\n0.05,1\n";
   CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("no column 'cube.x_m'"));
   std::ofstream(dir / "summary.json") << R"({"config": {"scene": "no/such/scene.json"}})";
@@ -312,3 +337,44 @@ TEST_CASE("a replay page plays, pauses, seeks and changes speed on its own clock
 }
 
 }  // namespace impetus
+
+TEST_CASE("the viewer answers only requests naming it as Host, and WebSockets only from its own page") {
+  using impetus::view::HostRule;
+  using impetus::view::host_problem;
+  using impetus::view::origin_problem;
+  HostRule loopback;
+  loopback.port = 8080;
+  for (const char* host : {"127.0.0.1:8080", "localhost:8080", "LOCALHOST:8080", "[::1]:8080", "127.0.0.2:8080"}) {
+    INFO(host);
+    CHECK(host_problem(host, loopback).empty());
+  }
+  // DNS rebinding: another site's name pointed at 127.0.0.1.
+  CHECK_THAT(host_problem("evil.example:8080", loopback), Catch::Contains("not a loopback name"));
+  CHECK_THAT(host_problem("127.0.0.1:9090", loopback), Catch::Contains("port 9090"));
+  CHECK_THAT(host_problem("127.0.0.1", loopback), Catch::Contains("port 80"));  // no port: 80
+  CHECK_THAT(host_problem("", loopback), Catch::Contains("no Host"));
+  for (const char* malformed : {"127.0.0.1:", "127.0.0.1:80x", "[::1", "[::1]x", ":8080", "127.0.0.1:99999"}) {
+    INFO(malformed);
+    CHECK_THAT(host_problem(malformed, loopback), Catch::Contains("is not HOST[:PORT]"));
+  }
+  CHECK(host_problem(std::string(10000, 'a'), loopback).size() < 300);  // the client's text is quoted short
+
+  HostRule remote;
+  remote.port = 8080;
+  remote.loopback_only = false;
+  remote.names = {"lab-pc"};
+  for (const char* host : {"192.168.1.20:8080", "[fe80::1]:8080", "lab-pc:8080", "localhost:8080"}) {
+    INFO(host);
+    CHECK(host_problem(host, remote).empty());
+  }
+  CHECK_THAT(host_problem("evil.example:8080", remote), Catch::Contains("--allow-host"));
+
+  // Origin: none (not a browser), or the page's own.
+  CHECK(origin_problem("", "127.0.0.1:8080").empty());
+  CHECK(origin_problem("http://127.0.0.1:8080", "127.0.0.1:8080").empty());
+  CHECK(origin_problem("http://LocalHost:8080", "localhost:8080").empty());
+  CHECK_THAT(origin_problem("http://evil.example", "127.0.0.1:8080"), Catch::Contains("not this viewer's page"));
+  CHECK_FALSE(origin_problem("null", "127.0.0.1:8080").empty());
+  CHECK_FALSE(origin_problem("http://127.0.0.1:8081", "127.0.0.1:8080").empty());
+  CHECK_FALSE(origin_problem("https://127.0.0.1:8080", "127.0.0.1:8080").empty());
+}

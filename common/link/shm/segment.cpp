@@ -154,9 +154,13 @@ OpenProblem check_header(SegmentMapping::Impl& impl, SegmentKind kind, std::size
     return {SegmentProblem::incompatible, std::string("it is a ") + to_string(header.kind) + ", not a " +
                                               to_string(kind)};
   }
-  if (header.layout_size_bytes != size_bytes || static_cast<std::size_t>(actual_size) < size_bytes) {
+  if (header.layout_size_bytes != size_bytes) {
     return {SegmentProblem::incompatible, "its layout is " + std::to_string(header.layout_size_bytes) +
                                               " bytes but this program expects " + std::to_string(size_bytes)};
+  }
+  if (static_cast<std::size_t>(actual_size) < size_bytes) {
+    return {SegmentProblem::incompatible, "the file is " + std::to_string(actual_size) + " bytes, shorter than the " +
+                                              std::to_string(size_bytes) + " its header says (cut short?)"};
   }
   return {};
 }
