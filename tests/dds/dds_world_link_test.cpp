@@ -152,7 +152,7 @@ TEST_CASE("a frame and a report keep every bit through the DDS types, and a coun
   received = {};
   encode(box_frame(5), sent);
   DdsFrameSample frame_sample;
-  to_dds(sent, 42, 3, *frame_sample);
+  to_dds(sent, 42, 3, 7, *frame_sample);
   CHECK((*frame_sample).client_id == 42);
   CHECK((*frame_sample).client_endpoint == 3);
   REQUIRE(from_dds(*frame_sample, received));
@@ -173,7 +173,7 @@ TEST_CASE("a frame and a report keep every bit through the DDS types, and a coun
   received_report = {};
   encode(report_of(9, 1, 1234), sent_report);
   DdsReportSample report_sample;
-  to_dds(sent_report, 42, 1, *report_sample);
+  to_dds(sent_report, 42, 1, 7, *report_sample);
   REQUIRE(from_dds(*report_sample, received_report));
   CHECK(std::memcmp(&sent_report, &received_report, used_bytes(sent_report)) == 0);
   (*report_sample).entries._length = 2;

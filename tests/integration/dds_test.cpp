@@ -124,6 +124,37 @@ TEST_CASE("over DDS the world applies exactly the impulse the controller rendere
   }
 }
 
+TEST_CASE("over DDS a controller serves one world: a second live world on its partition is reported, not adopted") {
+  const DdsDaemons daemons = make_daemons("twoworlds");
+  const pid_t first = daemons.world("1");
+  const pid_t haptic = daemons.haptic("u", "");
+  sleep_s(1.0);  // the controller follows the first world
+  const pid_t second = daemons.world("2");
+  const pid_t device = daemons.device("u", "", "tap");
+  CHECK(test::wait_for(device, 60.0) == 0);
+  stop(haptic);
+  stop(first);
+  stop(second);
+  INFO(test::read_text(daemons.dir / "haptic.out") << test::read_text(daemons.dir / "world2.out"));
+
+  const auto haptic_summary = test::read_json(daemons.dir / "haptic.json");
+  CHECK(haptic_summary["haptic"]["world_attaches"] == 1);  // never switched
+  CHECK(haptic_summary["haptic"]["dds"]["other_worlds"].get<int>() >= 1);
+  CHECK_THAT(test::read_text(daemons.dir / "haptic.out"), Catch::Contains("another world manager"));
+  // The tap's whole impulse landed in the followed world, exactly once; none in the other.
+  const auto& rendered = haptic_summary["haptic"]["impulse_by_object_Ns"]["0"];
+  const auto followed = test::read_json(daemons.dir / "world1.json");
+  const auto other = test::read_json(daemons.dir / "world2.json");
+  REQUIRE(rendered.is_array());
+  CHECK(rendered[0].get<double>() > 0.3);
+  for (int a = 0; a < 3; ++a) {
+    CHECK(followed["objects"]["cube"]["impulse_Ns"][a].get<double>() ==
+          Approx(rendered[a].get<double>()).epsilon(1e-12).margin(1e-15));
+    CHECK(other["objects"]["cube"]["impulse_Ns"][a].get<double>() == 0.0);
+  }
+  CHECK(haptic_summary["haptic"]["max_force_N"].get<double>() < 10.0);  // never at the clamp
+}
+
 TEST_CASE("over DDS a world killed mid-press is followed to its restart, which applies only what came after") {
   DdsDaemons daemons = make_daemons("restart");
   daemons.coupling = "local";

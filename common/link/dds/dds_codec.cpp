@@ -64,9 +64,10 @@ DdsReportSample::~DdsReportSample() {
 }
 
 void to_dds(const wire::PlaneFrame& frame, std::uint64_t client_id, std::uint32_t client_endpoint,
-            impetus_dds_PlaneFrame& out) {
+            std::uint64_t world_id, impetus_dds_PlaneFrame& out) {
   out.client_id = client_id;
   out.client_endpoint = client_endpoint;
+  out.world_id = world_id;
   out.checksum = frame.checksum;
   fields::visit_frame_header(frame, out, WireToDds{});
   const std::uint32_t count = std::min(frame.plane_count, kMaxPlanes);
@@ -75,9 +76,10 @@ void to_dds(const wire::PlaneFrame& frame, std::uint64_t client_id, std::uint32_
 }
 
 void to_dds(const wire::HapticReport& report, std::uint64_t client_id, std::uint32_t client_endpoint,
-            impetus_dds_HapticReport& out) {
+            std::uint64_t world_id, impetus_dds_HapticReport& out) {
   out.client_id = client_id;
   out.client_endpoint = client_endpoint;
+  out.world_id = world_id;
   out.checksum = report.checksum;
   fields::visit_report_header(report, out, WireToDds{});
   const std::uint32_t count = std::min(report.entry_count, kMaxImpulseEntries);

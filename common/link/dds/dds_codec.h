@@ -52,12 +52,13 @@ class DdsReportSample {
   impetus_dds_HapticReport sample_{};
 };
 
-// Wire → DDS, keyed (client_id, client_endpoint). The wire frame's counts over capacity are sent as capacity-long
+// Wire → DDS, keyed (client_id, client_endpoint), addressed by `world_id` (the sending world for a frame, the world a
+// report is for). The wire frame's counts over capacity are sent as capacity-long
 // sequences with the count as it is, so the far side rejects the frame (decode) rather than receive a truncated one.
 void to_dds(const wire::PlaneFrame& frame, std::uint64_t client_id, std::uint32_t client_endpoint,
-            impetus_dds_PlaneFrame& out);
+            std::uint64_t world_id, impetus_dds_PlaneFrame& out);
 void to_dds(const wire::HapticReport& report, std::uint64_t client_id, std::uint32_t client_endpoint,
-            impetus_dds_HapticReport& out);
+            std::uint64_t world_id, impetus_dds_HapticReport& out);
 
 // DDS → wire, unsealed as received (decode() checks the seal and the content). False, and `out` unusable, if a count
 // disagrees with its sequence's length or exceeds the capacity.

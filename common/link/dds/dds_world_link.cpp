@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <mutex>
 #include <set>
 #include <stdexcept>
@@ -121,6 +122,19 @@ struct DdsWorldLinkServer::State {
         const Key key{sample.client_id, sample.client_endpoint};
         if (key.first == 0) continue;
         int slot = slot_of(key);
+        if (infos[n].valid_data && sample.world_id != 0 && sample.world_id != world_id) {
+          // A controller that follows another world on this partition: nothing of it is applied here, and a slot it
+          // held before it chose is free again.
+          ++foreign;
+          if (slot >= 0) {
+            std::fprintf(stderr, "world_manager: endpoint slot %d is free again (controller %016llx follows another "
+                         "world on this partition)\n", slot, static_cast<unsigned long long>(key.first));
+            slots[slot].key = Key{0, 0};
+            ++released;
+            publish_info();
+          }
+          continue;
+        }
         if (infos[n].valid_data) {
           if (!from_dds(sample, report_wire) || decode(report_wire, report) != FrameError::ok ||
               report.endpoint != sample.client_endpoint) {
@@ -181,6 +195,7 @@ struct DdsWorldLinkServer::State {
   std::set<Key> refused_keys;
   std::uint64_t rejected = 0;
   std::uint64_t released = 0;
+  std::uint64_t foreign = 0;  // reports for another world on the partition
 };
 
 DdsWorldLinkServer::DdsWorldLinkServer(const DdsLinkOptions& options, const WorldLinkInfo& info) {
@@ -206,7 +221,7 @@ void DdsWorldLinkServer::publish_frame(std::uint32_t slot, const PlaneFrame& fra
   const Key key = state.slots[slot].key;
   if (key.first == 0) return;  // nobody holds the slot
   encode(frame, state.frame_wire);
-  to_dds(state.frame_wire, key.first, key.second, *state.frame_sample);
+  to_dds(state.frame_wire, key.first, key.second, state.world_id, *state.frame_sample);
   // A frame that cannot be sent is replaced by the next step's: the loss is the link's, and frames are best effort.
   dds_write(state.frame_writer, &*state.frame_sample);
 }
@@ -222,6 +237,7 @@ bool DdsWorldLinkServer::latest_haptic_stats(std::uint32_t slot, LoopStats& out)
 std::uint64_t DdsWorldLinkServer::rejected_reports() const { return state_->rejected; }
 std::uint64_t DdsWorldLinkServer::refused_endpoints() const { return state_->refused_keys.size(); }
 std::uint64_t DdsWorldLinkServer::released_slots() const { return state_->released; }
+std::uint64_t DdsWorldLinkServer::foreign_reports() const { return state_->foreign; }
 std::string DdsWorldLinkServer::name() const { return describe(state_->participant.options()); }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -284,6 +300,10 @@ struct DdsWorldLinkClient::State {
         if (!frame_infos[n].valid_data || sample.client_id != client_id || sample.client_endpoint >= endpoints) {
           continue;
         }
+        if (sample.world_id != followed.load()) {  // another world's, on the same partition
+          foreign_frames.fetch_add(1);
+          continue;
+        }
         // decode() on the servo's side checks the seal and the content; a sample whose counts disagree with its
         // sequences cannot even be laid out, and is counted here.
         if (!from_dds(sample, received_wire)) {
@@ -301,34 +321,62 @@ struct DdsWorldLinkClient::State {
     dds_sample_info_t sample_info{};
     while (dds_take(info_reader, &buffer, &sample_info, 1, 1) > 0) {
       const std::lock_guard<std::mutex> lock(info_mutex);
-      if (sample_info.valid_data && sample_info.instance_state == DDS_IST_ALIVE) {
-        if (sample.world_id != world_id) {
-          // A world we have not seen: the first, or one that took a dead world's place.
-          // The schedule is the first world's: the servo reads it without a lock, so it never changes under it (a
-          // restarted world runs the same command line).
-          const bool first = world_id == 0;
-          if (!first) switched.store(true);
-          world_id = sample.world_id;
-          attaches.fetch_add(1);
-          if (first) {
-            info.world_rate_hz = sample.world_rate_hz;
-            info.world_period_s = sample.world_period_s;
-            info.phase_ticks = sample.phase_ticks;
-            info.clock = static_cast<ClockMode>(sample.clock);
-            info.coupling = static_cast<Coupling>(sample.coupling);
-          }
+      const bool live = sample_info.valid_data && sample_info.instance_state == DDS_IST_ALIVE;
+      if (live && (world_id == 0 || sample.world_id == world_id || !alive.load())) {
+        follow(sample);
+      } else if (live) {
+        // A second live world on the partition: it is refused, not adopted (this controller's impulse must land in
+        // one world), and kept in mind in case the followed one goes.
+        if (others.emplace(sample.world_id, sample).second) {
+          other_worlds.fetch_add(1);
+          std::fprintf(stderr, "haptic_controller: another world manager (world %016llx) is live on %s; this "
+                       "controller serves world %016llx only and ignores it\n",
+                       static_cast<unsigned long long>(sample.world_id), describe(participant.options()).c_str(),
+                       static_cast<unsigned long long>(world_id));
+        } else {
+          others[sample.world_id] = sample;
         }
-        served = 0;
-        free_slots = 0;
-        for (const impetus_dds_SlotHolder& holder : sample.slots) {
-          if (holder.client_id == client_id) ++served;
-          if (holder.client_id == 0) ++free_slots;
-        }
-        alive.store(true);
       } else if (sample.world_id == world_id) {
         alive.store(false);  // the world left, or its process stopped answering
+        if (!others.empty()) {
+          // Another world is live on the partition: it takes the place of the one that went.
+          const impetus_dds_WorldInfo next = others.begin()->second;
+          others.erase(others.begin());
+          follow(next);
+        }
+      } else {
+        others.erase(sample.world_id);
       }
     }
+  }
+
+  // Follows the world of `sample` (the first, the same one again, or one that took a dead world's place), and reads
+  // how many of this controller's endpoints it serves. Holds info_mutex.
+  void follow(const impetus_dds_WorldInfo& sample) {
+    if (sample.world_id != world_id) {
+      // The schedule is the first world's: the servo reads it without a lock, so it never changes under it (a
+      // restarted world runs the same command line).
+      const bool first = world_id == 0;
+      if (!first) switched.store(true);
+      world_id = sample.world_id;
+      followed.store(world_id);
+      others.erase(world_id);
+      attaches.fetch_add(1);
+      if (first) {
+        info.world_rate_hz = sample.world_rate_hz;
+        info.world_period_s = sample.world_period_s;
+        info.phase_ticks = sample.phase_ticks;
+        info.clock = static_cast<ClockMode>(sample.clock);
+        info.coupling = static_cast<Coupling>(sample.coupling);
+      }
+    }
+    served = 0;
+    free_slots = 0;
+    for (const impetus_dds_SlotHolder& holder : sample.slots) {
+      if (holder.client_id == client_id) ++served;
+      if (holder.client_id == 0) ++free_slots;
+    }
+    alive.store(true);
   }
 
   // Sender thread: each endpoint's newest report, once per period.
@@ -346,7 +394,7 @@ struct DdsWorldLinkClient::State {
         const bool fresh = reports[k].try_read(sent_wire[k], last_sequence[k]);
         const bool repeat = std::chrono::duration<double>(now - last_sent[k]).count() > kReportRepeat_s;
         if (!fresh && !repeat) continue;
-        to_dds(sent_wire[k], client_id, k, *send_sample);
+        to_dds(sent_wire[k], client_id, k, followed.load(), *send_sample);
         if (dds_write(report_writer, &*send_sample) >= 0) sent.fetch_add(1);
         last_sent[k] = now;
       }
@@ -404,6 +452,10 @@ struct DdsWorldLinkClient::State {
   std::atomic<bool> alive{false};
   std::atomic<bool> switched{false};
   std::atomic<std::uint64_t> attaches{0};
+  std::atomic<std::uint64_t> followed{0};         // world_id, for the sender's reports and the receiver's frames
+  std::map<std::uint64_t, impetus_dds_WorldInfo> others;  // other live worlds on the partition, newest info each
+  std::atomic<std::uint64_t> other_worlds{0};     // how many were seen
+  std::atomic<std::uint64_t> foreign_frames{0};   // frames from them, dropped
 
   std::atomic<bool> stop{false};
   std::thread receiver;
@@ -493,5 +545,7 @@ std::uint64_t DdsWorldLinkClient::rejected_frames() const {
 std::uint64_t DdsWorldLinkClient::attaches() const { return state_->attaches.load(); }
 std::uint64_t DdsWorldLinkClient::client_id() const { return state_->client_id; }
 std::uint64_t DdsWorldLinkClient::reports_sent() const { return state_->sent.load(); }
+std::uint64_t DdsWorldLinkClient::other_worlds() const { return state_->other_worlds.load(); }
+std::uint64_t DdsWorldLinkClient::foreign_frames() const { return state_->foreign_frames.load(); }
 
 }  // namespace impetus

@@ -14,6 +14,11 @@
 // newest report of each endpoint as soon as it sees it (it looks every 250 µs). receive_frame() and publish_report()
 // only touch those channels: allocation-free, lock-free, no system call. The world's end runs on the world's thread and calls DDS directly.
 //
+// One world per controller. Frames carry their world's id and reports the id of the world they are for. A controller
+// follows the first world that answers; a second live world on the partition is reported and ignored (its frames are
+// dropped, and a world ignores reports for another world), and takes the followed world's place only once that one
+// has gone (left, or silent past its lease).
+//
 // Loss and repetition. Frames are best effort (a lost one is replaced by the next step's), reports reliable keep-last-1
 // and in any case running totals: the world applies total − applied, so a lost, repeated or reordered report changes
 // nothing it applies once a newer one arrives.
@@ -43,6 +48,8 @@ class DdsWorldLinkServer final : public WorldLinkServer {
   // Keys refused because every slot was taken, and slots freed because their controller left or went silent.
   std::uint64_t refused_endpoints() const;
   std::uint64_t released_slots() const;
+  // Reports of controllers that follow another world on the partition: never applied here.
+  std::uint64_t foreign_reports() const;
   std::string name() const;
 
  private:
@@ -75,6 +82,10 @@ class DdsWorldLinkClient final : public WorldLinkClient {
   std::uint64_t client_id() const;
   // Reports handed to DDS by the sender thread (each new one, and an unchanged one again every 0.1 s).
   std::uint64_t reports_sent() const;
+  // Other worlds seen live on the partition while this controller followed its own (refused, not adopted), and the
+  // frames they sent it (dropped).
+  std::uint64_t other_worlds() const;
+  std::uint64_t foreign_frames() const;
 
  private:
   struct State;

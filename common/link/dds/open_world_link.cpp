@@ -29,7 +29,8 @@ std::string link_name(const WorldLinkServer& link) {
 nlohmann::json link_summary(const WorldLinkClient& link, const LinkOptions& options) {
   const auto* dds = dynamic_cast<const DdsWorldLinkClient*>(&link);
   if (dds == nullptr) return nullptr;
-  return {{"domain", options.dds.domain_id}, {"partition", options.dds.partition}, {"reports_sent", dds->reports_sent()}};
+  return {{"domain", options.dds.domain_id}, {"partition", options.dds.partition}, {"reports_sent", dds->reports_sent()},
+          {"other_worlds", dds->other_worlds()}, {"foreign_frames", dds->foreign_frames()}};
 }
 
 nlohmann::json link_summary(const WorldLinkServer& link, const LinkOptions& options) {
@@ -38,6 +39,7 @@ nlohmann::json link_summary(const WorldLinkServer& link, const LinkOptions& opti
   return {{"domain", options.dds.domain_id},
           {"partition", options.dds.partition},
           {"refused_endpoints", dds->refused_endpoints()},
+          {"foreign_reports", dds->foreign_reports()},
           {"released_slots", dds->released_slots()}};
 }
 
