@@ -4,6 +4,7 @@
 #include "world_manager/engine/engine_registry.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -149,6 +150,12 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
   if (known_start && report.tick > endpoint.last_report_tick) {
     window.tick_s = window.length_s / static_cast<double>(report.tick - endpoint.last_report_tick);
   }
+  // The world time this report covers: since the endpoint's previous new report was applied, or one step for its
+  // first. A report seen again (a transport keeps the last one while its controller is silent) brings nothing and
+  // leaves that time alone, so the report after a silence covers the whole of it.
+  const double covered_world_s = known_start ? time_s_ - endpoint.last_applied_world_time_s : period_s_;
+  const bool new_report = known_start || endpoint.last_report_session != report.haptic_session;
+  if (new_report) endpoint.last_applied_world_time_s = time_s_;
   endpoint.last_report_session = report.haptic_session;
   endpoint.last_report_time_s = report.haptic_time_s;
   endpoint.last_report_tick = report.tick;
@@ -157,6 +164,17 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
   std::vector<Eigen::Vector3d>& applied = applied_by_owner_[owner];
   if (applied.empty()) applied.assign(floor_id + 1, Eigen::Vector3d::Zero());
   const std::uint32_t count = std::min(report.entry_count, kMaxImpulseEntries);
+  // The new impulse of each entry (the ledger's differences), before anything is applied.
+  struct Taken {
+    std::size_t id;
+    ImpulseDelta delta;
+    ImpulseDelta moment;
+    bool moment_finite;
+  };
+  std::array<Taken, kMaxImpulseEntries> taken;
+  std::uint32_t taken_count = 0;
+  Eigen::Vector3d reaction_Ns = Eigen::Vector3d::Zero();  // Σ ΔJ: the finger's reaction, static geometry's share too
+  double reaction_sum_Ns = 0.0;                           // Σ|ΔJ| over its shares
   for (std::uint32_t i = 0; i < count; ++i) {
     const ObjectImpulse& entry = report.entries[i];
     if (entry.object_id < 0 || static_cast<std::size_t>(entry.object_id) > floor_id ||
@@ -165,28 +183,60 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
       continue;
     }
     const auto id = static_cast<std::size_t>(entry.object_id);
-    const ImpulseDelta delta = ledger_.take(owner, entry);
-    // Position coupling moves nothing by the reports (its penalty comes from the sampled finger): nothing applied.
-    if (options_.coupling != Coupling::position) applied[id] += delta.impulse_Ns;
     ObjectImpulse moments = entry;  // the moments through the same ledger rules (owner, epoch, baseline)
     moments.impulse_Ns = entry.impulse_moment_Nss;
     moments.angular_impulse_Nms = entry.angular_impulse_moment_Nmss;
-    const ImpulseDelta moment = moment_ledger_.take(owner, moments);
+    Taken& t = taken[taken_count++];
+    t = {id, ledger_.take(owner, entry), moment_ledger_.take(owner, moments),
+         all_finite(entry.impulse_moment_Nss) && all_finite(entry.angular_impulse_moment_Nmss)};
+    reaction_Ns += t.delta.impulse_Ns;
+    reaction_sum_Ns += t.delta.impulse_Ns.norm();
+  }
+  Eigen::Vector3d static_delta_Ns = Eigen::Vector3d::Zero();
+  if (all_finite(report.static_impulse_Ns)) static_delta_Ns = ledger_.take_static(owner, report.static_impulse_Ns);
+  reaction_Ns += static_delta_Ns;
+  reaction_sum_Ns += static_delta_Ns.norm();
+  // What a device can have put in: its force limit over the world time the report covers, |Σ ΔJ| ≤ F_max·T, the
+  // reaction split among the contacts by at most kMaxReactionSplitRatio (Σ|ΔJ| ≤ √3·|reaction| for ≤ 3 constraints,
+  // haptic_controller/impulse_accumulator.cpp). World time, not haptic time: after a stalled world the controller has
+  // rendered against a plane that did not move for the whole stall, but the world simulates one step, and applying
+  // more than F_max·T_w in it would be a force the device cannot make, doing work nobody put in. The excess is cut
+  // from every share alike, dropped and counted: the world receives less, never more.
+  constexpr double kMaxReactionSplitRatio = 1.7320508075688772;
+  constexpr double kRounding = 1.0 + 1e-9;  // sums of a tick's worth of rounding
+  const double limit_Ns = options_.report_force_limit_N * std::max(covered_world_s, period_s_) * kRounding;
+  double scale = 1.0;
+  if (reaction_Ns.norm() > limit_Ns) scale = limit_Ns / reaction_Ns.norm();
+  if (reaction_sum_Ns > kMaxReactionSplitRatio * limit_Ns) {
+    scale = std::min(scale, kMaxReactionSplitRatio * limit_Ns / reaction_sum_Ns);
+  }
+  if (scale < 1.0) {
+    ++clipped_reports_;
+    clipped_impulse_Ns_ += (1.0 - scale) * reaction_sum_Ns;
+  }
+  for (std::uint32_t i = 0; i < taken_count; ++i) {
+    Taken& t = taken[i];
+    if (scale < 1.0) {
+      t.delta.impulse_Ns *= scale;
+      t.delta.angular_impulse_Nms *= scale;
+      t.moment.impulse_Ns *= scale;
+      t.moment.angular_impulse_Nms *= scale;
+    }
+    const std::size_t id = t.id;
+    // Position coupling moves nothing by the reports (its penalty comes from the sampled finger): nothing applied.
+    if (options_.coupling != Coupling::position) applied[id] += t.delta.impulse_Ns;
     // An entry whose total has not grown since the last report brings nothing new: handing it on would only wake a
     // sleeping object the finger touched once and left.
-    const bool nothing_new = delta.impulse_Ns.isZero(0.0) && delta.angular_impulse_Nms.isZero(0.0) &&
-                             moment.impulse_Ns.isZero(0.0) && moment.angular_impulse_Nms.isZero(0.0);
+    const bool nothing_new = t.delta.impulse_Ns.isZero(0.0) && t.delta.angular_impulse_Nms.isZero(0.0) &&
+                             t.moment.impulse_Ns.isZero(0.0) && t.moment.angular_impulse_Nms.isZero(0.0);
     if (nothing_new) continue;
     if (id < floor_id && scene_.objects[id].dynamic) {
-      const bool moment_finite = all_finite(entry.impulse_moment_Nss) && all_finite(entry.angular_impulse_moment_Nmss);
-      coupling_->take_impulse(id, delta, moment, moment_finite, window);
+      coupling_->take_impulse(id, t.delta, t.moment, t.moment_finite, window);
     } else {
-      total_static_impulse_Ns_ += delta.impulse_Ns;  // the haptic side named static geometry: it absorbs the push
+      total_static_impulse_Ns_ += t.delta.impulse_Ns;  // the haptic side named static geometry: it absorbs the push
     }
   }
-  if (all_finite(report.static_impulse_Ns)) {
-    total_static_impulse_Ns_ += ledger_.take_static(owner, report.static_impulse_Ns);
-  }
+  total_static_impulse_Ns_ += scale * static_delta_Ns;
 }
 
 Eigen::Vector3d World::applied_by(const CounterOwner& owner, std::size_t id) const {

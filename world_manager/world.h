@@ -11,6 +11,7 @@
 // Units SI, world frame right-handed with z up; object ids are scene indices, the floor is scene.floor_object_id().
 
 #include "common/contract/frames.h"
+#include "common/spidar/geometry.h"
 #include "world_manager/scene.h"
 #include "world_manager/couplings/coupling.h"
 #include "world_manager/engine/rigid_body_engine.h"
@@ -40,6 +41,9 @@ struct WorldOptions {
   // Published in every frame so the haptic side notices a restarted world; must be nonzero. Nodes pass
   // new_session_id() (common/runtime/process.h), tests a constant.
   std::uint64_t world_session = 1;
+  // The largest force a controller's device renders, N (the SPIDAR's, common/spidar/geometry.h): no report may bring
+  // a step more impulse than that force could in the world time since the endpoint's last applied report (take_report).
+  double report_force_limit_N = SpidarGeometry{}.max_force_N;
 };
 
 class World {
@@ -109,6 +113,11 @@ class World {
   const Eigen::Vector3d& total_static_impulse_Ns() const { return total_static_impulse_Ns_; }
   // Report entries ignored because their object id was out of range or their numbers not finite.
   std::uint64_t rejected_entries() const { return rejected_entries_; }
+  // Reports whose impulse exceeded what a device could render in the world time they cover, and the impulse cut
+  // from them (N·s, Σ|ΔJ| over their entries): never applied, counted here (a rogue or corrupted report; a stalled
+  // world's backlog).
+  std::uint64_t clipped_reports() const { return clipped_reports_; }
+  double clipped_impulse_Ns() const { return clipped_impulse_Ns_; }
   // Reports whose totals count against another world session (HapticReport::world_session): their finger is used,
   // their impulses are not.
   std::uint64_t foreign_reports() const { return foreign_reports_; }
@@ -128,6 +137,7 @@ class World {
     std::uint64_t last_report_session = 0;
     double last_report_time_s = 0.0;
     std::uint64_t last_report_tick = 0;
+    double last_applied_world_time_s = 0.0;  // the world time its previous report was applied at (same session)
   };
 
   void take_finger(Endpoint& endpoint, const HapticReport& report);
@@ -151,6 +161,8 @@ class World {
   Eigen::Vector3d total_static_impulse_Ns_ = Eigen::Vector3d::Zero();
   std::map<CounterOwner, std::vector<Eigen::Vector3d>> applied_by_owner_;  // per object (scene ids and the floor)
   std::uint64_t rejected_entries_ = 0;
+  std::uint64_t clipped_reports_ = 0;
+  double clipped_impulse_Ns_ = 0.0;
   std::uint64_t foreign_reports_ = 0;
 
   std::vector<Endpoint> endpoints_;   // kMaxEndpoints, allocated once

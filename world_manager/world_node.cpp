@@ -251,6 +251,8 @@ nlohmann::json WorldNode::summary() const {
             {"rejected_reports", stats_.rejected_frames},
             {"channel_repairs", link_ != nullptr ? link_->channel_repairs() : 0},
             {"foreign_reports", world_.foreign_reports()},
+            {"clipped_reports", world_.clipped_reports()},
+            {"clipped_impulse_Ns", world_.clipped_impulse_Ns()},
             {"stale_finger_steps", stale_finger_steps_},
             {"escaped_objects", escaped_names()},
             {"floor_penetration_max_m", world_.floor_penetration_max_m()},

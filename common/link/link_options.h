@@ -15,6 +15,10 @@ enum class LinkKind { shm, dds };
 struct DdsLinkOptions {
   std::uint32_t domain_id = 0;
   std::string partition = "impetus";
+  // DDS Security (authentication, access control, encryption): a folder made by scripts/dds_security.sh with this
+  // participant's credentials (dds_participant.h lists the files). Empty: an open link, which anyone on the network
+  // segment can join.
+  std::string security_dir;
 };
 
 // Highest domain id: the RTPS port mapping (7400 + 250·domain + offsets) stays below 65536 up to 232.

@@ -110,6 +110,11 @@ void add_link_flags(CLI::App& app, LinkOptions& link) {
   app.add_option("--dds-partition", link.dds.partition,
                  "--link dds: the DDS partition; worlds in other partitions of the domain are invisible (impetus)")
       ->check([](const std::string& name) { return name.empty() ? std::string("must not be empty") : std::string(); });
+  app.add_option("--dds-security", link.dds.security_dir,
+                 "--link dds: a secured link (DDS Security: only participants certified by the same CA, each allowed "
+                 "only its own topics, everything encrypted): this participant's folder made by "
+                 "scripts/dds_security.sh")
+      ->check(CLI::ExistingDirectory);
 }
 
 void add_output_flag(CLI::App& app, const std::string& flag, std::string& path, const std::string& description) {

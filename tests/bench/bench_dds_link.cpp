@@ -6,7 +6,8 @@
 // most that. The two ends may run in different network namespaces of one host (they share CLOCK_MONOTONIC).
 // Prints p50/p99/max; asserts nothing.
 //
-//   bench_dds_link [--link dds|shm] [--seconds S] [--role both|world|controller] [--partition NAME]
+//   bench_dds_link [--link dds|shm] [--seconds S] [--role both|world|controller] [--partition NAME] [--secure DIR]
+//   --secure DIR: a secured DDS link (DDS Security), DIR made by scripts/dds_security.sh DIR world controller.
 //   role both (default): the controller end in a child process; world and controller: one end each, for
 //   `ip netns exec` on two hosts (start the world first).
 
@@ -37,12 +38,22 @@ struct Options {
   double seconds = 5.0;
   std::string role = "both";
   std::string partition = "impetus_bench_" + std::to_string(getpid());
+  std::string secure_dir;  // empty: an open link
 };
+
+// This end's DDS options: with --secure, the world's or the controller's folder.
+DdsLinkOptions dds_options(const Options& options, const char* role) {
+  DdsLinkOptions dds;
+  dds.partition = options.partition;
+  if (!options.secure_dir.empty()) dds.security_dir = options.secure_dir + "/" + role;
+  return dds;
+}
 
 double now_s() { return static_cast<double>(monotonic_now_ns()) * 1e-9; }
 
 void print(const char* what, const Options& options, const LatencyHistogram& latency) {
-  std::printf("%s link, %s: %llu samples, p50 %.1f us, p99 %.1f us, max %.1f us\n", options.link.c_str(), what,
+  std::printf("%s%s link, %s: %llu samples, p50 %.1f us, p99 %.1f us, max %.1f us\n",
+              options.secure_dir.empty() ? "" : "secured ", options.link.c_str(), what,
               static_cast<unsigned long long>(latency.count()), latency.percentile_ns(0.5) / 1e3,
               latency.percentile_ns(0.99) / 1e3, latency.max_ns() / 1e3);
   std::fflush(stdout);
@@ -55,7 +66,7 @@ int run_world(const Options& options) {
   info.clock = ClockMode::realtime;
   std::unique_ptr<WorldLinkServer> link;
   if (options.link == "dds") {
-    link = std::make_unique<DdsWorldLinkServer>(DdsLinkOptions{0, options.partition}, info);
+    link = std::make_unique<DdsWorldLinkServer>(dds_options(options, "world"), info);
   } else {
     link = std::make_unique<ShmWorldLinkServer>(options.partition, info);
   }
@@ -97,7 +108,7 @@ int run_world(const Options& options) {
 int run_controller(const Options& options) {
   std::unique_ptr<WorldLinkClient> link;
   if (options.link == "dds") {
-    link = std::make_unique<DdsWorldLinkClient>(DdsLinkOptions{0, options.partition}, ClockMode::realtime, 30.0, 1);
+    link = std::make_unique<DdsWorldLinkClient>(dds_options(options, "controller"), ClockMode::realtime, 30.0, 1);
   } else {
     link = std::make_unique<ShmWorldLinkClient>(options.partition, ClockMode::realtime, 30.0, 1);
   }
@@ -144,10 +155,12 @@ int main(int argc, char** argv) {
       options.role = argv[++k];
     } else if (arg == "--partition" && has_value) {
       options.partition = argv[++k];
+    } else if (arg == "--secure" && has_value) {
+      options.secure_dir = argv[++k];
     } else {
       std::fprintf(stderr,
                    "usage: bench_dds_link [--link dds|shm] [--seconds S] [--role both|world|controller] "
-                   "[--partition NAME]\n");
+                   "[--partition NAME] [--secure DIR]\n");
       return arg == "--help" || arg == "-h" ? 0 : 2;
     }
   }

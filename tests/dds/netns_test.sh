@@ -4,7 +4,7 @@
 # controllers and their devices in another, joined by a veth pair (iproute2). Real time; asserts the ledger, the
 # re-attachment and the absence of bursts, never timing.
 #
-#   tests/dds/netns_test.sh BUILD_DIR OUT_DIR [hosts|netem]
+#   tests/dds/netns_test.sh BUILD_DIR OUT_DIR [hosts|netem|secure]
 #
 # hosts (the default):
 # 1. a tap trial across the hosts at 0, 1 and 10 % packet loss (Cyclone's Internal/Test/XmitLossiness on both
@@ -16,12 +16,16 @@
 # netem: the tap trial with 10 and 50 ms of one-way delay on the veth (tc netem on both ends): the world applies
 #    exactly what was rendered, and the cube's stop position is printed beside the in-process delay line's
 #    (docs/latency.md). Exits 77 where the kernel has no netem qdisc.
+# secure: a secured link (DDS Security, credentials from scripts/dds_security.sh): a tap trial across the hosts with
+#    the ledger exact; a controller without credentials, one certified by another CA and one whose permissions do not
+#    allow publishing reports are each refused, and the world serves none of them; the link's one-way latency, open
+#    and secured, is printed side by side.
 # Needs root (network namespaces). Exits 77 (CTest: skipped, not passed) where namespaces cannot be made.
 set -euo pipefail
 build="${1:?usage: netns_test.sh BUILD_DIR OUT_DIR}"
 out="${2:?usage: netns_test.sh BUILD_DIR OUT_DIR}"
 mode="${3:-hosts}"
-case "$mode" in hosts|netem) ;; *) echo "netns_test: the mode is hosts or netem, not '$mode'" >&2; exit 2 ;; esac
+case "$mode" in hosts|netem|secure) ;; *) echo "netns_test: the mode is hosts, netem or secure, not '$mode'" >&2; exit 2 ;; esac
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 skip() { echo "netns_test: SKIPPED: $*"; exit 77; }
 fail() { echo "netns_test: FAILED: $*" >&2; exit 1; }
@@ -41,19 +45,20 @@ rm -rf "$out"
 mkdir -p "$out"
 scene="$root/scenes/tap.json"
 link=(--clock realtime --link dds --dds-partition "$tag")
+world_security=() hands_security=()  # --dds-security DIR of each host's participants (secure mode)
 
 # world DIR [extra world_manager flags]: starts the world on its host; sets $world.
 start_world() {
   local dir="$1"; shift
-  ip netns exec "$world_ns" "$build/world_manager/world_manager" --scene "$scene" "${link[@]}" --shm "${tag}_world" \
-    --log "$dir/world.csv" --summary "$dir/world.json" "$@" >"$dir/world.out" 2>&1 &
+  ip netns exec "$world_ns" "$build/world_manager/world_manager" --scene "$scene" "${link[@]}" "${world_security[@]}" \
+    --shm "${tag}_world" --log "$dir/world.csv" --summary "$dir/world.json" "$@" >"$dir/world.out" 2>&1 &
   world=$!; pids+=("$world")
 }
 # hands DIR USER TRAJECTORY: a controller and its device on the other host; sets $haptic and $device.
 start_hands() {
   local dir="$1" user="$2" trajectory="$3"
-  ip netns exec "$hands_ns" "$build/haptic_controller/haptic_controller" "${link[@]}" --shm "${tag}_$user" \
-    --log "$dir/haptic_$user.csv" --summary "$dir/haptic_$user.json" >"$dir/haptic_$user.out" 2>&1 &
+  ip netns exec "$hands_ns" "$build/haptic_controller/haptic_controller" "${link[@]}" "${hands_security[@]}" \
+    --shm "${tag}_$user" --log "$dir/haptic_$user.csv" --summary "$dir/haptic_$user.json" >"$dir/haptic_$user.out" 2>&1 &
   haptic=$!; pids+=("$haptic")
   ip netns exec "$hands_ns" "$build/spidar_sim/spidar_sim" --clock realtime --shm "${tag}_$user" \
     --trajectory "$trajectory" --attach-timeout 30 >"$dir/device_$user.out" 2>&1 &
@@ -85,6 +90,52 @@ for user in users:
     print(f"{dir}: controller {user}: rendered = applied = {rendered} N·s, {haptic.get('dds', {}).get('reports_sent')} reports sent")
 PY
 }
+
+if [ "$mode" = secure ]; then
+  creds="$out/credentials"
+  bash "$root/scripts/dds_security.sh" "$creds" world controller observer >/dev/null
+  bash "$root/scripts/dds_security.sh" "$out/other_ca" controller >/dev/null
+  # 1. A tap across the hosts, both ends secured: the world applies exactly what the controller rendered.
+  dir="$out/tap"; mkdir -p "$dir"
+  world_security=(--dds-security "$creds/world") hands_security=(--dds-security "$creds/controller")
+  start_world "$dir"
+  start_hands "$dir" u tap
+  wait "$device" || fail "secured tap: spidar_sim exited with status $?"
+  stop "$haptic" "secured tap: haptic_controller"
+  # 2. Refused while the secured world runs: no credentials, another CA, and permissions without the report topic.
+  dir2="$out/refused"; mkdir -p "$dir2"
+  for who in open other_ca observer; do
+    case "$who" in
+      open) flags=() ;;
+      other_ca) flags=(--dds-security "$out/other_ca/controller") ;;
+      observer) flags=(--dds-security "$creds/observer") ;;
+    esac
+    status=0
+    ip netns exec "$hands_ns" "$build/haptic_controller/haptic_controller" "${link[@]}" "${flags[@]}" \
+      --shm "${tag}_$who" --world-wait 5 >"$dir2/$who.out" 2>&1 || status=$?
+    [ "$status" -ne 0 ] || fail "secured: a controller ($who) was served: $(cat "$dir2/$who.out")"
+    echo "netns_test: secured: refused ($who): $(tail -1 "$dir2/$who.out")"
+  done
+  grep -q "Not Allowed By Security" "$dir2/observer.out" || fail "secured: the observer's writer was not refused"
+  stop "$world" "secured tap: world_manager"
+  check_ledger "$dir" u || fail "secured tap: the ledger disagrees"
+  [ "$(grep -c "serves controller" "$dir/world.out")" -eq 1 ] ||
+    fail "secured: the world served more than its one certified controller: $(cat "$dir/world.out")"
+  # 3. One-way latency across the hosts, open and secured (bench_dds_link, one end on each host).
+  if [ -x "$build/tests/bench_dds_link" ]; then
+    for secure in "" "$creds"; do
+      flags=(--seconds 5 --partition "${tag}_bench")
+      [ -n "$secure" ] && flags+=(--secure "$secure")
+      ip netns exec "$world_ns" "$build/tests/bench_dds_link" --role world "${flags[@]}" >"$out/bench_world.out" 2>&1 &
+      bench=$!; pids+=("$bench")
+      ip netns exec "$hands_ns" "$build/tests/bench_dds_link" --role controller "${flags[@]}" 2>&1 | grep "link," || true
+      wait "$bench" || true
+      grep "link," "$out/bench_world.out" || true
+    done
+  fi
+  echo "netns_test: passed (secure)"
+  exit 0
+fi
 
 if [ "$mode" = netem ]; then
   tc -n "$world_ns" qdisc add dev "$world_if" root netem delay 1ms 2>/dev/null ||

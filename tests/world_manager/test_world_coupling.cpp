@@ -3,6 +3,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <limits>
+
 #include <Eigen/Geometry>
 
 #include <cmath>
@@ -103,8 +105,17 @@ TEST_CASE("a repeated report applies nothing twice") {
   CHECK(close(world->states()[0].velocity_mps, Vector3d(0.3, 0.0, 0.0)));
 }
 
+// Reports of whole N·s in one step: more than a device renders, so the world's bound on a report's impulse
+// (World::take_report) is lifted to test the ledger alone.
+impetus::WorldOptions unbounded_reports() {
+  impetus::WorldOptions options;
+  options.report_force_limit_N = std::numeric_limits<double>::infinity();
+  return options;
+}
+
 TEST_CASE("a restarted haptic session or a new epoch starts from a zero baseline: no burst") {
-  auto world = make_world(impetus::parse_scene(impetus::test::free_body_document(tilted_box()), "free.json"));
+  auto world = make_world(impetus::parse_scene(impetus::test::free_body_document(tilted_box()), "free.json"),
+                          unbounded_reports());
   HapticReport first = make_report(42, 50);
   add_entry(first, 0, 1, {10.0, 0.0, 0.0});  // a long session has accumulated a large total
   world->step(&first);
@@ -126,11 +137,57 @@ TEST_CASE("a restarted haptic session or a new epoch starts from a zero baseline
   }
 }
 
+TEST_CASE("a report bringing more impulse than a device renders in the world time it covers is cut to that, counted") {
+  // 10 N over one 50 ms step is 0.5 N·s. A report claiming 1.61 N·s in one step (a world resumed after a stall, whose
+  // controller rendered against a frozen plane all along; or a rogue participant) gets 0.5 and 1.11 is counted.
+  auto world = make_world(impetus::parse_scene(impetus::test::free_body_document(tilted_box()), "free.json"));
+  const double period_s = world->world_period_s();
+  REQUIRE(period_s == Approx(0.05));
+  HapticReport report = make_report(7, 50);
+  add_entry(report, 0, 1, {1.61, 0.0, 0.0});
+  world->step(&report);
+  CHECK(world->step_impulse_Ns(0).x() == Approx(10.0 * period_s).epsilon(1e-8));
+  CHECK(world->clipped_reports() == 1);
+  CHECK(world->clipped_impulse_Ns() == Approx(1.61 - 10.0 * period_s).epsilon(1e-8));
+  // Within the bound: applied whole. The next report covers one step; 0.4 N·s more is within 0.5.
+  report.tick = 100;
+  report.haptic_time_s = 0.1;
+  report.entries[0].impulse_Ns = {2.01, 0.0, 0.0};
+  world->step(&report);
+  CHECK(world->step_impulse_Ns(0).x() == Approx(0.4));
+  CHECK(world->clipped_reports() == 1);
+  // Three steps without a new report, then one covering them: four steps' worth of force may have gone in.
+  for (int k = 0; k < 3; ++k) world->step(std::span<const HapticReport* const>{});
+  report.tick = 300;
+  report.haptic_time_s = 0.3;
+  report.entries[0].impulse_Ns = {2.01 + 1.9, 0.0, 0.0};
+  world->step(&report);
+  CHECK(world->step_impulse_Ns(0).x() == Approx(1.9));
+  CHECK(world->clipped_reports() == 1);
+  // The same report again for three steps (a transport keeps the last one while its controller is silent, e.g. a
+  // network link down), then a new one: it covers all four steps.
+  for (int k = 0; k < 3; ++k) world->step(&report);
+  report.tick = 400;
+  report.haptic_time_s = 0.4;
+  report.entries[0].impulse_Ns = {3.91 + 1.9, 0.0, 0.0};
+  world->step(&report);
+  CHECK(world->step_impulse_Ns(0).x() == Approx(1.9));
+  CHECK(world->clipped_reports() == 1);
+  // Shares on several contacts: |Σ ΔJ| ≤ F·T and Σ|ΔJ| ≤ √3·F·T. Two opposite shares of 0.6 N·s each (a pinch) sum
+  // to zero but are more than √3·0.5 together.
+  HapticReport pinch = make_report(8, 50);
+  add_entry(pinch, 0, 1, {0.6, 0.0, 0.0});
+  pinch.static_impulse_Ns = {-0.6, 0.0, 0.0};
+  world->step(&pinch);
+  CHECK(world->clipped_reports() == 2);
+  CHECK(world->step_impulse_Ns(0).x() == Approx(0.5 * 1.7320508075688772 * 0.5).epsilon(1e-8));
+}
+
 TEST_CASE("entries on static geometry or unknown ids move nothing") {
   json document = impetus::test::free_body_document(tilted_box());
   document["objects"].push_back(json{{"name", "wall"}, {"shape", "box"}, {"size_m", {0.1, 0.1, 0.1}},
                                      {"dynamic", false}, {"position_m", {1, 0, 0}}});
-  auto world = make_world(impetus::parse_scene(document, "free.json"));
+  auto world = make_world(impetus::parse_scene(document, "free.json"), unbounded_reports());
   HapticReport report = make_report(5, 50);
   add_entry(report, 1, 1, {1.0, 0.0, 0.0});   // the static wall
   add_entry(report, 99, 1, {1.0, 0.0, 0.0});  // no such object

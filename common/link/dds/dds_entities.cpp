@@ -3,6 +3,8 @@
 
 #include "common/link/dds/dds_participant.h"
 
+#include <string>
+
 namespace impetus {
 namespace {
 
@@ -44,16 +46,30 @@ dds_entity_t make_topic(dds_entity_t participant, const dds_topic_descriptor_t* 
                    std::string("cannot create DDS topic ") + name);
 }
 
+namespace {
+
+// "the topic NAME", and on a secured link why it may be refused.
+std::string about_topic(dds_entity_t topic, const char* role) {
+  char name[128] = {};
+  dds_get_name(topic, name, sizeof name);
+  return std::string(" to ") + role + " topic " + name +
+         " (on a secured link: do this participant's permissions, --dds-security DIR/permissions.p7s, allow it?)";
+}
+
+}  // namespace
+
 dds_entity_t make_writer(dds_entity_t publisher, dds_entity_t topic, Delivery delivery) {
   Qos qos;
   set_delivery(qos.qos, delivery);
-  return dds_check(dds_create_writer(publisher, topic, qos.qos, nullptr), "cannot create a DDS writer");
+  return dds_check(dds_create_writer(publisher, topic, qos.qos, nullptr),
+                   "cannot create a DDS writer" + about_topic(topic, "publish"));
 }
 
 dds_entity_t make_reader(dds_entity_t subscriber, dds_entity_t topic, Delivery delivery) {
   Qos qos;
   set_delivery(qos.qos, delivery);
-  return dds_check(dds_create_reader(subscriber, topic, qos.qos, nullptr), "cannot create a DDS reader");
+  return dds_check(dds_create_reader(subscriber, topic, qos.qos, nullptr),
+                   "cannot create a DDS reader" + about_topic(topic, "subscribe"));
 }
 
 }  // namespace impetus

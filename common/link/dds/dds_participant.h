@@ -13,7 +13,10 @@ namespace impetus {
 // "domain D partition 'P'", for messages.
 std::string describe(const DdsLinkOptions& options);
 
-// A participant in `options.domain_id`, deleted with everything it created. The domain is created on first use in the
+// A participant in `options.domain_id`, deleted with everything it created. With `options.security_dir` it joins
+// secured (DDS Security's built-in plugins, shipped with Cyclone DDS): the folder must hold identity_ca.pem,
+// permissions_ca.pem, governance.p7s (the shared trust and rules) and cert.pem, key.pem, permissions.p7s (this
+// participant's identity and grants), as scripts/dds_security.sh makes them; a missing one is named. The domain is created on first use in the
 // process with the configuration dds_domain_config() gives; later participants share it. Throws std::runtime_error
 // naming the domain if DDS refuses (a bad configuration in CYCLONEDDS_URI, no usable network interface).
 class DdsParticipant {

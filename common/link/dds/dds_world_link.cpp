@@ -4,6 +4,7 @@
 #include "common/link/dds/dds_codec.h"
 #include "common/link/dds/dds_entities.h"
 #include "common/link/shm/seqlock.h"
+#include "common/runtime/message_text.h"
 #include "common/runtime/process.h"
 
 #include <dds/dds.h>
@@ -491,8 +492,12 @@ DdsWorldLinkClient::DdsWorldLinkClient(const DdsLinkOptions& options, ClockMode 
     if (std::chrono::steady_clock::now() > give_up || g_stop_requested.load()) {
       const std::string where = describe(options);
       if (world == 0) {
-        throw std::runtime_error("no world manager answered on " + where + " within " + std::to_string(wait_s) +
-                                 " s (is it running with --link dds and the same --dds-domain and --dds-partition?)");
+        throw std::runtime_error(
+            "no world manager answered on " + where + " within " + readable(wait_s) +
+            " s (is it running with --link dds and the same --dds-domain and --dds-partition" +
+            (options.security_dir.empty()
+                 ? std::string(", and is it open? a secured world answers only secured participants)")
+                 : std::string(", and secured with credentials of the same CAs? scripts/dds_security.sh)")));
       }
       throw std::runtime_error("the world on " + where + " gave this controller " + std::to_string(served) + " of " +
                                std::to_string(endpoints) + " endpoint slot(s) within " + std::to_string(wait_s) +
