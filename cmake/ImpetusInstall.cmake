@@ -42,6 +42,9 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/ImpetusConfigVersion.cmak
                                  COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/ImpetusConfig.cmake ${PROJECT_BINARY_DIR}/ImpetusConfigVersion.cmake
         DESTINATION ${IMPETUS_INSTALL_CMAKEDIR})
+# The way up from LIBDIR/pkgconfig to the prefix ("../.." for lib, "../../.." for lib/x86_64-linux-gnu), so the file
+# names the prefix it was installed into, whatever --prefix said.
+file(RELATIVE_PATH IMPETUS_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
 configure_file(${PROJECT_SOURCE_DIR}/cmake/impetus.pc.in ${PROJECT_BINARY_DIR}/impetus.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/impetus.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 

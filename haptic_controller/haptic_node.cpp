@@ -136,7 +136,11 @@ void HapticNode::log_tick(Endpoint& endpoint, std::uint64_t tick, double now_s, 
 }
 
 bool HapticNode::lockstep_tick(std::uint64_t t) {
-  if (t >= max_ticks() || stop_requested() || !device_.wait_attached()) return false;
+  if (t >= max_ticks()) {
+    duration_reached_ = true;  // the device was still playing: the trial was cut at --duration
+    return false;
+  }
+  if (stop_requested() || !device_.wait_attached()) return false;
   // Exactly t·T: interpolation weights are then tick counts over n, the same in every run.
   const double now_s = static_cast<double>(t) * period_s_;
   tick(t, now_s, period_s_, 0);
@@ -239,6 +243,7 @@ void HapticNode::run_realtime() {
     tick(timing.index, timing.now_s, timing.elapsed_s, timing.lateness_ns);
     if (timing.index % kStatsEveryTicks == 0) publish_stats(&clock);
   }
+  if (clock.ticks() >= ticks) duration_reached_ = true;
   // The device's minimum output as the servo stops: the last force commanded would otherwise stay on the fingers.
   commands_.fill(FingerCommand{});
   device_.command_fingers(clock.ticks(), commands_.data());
@@ -328,6 +333,7 @@ nlohmann::json HapticNode::summary() const {
   haptic.update(nlohmann::json{
       {"ticks", endpoints_[0]->servo.counters().ticks},
       {"rate_hz", options_.rate_hz},
+      {"duration_reached", duration_reached_},
       {"faults", faults},
       {"saturations", device_.counters().saturations},
       {"devices_lost", device_.counters().devices_lost},

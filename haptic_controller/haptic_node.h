@@ -70,6 +70,8 @@ class HapticNode final : public FollowerStepper {
   // log cannot be opened.
   HapticNode(const HapticNodeOptions& options, WorldLinkClient& world, HapticDevice& device);
 
+  // Whether the trial ended at --duration (a trajectory longer than it was cut; the summary's "duration_reached").
+  bool duration_reached() const { return duration_reached_; }
   // Runs until the duration, a stop request, or (lockstep) no device. Returns the exit status.
   int run();
 
@@ -114,6 +116,7 @@ class HapticNode final : public FollowerStepper {
   nlohmann::json endpoint_summary(const Endpoint& endpoint) const;
 
   HapticNodeOptions options_;
+  bool duration_reached_ = false;  // the trial ended at options_.duration_s, not because the device left
   double period_s_;
   WorldLinkClient& world_;
   bool cut_short_ = false;  // lockstep: the world or the device went away mid-trial

@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
                  "--shm for its device, on one world");
   app.add_flag("!--no-realtime-priority", options.realtime_priority,
                "do not ask for SCHED_FIFO and mlockall in real time");
-  CLI11_PARSE(app, argc, argv);
+  if (const std::optional<int> status = parse_flags(app, "haptic_controller", argc, argv)) return *status;
 
   return run_node("haptic_controller", [&] {
     options.haptic_session = new_session_id();
@@ -90,6 +90,10 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(counters.ticks), static_cast<unsigned long long>(counters.faults),
                  static_cast<unsigned long long>(counters.force_clamps),
                  static_cast<unsigned long long>(device.device().counters().saturations));
+    if (node.duration_reached()) {
+      std::fprintf(stderr, "haptic_controller: warning: the trial stopped at --duration %g s, before the device's "
+                   "trajectory ended\n", options.duration_s);
+    }
     return status;
   });
 }

@@ -4,6 +4,11 @@
 #   scripts/build.sh [--daemons] [BUILD_DIR [extra cmake -D options...]]     default BUILD_DIR: build (Release)
 #   --daemons   build only world_manager, haptic_controller, spidar_sim and viewer (what the demo needs), not the tests
 set -euo pipefail
+case "${1:-}" in
+  -h|--help) sed -n '3,5p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  --daemons|-D*|"") ;;
+  -*) echo "build.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+esac
 cd "$(dirname "$0")/.."
 targets=()
 if [ "${1:-}" = "--daemons" ]; then

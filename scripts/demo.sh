@@ -6,6 +6,9 @@
 # live at http://127.0.0.1:8080/ (the finger waits 5 s for you to open it); afterwards the demo says how to replay it.
 #   scripts/demo.sh [extra scripts/run.sh arguments, e.g. --coupling position or --view-listen 127.0.0.1:9000]
 set -euo pipefail
+for arg in "$@"; do
+  case "$arg" in -h|--help) sed -n '3,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
+done
 cd "$(dirname "$0")/.."
 bash scripts/build.sh --daemons build
 out=out/demo

@@ -8,7 +8,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 browser=0
-[ "${1:-}" = "--browser" ] && browser=1
+case "${1:-}" in
+  -h|--help) sed -n '3,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  --browser) browser=1 ;;
+  "") ;;
+  *) echo "deps.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+esac
 IMPETUS_PACKAGES=(cmake g++ make pkg-config libeigen3-dev libode-dev libboost-dev catch2 nlohmann-json3-dev
                   libcli11-dev python3-matplotlib python3-numpy python3-tqdm
                   pybind11-dev python3-dev  # the impetus Python module (python/)

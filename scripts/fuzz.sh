@@ -9,6 +9,7 @@
 # Needs clang and libclang-rt-<version>-dev (not in scripts/deps.sh: the default test suite replays the corpus with
 # g++ and does not need them).
 set -euo pipefail
+case "${1:-}" in -h|--help) sed -n '3,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
 cd "$(dirname "$0")/.."
 
 seconds=60

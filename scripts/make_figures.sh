@@ -3,6 +3,11 @@
 # Regenerates the figures and tables docs/results.md shows (docs/*.png, docs/*.md) from real lockstep runs.
 #   scripts/make_figures.sh
 set -euo pipefail
+case "${1:-}" in
+  -h|--help) sed -n '3,4p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  "") ;;
+  *) echo "make_figures.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+esac
 cd "$(dirname "$0")/.."
 bash scripts/build.sh build >/dev/null
 mkdir -p docs

@@ -107,6 +107,20 @@ if ((${#users[@]})) && [ "$clock" = lockstep ]; then
   haptic_args+=(--followers "${#users[@]}")  # the first controller leads, and starts when every user is there
 fi
 
+# Every process's flags are checked before any starts (--check-flags parses them and exits): a bad value is one
+# message and status 2, not three daemons started and stopped.
+check_flags() {
+  local bin="$1" message
+  shift
+  if ! message="$("$build/$bin/$bin" "$@" --check-flags 2>&1 >/dev/null)"; then
+    echo "run.sh: $bin: ${message:-its flags were refused}" >&2
+    exit 2
+  fi
+}
+check_flags world_manager "${world_args[@]}"
+check_flags haptic_controller "${haptic_args[@]}"
+check_flags spidar_sim "${device_args[@]}"
+
 pids=()
 viewer_pid=""
 stop_all() {
@@ -206,6 +220,11 @@ for ((u = 1; u <= ${#users[@]}; ++u)); do
     cat "$out/user$u.haptic.err" "$out/user$u.device.err" >&2
     status=1
   fi
+done
+# The processes' warnings (objects placed inside each other or too light for the coupling, a trajectory cut at
+# --duration) reach the user here, not only the .err files.
+for err in "$out"/*.err; do
+  [ -f "$err" ] && grep -h "warning:" "$err" | sed 's/^/run.sh: /' >&2 || true
 done
 end=$(date +%s.%N)
 trap - INT TERM

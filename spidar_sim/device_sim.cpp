@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <stdexcept>
 #include <string>
@@ -13,11 +14,52 @@
 namespace impetus {
 
 
+std::string trajectory_problem(const Trajectory& trajectory, const SpidarGeometry& geometry) {
+  const double half_m = 0.5 * geometry.frame_side_m;
+  const auto outside = [&](const Vec3& point_m) {
+    for (int a = 0; a < 3; ++a) {
+      if (!(std::abs(point_m[a] - geometry.centre_m[a]) <= half_m)) return true;
+    }
+    return false;
+  };
+  // A line stays inside a cube when its ends do; an arc is looked at in 64 places (a bulge between two of them is
+  // at most r·(1 − cos(π/64)), 0.1 % of its radius).
+  constexpr int kArcSamples = 64;
+  for (const TrajectorySegment& segment : trajectory.segments()) {
+    const double span_s = segment.end_s - segment.begin_s;
+    const int samples = segment.path == TrajectorySegment::Path::arc ? kArcSamples : 1;
+    for (int k = 0; k <= samples; ++k) {
+      const double t_s = segment.begin_s + span_s * static_cast<double>(k) / samples;
+      const Vec3 point_m = trajectory.position_at(t_s);
+      if (!outside(point_m)) continue;
+      char text[256];
+      std::snprintf(text, sizeof text,
+                    "at t = %g s the target (%g, %g, %g) m is outside the device's frame, the %g m cube around "
+                    "(%g, %g, %g) m, where the strings cannot hold the finger",
+                    t_s, point_m[0], point_m[1], point_m[2], geometry.frame_side_m, geometry.centre_m[0],
+                    geometry.centre_m[1], geometry.centre_m[2]);
+      return text;
+    }
+  }
+  return "";
+}
+
+namespace {
+
+const Trajectory& checked(const Trajectory& trajectory, const SpidarGeometry& geometry) {
+  if (const std::string problem = trajectory_problem(trajectory, geometry); !problem.empty()) {
+    throw TrajectoryError(trajectory.description() + ": " + problem);
+  }
+  return trajectory;
+}
+
+}  // namespace
+
 DeviceSim::DeviceSim(const SpidarGeometry& geometry, HardwareParams hardware, FingerParams finger,
                      Trajectory trajectory)
     : hardware_(geometry, hardware),
       trajectory_(std::move(trajectory)),
-      finger_(finger, to_eigen(trajectory_.position_at(0.0))) {
+      finger_(finger, to_eigen(checked(trajectory_, geometry).position_at(0.0))) {
   state_.encoder_counts = hardware_.encoder_counts(finger_.position_m());
 }
 

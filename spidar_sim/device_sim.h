@@ -30,9 +30,14 @@ struct DeviceLogRow {
   std::array<std::int64_t, kStringCount> encoder_counts;
 };
 
+// Why `trajectory` cannot be played on a device of `geometry`, or "" if it can: a target outside the frame's cube, where
+// no string tension holds the finger (the device would only saturate). Names the time and the point.
+std::string trajectory_problem(const Trajectory& trajectory, const SpidarGeometry& geometry);
+
 class DeviceSim {
  public:
-  // Throws std::invalid_argument (from the parts) if the geometry or parameters are unusable.
+  // Throws std::invalid_argument (from the parts) if the geometry or parameters are unusable, and TrajectoryError if
+  // the trajectory leaves the device's frame (where the strings cannot hold the finger: trajectory_problem).
   DeviceSim(const SpidarGeometry& geometry, HardwareParams hardware, FingerParams finger, Trajectory trajectory);
 
   // Advances one device tick of dt_s (finite, > 0 and at most kMaxTick_s; else std::invalid_argument) and returns the

@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
       ->check(positive_number(kMaxFingerMass_kg));
   app.add_option("--motor-lag", hardware.motor_time_constant_s, "motor time constant, s (0 = ideal)")
       ->check(number_in(0.0, kMaxMotorLag_s));
-  CLI11_PARSE(app, argc, argv);
+  if (const std::optional<int> status = parse_flags(app, "spidar_sim", argc, argv)) return *status;
 
   if (trajectory_spec.empty() && finger_specs.empty()) {
     std::fprintf(stderr, "spidar_sim: error: give --trajectory, or --finger NAME=TRAJECTORY for each finger\n");

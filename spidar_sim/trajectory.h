@@ -146,6 +146,7 @@ class Trajectory {
   Trajectory held_until(double end_s) const;
   // The spec or path this trajectory was made from, for logs and run summaries.
   const std::string& description() const { return description_; }
+  const std::vector<TrajectorySegment>& segments() const { return segments_; }
 
  private:
   // Index of the first segment still running at t_s (t_s < its end), the last if none is; `hint` is tried first.

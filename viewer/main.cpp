@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingDirectory);
   app.add_option("--duration", options.duration_s, "seconds to serve (default: until stopped)")
       ->check(positive_number(kMaxFlagSeconds));
-  CLI11_PARSE(app, argc, argv);
+  if (const std::optional<int> status = parse_flags(app, "viewer", argc, argv)) return *status;
   options.web_dir = web_dir;
   return run_node("viewer", [&] {
     view::ViewerNode node(options, argv[0]);

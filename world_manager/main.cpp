@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   app.add_option("--substeps", options.substeps, "ODE steps per world period (default: the scene's physics.substeps)")
       ->check(whole_number_in(1, limits::kMaxSubsteps));
   app.add_option("--coupling", options.coupling, "impulse (paper §2.2), position (the previous method) or local")
-      ->transform(CLI::CheckedTransformer(kCouplingNames, CLI::ignore_case));
+      ->transform(enum_names(kCouplingNames));
   add_clock_flag(app, options.clock);
   app.add_option("--phase", options.phase_ticks, "lockstep: world step i happens at haptic tick i*n + PHASE")
       ->check(whole_number_in(0, kMaxPhaseTicks));
@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
         throw CLI::Success();  // printed: exit 0 before the required flags are checked
       },
       "print the couplings, engines, shapes and scene defaults as JSON, and exit");
-  CLI11_PARSE(app, argc, argv);
+  if (const std::optional<int> status = parse_flags(app, "world_manager", argc, argv)) return *status;
 
   return run_node("world_manager", [&] {
     prepare_engines();
@@ -75,8 +75,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "world_manager: '%s', %zu objects, %.1f Hz, %s coupling, %s clock, link %s\n",
                  options.scene_path.c_str(), node.world().scene().objects.size(), info.world_rate_hz,
                  to_string(info.coupling), to_string(info.clock), link_name(*link).c_str());
-    const std::string warnings = node.warnings();
-    if (!warnings.empty()) std::fprintf(stderr, "world_manager: warning: %s\n", warnings.c_str());
+    for (const std::string& warning : node.warnings()) {
+      std::fprintf(stderr, "world_manager: warning: %s\n", warning.c_str());
+    }
     const int status = node.run();
     nlohmann::json summary = node.summary();
     if (nlohmann::json dds = link_summary(*link, link_options); !dds.is_null()) summary["world"]["dds"] = dds;

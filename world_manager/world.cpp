@@ -37,6 +37,7 @@ World::World(const Scene& scene, const WorldOptions& options)
   if (options.world_session == 0) throw std::invalid_argument("world_session must be nonzero");
 
   engine_ = make_engine(scene_);
+  start_overlaps_ = engine_->overlaps(kStartOverlap_m);
   const CouplingContext context{scene_, period_s_, scene_.physics.substeps, *engine_, states_, applied_};
   coupling_ = make_coupling(options.coupling, context, stiffness_Npm, damping_Nspm);
 

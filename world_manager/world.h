@@ -83,6 +83,12 @@ class World {
   std::size_t endpoint_slots() const { return slots_used_; }
   // Objects the engine took out of the simulation after the solver threw them out of range (RigidBodyEngine::escaped).
   const std::vector<std::size_t>& escaped() const;
+  // Pairs the scene placed inside each other by more than kStartOverlap_m, as the engine found them at the start (the
+  // solver pushes them apart on the first steps: a sphere below the floor leaves it at about 0.5 m/s).
+  const std::vector<RigidBodyEngine::Overlap>& start_overlaps() const { return start_overlaps_; }
+  // Deeper than any resting contact sinks (the contact spring's give under a body's weight is microns), shallower
+  // than a placement mistake a user would notice.
+  static constexpr double kStartOverlap_m = 1e-4;
 
   // Whether dynamic object `id` sleeps (scene physics.auto_disable): at rest, not simulated until something wakes it.
   bool asleep(std::size_t id) const { return engine_->asleep(id); }
@@ -150,6 +156,7 @@ class World {
   WorldOptions options_;
   double period_s_;
   std::unique_ptr<RigidBodyEngine> engine_;
+  std::vector<RigidBodyEngine::Overlap> start_overlaps_;
   std::vector<ObjectState> states_;
   ImpulseLedger ledger_;
   // The same running totals' first moments in time (ObjectImpulse::impulse_moment_Nss), differenced with the same

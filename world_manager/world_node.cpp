@@ -69,19 +69,32 @@ WorldLinkInfo WorldNode::link_info() const {
   return info;
 }
 
-std::string WorldNode::warnings() const {
-  if (options_.coupling != Coupling::impulse) return "";
-  const double max_force_N = SpidarGeometry{}.max_force_N;
-  const LightObjects light = light_for_impulse_coupling(scene_, world_.world_period_s(), max_force_N);
-  if (light.count == 0) return "";
+std::vector<std::string> WorldNode::warnings() const {
+  std::vector<std::string> out;
   char text[512];
-  std::snprintf(text, sizeof text,
-                "%zu object(s) are light for impulse coupling at %.1f Hz, the lightest '%s' (%.3g kg): the device's "
-                "%.0f N held for one world period would give it %.3g m/s; a push can launch it. Use --coupling "
-                "local or a faster --rate.",
-                light.count, 1.0 / world_.world_period_s(), light.lightest_name.c_str(), light.lightest_mass_kg,
-                max_force_N, light.lightest_speed_mps);
-  return text;
+  if (options_.coupling == Coupling::impulse) {
+    const double max_force_N = SpidarGeometry{}.max_force_N;
+    const LightObjects light = light_for_impulse_coupling(scene_, world_.world_period_s(), max_force_N);
+    if (light.count > 0) {
+      std::snprintf(text, sizeof text,
+                    "%zu object(s) are light for impulse coupling at %.1f Hz, the lightest '%s' (%.3g kg): the "
+                    "device's %.0f N held for one world period would give it %.3g m/s; a push can launch it. Use "
+                    "--coupling local or a faster --rate.",
+                    light.count, 1.0 / world_.world_period_s(), light.lightest_name.c_str(), light.lightest_mass_kg,
+                    max_force_N, light.lightest_speed_mps);
+      out.emplace_back(text);
+    }
+  }
+  const std::size_t floor_id = scene_.objects.size();
+  for (const RigidBodyEngine::Overlap& overlap : world_.start_overlaps()) {
+    const std::string other = overlap.b == floor_id ? "the floor" : "'" + scene_.objects[overlap.b].name + "'";
+    std::snprintf(text, sizeof text,
+                  "'%s' starts %.3g mm inside %s (the engine will push them apart on the first steps); place them "
+                  "apart in the scene",
+                  scene_.objects[overlap.a].name.c_str(), overlap.depth_m * 1e3, other.c_str());
+    out.emplace_back(text);
+  }
+  return out;
 }
 
 void WorldNode::connect_view(WorldViewPublisher& view) {
@@ -252,6 +265,7 @@ nlohmann::json WorldNode::summary() const {
             {"channel_repairs", link_ != nullptr ? link_->channel_repairs() : 0},
             {"foreign_reports", world_.foreign_reports()},
             {"clipped_reports", world_.clipped_reports()},
+            {"warnings", warnings()},
             {"clipped_impulse_Ns", world_.clipped_impulse_Ns()},
             {"stale_finger_steps", stale_finger_steps_},
             {"escaped_objects", escaped_names()},

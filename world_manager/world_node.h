@@ -57,8 +57,9 @@ class WorldNode final : public WorldStepper {
   // One world step (the in-process link's lockstep turn).
   void step_world() override;
 
-  // Start-up warnings a user should see (objects too light for the coupling at this rate), one per line; "" if none.
-  std::string warnings() const;
+  // Start-up warnings a user should see: objects too light for the coupling at this rate, objects placed inside each
+  // other or the floor. Also in the summary ("world": {"warnings": [...]}).
+  std::vector<std::string> warnings() const;
   // The world half of summary.json: objects, world statistics, config.
   nlohmann::json summary() const;
   const World& world() const { return world_; }

@@ -92,7 +92,25 @@ CLI::Validator whole_number_in(std::uint64_t lowest, std::uint64_t highest) {
 
 void add_clock_flag(CLI::App& app, ClockMode& clock) {
   app.add_option("--clock", clock, "realtime or lockstep (all three processes must agree)")
-      ->transform(CLI::CheckedTransformer(kClockNames, CLI::ignore_case));
+      ->transform(enum_names(kClockNames));
+}
+
+const char* impetus_version() { return IMPETUS_VERSION; }
+
+std::optional<int> parse_flags(CLI::App& app, const char* name, int argc, char** argv) {
+  app.set_version_flag("--version", std::string(name) + " " + impetus_version());
+  bool check_only = false;
+  app.add_flag("--check-flags", check_only, "check the flags and exit (0: good, 2: bad usage with a message); starts "
+               "nothing (scripts/run.sh checks every process's flags before it starts any)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    // --help, --version and a flag that printed what was asked and ended the parse (CLI::Success) are code 0; any
+    // other is bad usage. app.exit prints the help, the version or the message naming the flag.
+    return app.exit(error) == 0 ? 0 : 2;
+  }
+  if (check_only) return 0;
+  return std::nullopt;
 }
 
 void add_shm_flag(CLI::App& app, std::string& shm) {
@@ -104,7 +122,7 @@ void add_link_flags(CLI::App& app, LinkOptions& link) {
   app.add_option("--link", link.kind,
                  "transport of the world link: shm (shared memory on this host, the default) or dds (DDS, world and "
                  "controller on the same or different hosts; real time only)")
-      ->transform(CLI::CheckedTransformer(kLinkNames, CLI::ignore_case));
+      ->transform(enum_names(kLinkNames));
   app.add_option("--dds-domain", link.dds.domain_id, "--link dds: the DDS domain id, 0 to 232 (0)")
       ->check(whole_number_in(0, kMaxDdsDomainId));
   app.add_option("--dds-partition", link.dds.partition,

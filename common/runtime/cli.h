@@ -7,15 +7,19 @@
 #include "common/contract/limits.h"
 #include "common/link/link_options.h"
 #include "common/runtime/lockstep.h"
+#include "common/runtime/message_text.h"
 #include "common/runtime/process.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cctype>
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace impetus {
 
@@ -24,6 +28,25 @@ inline const std::map<std::string, ClockMode> kClockNames{{"realtime", ClockMode
                                                           {"lockstep", ClockMode::lockstep}};
 inline const std::map<std::string, Coupling> kCouplingNames{
     {"impulse", Coupling::impulse}, {"position", Coupling::position}, {"local", Coupling::local}};
+
+// A CLI11 transform for an enum flag: its name (any case) becomes the enum's value; another text is refused with
+// "must be a, b or c, not 'x'" (CLI11's own CheckedTransformer prints its mapping table).
+template <class T>
+CLI::Validator enum_names(const std::map<std::string, T>& names) {
+  return CLI::Validator(
+      [&names](std::string& value) {
+        std::string lower = value;
+        for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        if (const auto found = names.find(lower); found != names.end()) {
+          value = std::to_string(static_cast<long long>(found->second));
+          return std::string();
+        }
+        std::vector<std::string> choices;
+        for (const auto& [name, unused] : names) choices.push_back(name);
+        return "must be " + one_of(choices) + ", not '" + value + "'";
+      },
+      "");
+}
 
 // A CLI11 validator for file paths we will write: not empty, the directory must exist and be writable.
 std::string check_writable_path(const std::string& path);
@@ -38,6 +61,13 @@ CLI::Validator whole_number_in(std::uint64_t lowest, std::uint64_t highest);
 // Longest --duration, --world-wait or --attach-timeout: 10^7 s (116 days) is longer than any session, and tick counts
 // at 20 kHz stay exact far beyond it, so the bound only rejects typing mistakes and values that would overflow.
 inline constexpr double kMaxFlagSeconds = 1e7;
+
+// Adds --version ("NAME VERSION") and --check-flags, and parses argv. Returns the exit status main must return at once,
+// or nothing to go on: 0 after --help, --version or --check-flags, which print and do nothing else; 2 for bad usage (an unknown flag, a bad or missing
+// value), after a message naming it. Bad input found later (a file that cannot be used) is run_node's: status 1.
+std::optional<int> parse_flags(CLI::App& app, const char* name, int argc, char** argv);
+// The project's version ("0.2.0").
+const char* impetus_version();
 
 void add_clock_flag(CLI::App& app, ClockMode& clock);
 void add_shm_flag(CLI::App& app, std::string& shm);

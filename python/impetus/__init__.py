@@ -16,10 +16,22 @@ Ctrl-C (SIGINT in the main thread) ends a running trial between two ticks and ra
 import json
 import numbers
 import pathlib
+import sys
 import tempfile
 import time
+import warnings
 
-from . import _impetus
+try:
+    from . import _impetus
+except ImportError as _error:
+    # The compiled half is built for one CPython minor version (its ABI tag) and needs numpy.
+    _built_for = "@Python3_VERSION_MAJOR@.@Python3_VERSION_MINOR@"
+    _running = f"{sys.version_info.major}.{sys.version_info.minor}"
+    if _running != _built_for:
+        raise ImportError(f"impetus: its compiled module was built for CPython {_built_for}, and this is "
+                          f"{_running} ({sys.executable}): run it with /usr/bin/python3 (Debian's {_built_for}) or "
+                          "rebuild Impetus for this Python") from _error
+    raise ImportError(f"impetus: its compiled module cannot be loaded: {_error}") from _error
 
 __version__ = "@PROJECT_VERSION@"
 
@@ -187,6 +199,13 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
         trajectory_text = " ".join(fingers) if fingers else str(trajectory)
         summary["config"].update({"scene": str(scene), "trajectory": trajectory_text, "duration_s": float(duration_s),
                                   "wall_time_s": time.monotonic() - start})
+        # What the daemons print as warnings, where a Python user looks: the world's start-up warnings (objects placed
+        # inside each other, too light for the coupling) and a trajectory cut at duration_s.
+        for warning in summary.get("world", {}).get("warnings", []):
+            warnings.warn(f"impetus: {warning}", RuntimeWarning, stacklevel=2)
+        if summary.get("haptic", {}).get("duration_reached"):
+            warnings.warn(f"impetus: the trial stopped at duration_s={float(duration_s):g} s, before the trajectory "
+                          "ended", RuntimeWarning, stacklevel=2)
         if out_dir is not None:
             (directory / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
         table = {key: read_log(directory / name) for key, name in LOG_FILES.items()} if logs else {}

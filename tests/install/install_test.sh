@@ -68,7 +68,18 @@ viewer_serves() {
 }
 viewer_serves "$prefix"
 
-PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs impetus | grep -q -- "-limpetus_loop"
+# pkg-config names the prefix the files were installed into (not the configured /usr/local), in a prefix and in the
+# unpacked DEB alike: its include and lib directories hold the headers and libraries.
+pkg_config_finds() {  # pkg_config_finds PKGCONFIG_DIR
+  local includedir libdir
+  PKG_CONFIG_PATH="$1" pkg-config --cflags --libs impetus | grep -q -- "-limpetus_loop" ||
+    { echo "install_test: pkg-config in $1 does not list -limpetus_loop" >&2; exit 1; }
+  includedir="$(PKG_CONFIG_PATH="$1" pkg-config --variable=includedir impetus)"
+  libdir="$(PKG_CONFIG_PATH="$1" pkg-config --variable=libdir impetus)"
+  [ -f "$includedir/loop/in_process_trial.h" ] && [ -f "$libdir/libimpetus_loop.a" ] ||
+    { echo "install_test: pkg-config in $1 points to $includedir and $libdir, which lack the files" >&2; exit 1; }
+}
+pkg_config_finds "$prefix/lib/pkgconfig"
 
 (cd "$build" && cpack -G DEB -B "$scratch/deb" > "$scratch/cpack.log")
 deb=$(ls "$scratch"/deb/impetus_*.deb)
@@ -76,4 +87,5 @@ dpkg -x "$deb" "$scratch/root"
 "$scratch/root/usr/bin/world_manager" --help | grep -q -- "--scene"
 python_trial "$scratch/root/usr"
 viewer_serves "$scratch/root/usr"
+pkg_config_finds "$(dirname "$(find "$scratch/root/usr" -name impetus.pc | head -1)")"
 echo "install_test: installed, example built and ran, package $(basename "$deb") $(du -k "$deb" | cut -f1) KiB"

@@ -45,11 +45,71 @@ TEST_CASE("every binary has --help") {
   }
 }
 
+TEST_CASE("every binary has --version, bad usage exits 2 and bad input 1") {
+  for (const char* name : {"world_manager", "haptic_controller", "spidar_sim", "viewer"}) {
+    INFO(name);
+    const Result version = run(test::binary(name) + " --version", std::string("version-") + name);
+    CHECK(version.status == 0);
+    CHECK_THAT(version.output, Catch::StartsWith(std::string(name) + " ") && Catch::Contains("."));
+    const std::string required = std::string(name) == "world_manager" ? " --scene scenes/tap.json" : "";
+    const Result unknown = run(test::binary(name) + required + " --no-such-flag", std::string("usage-") + name);
+    CHECK(unknown.status == 2);
+    CHECK_THAT(unknown.output, Catch::Contains("--no-such-flag"));
+  }
+  CHECK(run(test::binary("world_manager") + " --scene scenes/tap.json --coupling spring", "usage-enum").status == 2);
+  CHECK(run(test::binary("world_manager") + " --scene scenes/tap.json --check-flags", "check-flags").status == 0);
+  // A file that exists but cannot be used is bad input.
+  const auto bad_scene = test::out_dir("bad-input-scene") / "bad_scene.json";
+  std::ofstream(bad_scene) << R"({"objects": [{"name": "c", "shape": "cube"}]})";
+  const Result bad_input = run(test::binary("world_manager") + " --scene " + bad_scene.string() +
+                                   " --shm impetus_test_bad_" + std::to_string(getpid()),
+                               "bad-input");
+  CHECK(bad_input.status == 1);
+  CHECK_THAT(bad_input.output, Catch::Contains("bad_scene.json") && Catch::Contains("cube"));
+}
+
+TEST_CASE("a script's --help prints and does nothing else, and run.sh checks every flag before starting anything") {
+  namespace fs = std::filesystem;
+  const fs::path source(IMPETUS_SOURCE_DIR);
+  // demo.sh --help used to delete out/demo; make_figures.sh --help regenerated the tracked figures; build.sh --help
+  // handed --help to cmake as a directory.
+  const fs::path marker = source / "out" / "demo" / "kept-by-help";
+  fs::create_directories(marker.parent_path());
+  std::ofstream(marker) << "a trial's output\n";
+  const auto figure_time = fs::last_write_time(source / "docs" / "phase.md");
+  for (const char* script : {"demo.sh", "build.sh", "deps.sh", "fuzz.sh", "make_figures.sh", "run.sh", "bench.sh",
+                             "test.sh", "dds_security.sh"}) {
+    INFO(script);
+    const Result help = run(std::string("bash scripts/") + script + " --help", std::string("script-help-") + script);
+    CHECK(help.status == 0);
+    CHECK(help.output.size() > 40);
+  }
+  CHECK(fs::exists(marker));
+  fs::remove(marker);
+  CHECK(fs::last_write_time(source / "docs" / "phase.md") == figure_time);
+  CHECK_FALSE(fs::exists(source / "--help"));
+  for (const char* script : {"deps.sh", "make_figures.sh", "build.sh"}) {
+    INFO(script);
+    CHECK(run(std::string("bash scripts/") + script + " --bogus", std::string("script-bad-") + script).status == 2);
+  }
+  // A bad value: one message and status 2, and no daemon started (no summary, no segment).
+  const auto dir = test::out_dir("run-bad-coupling");
+  const Result bad = run("bash scripts/run.sh --scene scenes/tap.json --trajectory tap --coupling spring --out " +
+                             (dir / "trial").string(),
+                         "run-bad-coupling-output");
+  CHECK(bad.status == 2);
+  CHECK_THAT(bad.output, Catch::Contains("run.sh: world_manager") && Catch::Contains("spring"));
+  CHECK_FALSE(fs::exists(dir / "trial" / "world.json"));
+  CHECK_FALSE(fs::exists(dir / "trial" / "haptic.json"));
+}
+
 TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment left behind") {
   const std::string shm = "impetus_test_cli_" + std::to_string(getpid());
   const std::string world = test::binary("world_manager") + " --shm " + shm + " ";
   const std::string haptic = test::binary("haptic_controller") + " --shm " + shm + " --world-wait 0.2 ";
   const std::string device = test::binary("spidar_sim") + " --shm " + shm + " --attach-timeout 0.2 ";
+  const auto far_csv = test::out_dir("cli-far") / "far.csv";  // a finger 5 m out of the 0.4 m frame
+  std::ofstream(far_csv) << "t,x,y,z\n0,0,0,0.05\n1,5,0,0.05\n";
   struct Case {
     std::string command;
     std::string expected;
@@ -75,6 +135,7 @@ TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment 
       {haptic, "world link"},  // no world manager running
       {device + "--trajectory tap:speed=-1", "speed"},
       {device + "--trajectory nosuchfile.csv", "nosuchfile.csv"},
+      {device + "--trajectory " + far_csv.string(), "outside the device's frame"},
       {device + "--trajectory tap", "device port"},  // no haptic controller running
       // A phase is an offset within one world period; 2^64 must not saturate into a valid-looking value.
       {world + "--scene scenes/tap.json --clock lockstep --phase 50", "the phase must be 0 to 49"},

@@ -13,6 +13,7 @@ import subprocess
 import sys
 import threading
 import unittest
+import warnings
 
 import numpy as np
 
@@ -248,6 +249,40 @@ class Arguments(unittest.TestCase):
             self.fail("the trial went on after Ctrl-C")
         print(f"  {out.strip()}")
         self.assertIn("interrupted after", out, err)
+
+    def test_warnings_reach_python(self):
+        # What the daemons print as warnings reaches a Python user as RuntimeWarning: a body placed inside the floor,
+        # and a trajectory cut at duration_s (it ended with exit 0 and no word before).
+        scene = OUT / "sunk.json"
+        scene.parent.mkdir(parents=True, exist_ok=True)
+        scene.write_text(json.dumps({"objects": [{"name": "ball", "shape": "sphere", "radius_m": 0.02, "dynamic": True,
+                                                  "mass_kg": 0.1, "position_m": [0.1, 0.1, 0.01]}]}))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            impetus.run_trial(scene, "tap", logs=False, duration_s=0.3)
+        messages = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+        self.assertTrue(any("'ball' starts 10 mm inside the floor" in m for m in messages), messages)
+        self.assertTrue(any("duration_s=0.3" in m for m in messages), messages)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            impetus.run_trial(self.scene(), "tap", "local", logs=False)
+        self.assertEqual([str(w.message) for w in caught], [])  # the shipped tap, local coupling: nothing to warn
+
+    def test_another_python_is_told_which_it_needs(self):
+        # The package without its compiled module, imported by an interpreter that says it is CPython 3.99: the
+        # ImportError names the version the module was built for, not a bare "No module named _impetus".
+        package = OUT / "no-module" / "impetus"
+        package.mkdir(parents=True, exist_ok=True)
+        (package / "__init__.py").write_text((pathlib.Path(impetus.__file__)).read_text())
+        code = ("import collections, sys\n"
+                "V = collections.namedtuple('V', 'major minor micro releaselevel serial')\n"
+                "sys.version_info = V(3, 99, 0, 'final', 0)\n"
+                f"sys.path.insert(0, {str(package.parent)!r})\n"
+                "import impetus\n")
+        result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("was built for CPython 3.", result.stderr)
+        self.assertIn("this is 3.99", result.stderr)
 
     def test_read_log_refuses_a_damaged_file(self):
         damaged = OUT / "damaged.csv"

@@ -167,3 +167,21 @@ TEST_CASE("log rows have one value per header column, time first") {
   CHECK(header.rfind("time_s,", 0) == 0);
   CHECK(std::stod(row) == Approx(kTick_s));
 }
+
+TEST_CASE("a trajectory that leaves the device's frame is refused, naming the time and the point") {
+  const SpidarGeometry geometry;  // a 0.4 m cube around (0, 0, 0.05)
+  std::istringstream outside("t,x,y,z\n0,0,0,0.05\n1,5,0,0.05\n");
+  const Trajectory far = impetus::parse_trajectory_csv(outside, "far.csv");
+  CHECK_THAT(impetus::trajectory_problem(far, geometry),
+             Catch::Contains("t = 1 s") && Catch::Contains("(5, 0, 0.05)") && Catch::Contains("0.4 m cube"));
+  CHECK_THROWS_WITH(DeviceSim(geometry, HardwareParams{}, FingerParams{}, far), Catch::StartsWith("far.csv: "));
+  // Every built-in the suite uses stays inside; an arc is looked at along its length, not only at its ends.
+  for (const char* spec : {"tap", "press", "slide", "circle"}) {
+    INFO(spec);
+    CHECK(impetus::trajectory_problem(load_trajectory(spec), geometry).empty());
+  }
+  CHECK_FALSE(impetus::trajectory_problem(load_trajectory("circle:radius=0.3"), geometry).empty());
+  // On the frame's face is inside.
+  std::istringstream edge("t,x,y,z\n0,0,0,0.05\n1,0.2,0,0.05\n");
+  CHECK(impetus::trajectory_problem(impetus::parse_trajectory_csv(edge, "edge.csv"), geometry).empty());
+}

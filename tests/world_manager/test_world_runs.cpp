@@ -160,3 +160,31 @@ TEST_CASE("the world reports how deep a body has been into the floor, and shorte
   for (int i = 0; i < 40; ++i) world->step(nullptr);
   CHECK(world->floor_penetration_max_m() < 1e-5);
 }
+
+TEST_CASE("bodies a scene places inside each other or the floor are found at the start, resting ones are not") {
+  using nlohmann::json;
+  const json document{
+      {"objects",
+       {{{"name", "sunk"}, {"shape", "sphere"}, {"radius_m", 0.02}, {"dynamic", true}, {"mass_kg", 0.1},
+         {"position_m", {0.0, 0.0, 0.01}}},  // 10 mm below the floor
+        {{"name", "a"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", true}, {"mass_kg", 0.1},
+         {"position_m", {0.2, 0.0, 0.025}}},  // resting on the floor: touching, not inside
+        {{"name", "b"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", true}, {"mass_kg", 0.1},
+         {"position_m", {0.245, 0.0, 0.025}}},  // 5 mm into a
+        {{"name", "wall"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", false},
+         {"position_m", {-0.2, 0.0, 0.025}}}}}};  // static on the floor: never reported
+  const auto world = make_world(impetus::parse_scene(document, "overlaps.json"));
+  const auto& overlaps = world->start_overlaps();
+  REQUIRE(overlaps.size() == 2);
+  CHECK(overlaps[0].a == 0);
+  CHECK(overlaps[0].b == 4);  // the floor
+  CHECK(overlaps[0].depth_m == Approx(0.01).epsilon(1e-6));
+  CHECK(overlaps[1].a == 1);
+  CHECK(overlaps[1].b == 2);
+  CHECK(overlaps[1].depth_m == Approx(0.005).epsilon(1e-6));
+  // The shipped scenes start clean.
+  for (const char* scene : {"tap.json", "stack.json", "shapes.json"}) {
+    INFO(scene);
+    CHECK(make_world(impetus::load_scene(impetus::test::scene_path(scene)))->start_overlaps().empty());
+  }
+}

@@ -558,4 +558,44 @@ ContactGraph& OdeEngine::contacts() { return ode_->contact_graph; }
 
 const std::vector<std::size_t>& OdeEngine::escaped() const { return ode_->escape_guard.escaped(); }
 
+std::vector<RigidBodyEngine::Overlap> OdeEngine::overlaps(double min_depth_m) const {
+  const Handles& ode = *ode_;
+  const Scene& scene = *ode.scene;
+  // Pairs by their boxes swept along x (O(n log n)), then each pair's contacts (dCollide, which changes nothing);
+  // the spaces are left alone so the steps that follow meet them exactly as they were.
+  struct Box {
+    std::size_t id;
+    Eigen::AlignedBox3d bounds;
+  };
+  std::vector<Box> boxes;
+  for (std::size_t id = 0; id < ode.geoms.size(); ++id) boxes.push_back({id, geom_bounds(ode.geoms[id])});
+  std::sort(boxes.begin(), boxes.end(), [](const Box& x, const Box& y) { return x.bounds.min().x() < y.bounds.min().x(); });
+  std::vector<Overlap> found;
+  const auto deepest = [&](dGeomID a, dGeomID b) {
+    dContactGeom contacts[kMaxContactsPerPair];
+    const int count = dCollide(a, b, kMaxContactsPerPair, contacts, sizeof(dContactGeom));
+    double depth_m = 0.0;
+    for (int c = 0; c < count; ++c) depth_m = std::max(depth_m, contacts[c].depth);
+    return depth_m;
+  };
+  const auto record = [&](std::size_t a, std::size_t b, double depth_m) {
+    if (depth_m > min_depth_m) found.push_back({std::min(a, b), std::max(a, b), depth_m});
+  };
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const Box& a = boxes[i];
+    for (std::size_t j = i + 1; j < boxes.size() && boxes[j].bounds.min().x() <= a.bounds.max().x(); ++j) {
+      const Box& b = boxes[j];
+      if (!(scene.objects[a.id].dynamic || scene.objects[b.id].dynamic) || !a.bounds.intersects(b.bounds)) continue;
+      record(a.id, b.id, deepest(ode.geoms[a.id], ode.geoms[b.id]));
+    }
+    if (ode.floor != nullptr && scene.objects[a.id].dynamic) {
+      record(a.id, ode.geoms.size(), deepest(ode.geoms[a.id], ode.floor));
+    }
+  }
+  std::sort(found.begin(), found.end(), [](const Overlap& x, const Overlap& y) {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  });
+  return found;
+}
+
 }  // namespace impetus

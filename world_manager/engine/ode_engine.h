@@ -45,6 +45,7 @@ class OdeEngine final : public RigidBodyEngine {
   const std::vector<std::size_t>& moved() const override;
   ContactGraph& contacts() override;
   const std::vector<std::size_t>& escaped() const override;
+  std::vector<Overlap> overlaps(double min_depth_m) const override;
 
  private:
   struct Handles;

@@ -56,6 +56,16 @@ class RigidBodyEngine {
 
   // The contacts recorded by the last step that recorded them (a sleeping body keeps those it fell asleep with).
   virtual ContactGraph& contacts() = 0;
+  // Two objects whose geometry overlaps (b: another object's id, or the object count for the floor) by depth_m.
+  struct Overlap {
+    std::size_t a = 0;
+    std::size_t b = 0;
+    double depth_m = 0.0;
+  };
+  // Every pair with a dynamic body that overlaps by more than `min_depth_m` now, in order of a, then b: what a scene
+  // placed inside another, which the solver would push apart on the first step. Changes nothing.
+  virtual std::vector<Overlap> overlaps(double min_depth_m) const = 0;
+
   // Objects taken out of the simulation because the solver threw them beyond kEscapeDistance_m (scene.h) or made their
   // state non-finite (engine/escape_guard.h, which every engine asks); they stay where they were taken out, at rest,
   // and collide with nothing. In order of escape.
