@@ -19,6 +19,7 @@ IMPETUS_PACKAGES=(cmake g++ make pkg-config libeigen3-dev libode-dev libboost-de
                   pybind11-dev python3-dev  # the impetus Python module (python/)
                   cyclonedds-dev cyclonedds-tools  # the world link over DDS (common/link/dds; idlc)
                   iproute2  # network namespaces: the DDS tests' and benchmark's two hosts
+                  openssl  # the secured DDS link's certificates and signed documents (scripts/dds_security.sh)
                   curl  # the install test fetches the installed viewer's page
                   time  # /usr/bin/time: each process's peak RSS in scripts/bench.sh
                   valgrind)  # callgrind: the haptic tick's instruction counts in scripts/bench.sh

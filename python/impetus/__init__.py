@@ -15,6 +15,7 @@ Ctrl-C (SIGINT in the main thread) ends a running trial between two ticks and ra
 """
 import json
 import numbers
+import os
 import pathlib
 import sys
 import tempfile
@@ -34,6 +35,7 @@ except ImportError as _error:
     raise ImportError(f"impetus: its compiled module cannot be loaded: {_error}") from _error
 
 __version__ = "@PROJECT_VERSION@"
+__all__ = ["COUPLINGS", "LOG_FILES", "Trial", "defaults", "read_log", "run_trial", "scene_dir", "shipped_scene"]
 
 
 
@@ -161,6 +163,13 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
     Raises ValueError for an argument out of range (naming it, its value and the range) and RuntimeError for a file
     that cannot be used (naming the file and the field).
     """
+    if not isinstance(scene, (str, os.PathLike)):
+        raise TypeError(f"scene: must be a path (str or os.PathLike), not {type(scene).__name__}")
+    if not isinstance(trajectory, (str, os.PathLike, dict)):
+        raise TypeError(f"trajectory: must be a built-in spec, a path or a {{name: trajectory}} dict, not "
+                        f"{type(trajectory).__name__}")
+    if out_dir is not None and not isinstance(out_dir, (str, os.PathLike)):
+        raise TypeError(f"out_dir: must be a path or None, not {type(out_dir).__name__}")
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling: must be one of {', '.join(COUPLINGS)}, not {coupling!r}")
     if isinstance(users, (str, dict)) or not all(isinstance(user, (str, dict, pathlib.Path)) for user in users):

@@ -2,8 +2,9 @@
 # SPDX-License-Identifier: Apache-2.0
 # What a user of the library does: install Impetus into a prefix, build the example project against the installed
 # package (find_package(Impetus 0.2)), run it; import the Python package from the prefix and run a trial with a
-# shipped scene; check the pkg-config file; make the Debian package, unpack it into a scratch root (dpkg -x) and run a
-# daemon and the Python package from it.
+# shipped scene; check the pkg-config file; make the Debian packages (impetus, the runtime; impetus-dev, headers and
+# libraries), check that the runtime depends on no -dev package, unpack both into a scratch root (dpkg -x) and run a
+# daemon, the viewer, the Python package and pkg-config from it.
 # usage: install_test.sh SOURCE_DIR BUILD_DIR SCRATCH_DIR [PYTHON]   (PYTHON 0: the build has no Python package)
 set -euo pipefail
 src=$1 build=$2 scratch=$3 python=${4:-1}
@@ -11,9 +12,9 @@ rm -rf "$scratch" && mkdir -p "$scratch"
 prefix="$scratch/prefix"
 
 cmake --install "$build" --prefix "$prefix" > "$scratch/install.log"
-for file in bin/world_manager lib/cmake/Impetus/ImpetusConfig.cmake lib/cmake/Impetus/ImpetusConfigVersion.cmake \
+for file in bin/impetus-world-manager bin/impetus-haptic-controller bin/impetus-spidar-sim lib/cmake/Impetus/ImpetusConfig.cmake lib/cmake/Impetus/ImpetusConfigVersion.cmake \
             lib/pkgconfig/impetus.pc include/impetus/loop/in_process_trial.h share/impetus/scenes/tap.json \
-            share/impetus/desktop_spidar.json bin/viewer share/impetus/viewer/web/index.html \
+            share/impetus/desktop_spidar.json bin/impetus-viewer share/impetus/viewer/web/index.html \
             share/impetus/viewer/web/node_modules/three/build/three.module.js; do
   [ -e "$prefix/$file" ] || { echo "install_test: $prefix/$file was not installed" >&2; exit 1; }
 done
@@ -48,7 +49,7 @@ python_trial "$prefix"
 # The installed viewer finds its page and three.js in the prefix (no source tree, no network).
 viewer_serves() {
   # Long enough to outlast a loaded machine's start-up and requests; stopped below once they are answered.
-  "$1/bin/viewer" --shm "impetus_install_test_$$" --listen 127.0.0.1:0 --duration 60 > "$scratch/viewer.out" 2>&1 &
+  "$1/bin/impetus-viewer" --shm "impetus_install_test_$$" --listen 127.0.0.1:0 --duration 60 > "$scratch/viewer.out" 2>&1 &
   local pid=$! url=""
   for _ in $(seq 100); do
     url=$(sed -n 's/.*serving \(http[^ ]*\).*/\1/p' "$scratch/viewer.out")
@@ -83,9 +84,20 @@ pkg_config_finds "$prefix/lib/pkgconfig"
 
 (cd "$build" && cpack -G DEB -B "$scratch/deb" > "$scratch/cpack.log")
 deb=$(ls "$scratch"/deb/impetus_*.deb)
+dev_deb=$(ls "$scratch"/deb/impetus-dev_*.deb)
+# The runtime package needs no development package; the -dev one needs the runtime and the headers' -dev packages.
+if dpkg-deb -f "$deb" Depends | grep -q -- "-dev"; then
+  echo "install_test: $(basename "$deb") depends on -dev packages: $(dpkg-deb -f "$deb" Depends)" >&2
+  exit 1
+fi
+dpkg-deb -f "$dev_deb" Depends | grep -q "impetus (= " ||
+  { echo "install_test: $(basename "$dev_deb") does not depend on impetus: $(dpkg-deb -f "$dev_deb" Depends)" >&2; exit 1; }
 dpkg -x "$deb" "$scratch/root"
-"$scratch/root/usr/bin/world_manager" --help | grep -q -- "--scene"
+"$scratch/root/usr/bin/impetus-world-manager" --help | grep -q -- "--scene"
 python_trial "$scratch/root/usr"
 viewer_serves "$scratch/root/usr"
+[ ! -e "$scratch/root/usr/include" ] || { echo "install_test: the runtime package ships headers" >&2; exit 1; }
+dpkg -x "$dev_deb" "$scratch/root"
 pkg_config_finds "$(dirname "$(find "$scratch/root/usr" -name impetus.pc | head -1)")"
-echo "install_test: installed, example built and ran, package $(basename "$deb") $(du -k "$deb" | cut -f1) KiB"
+echo "install_test: installed, example built and ran, packages $(basename "$deb") $(du -k "$deb" | cut -f1) KiB" \
+     "and $(basename "$dev_deb") $(du -k "$dev_deb" | cut -f1) KiB"

@@ -164,6 +164,16 @@ class Arguments(unittest.TestCase):
                     impetus.run_trial(self.scene(), "tap", logs=False, **kwargs)
                 self.assertIn(name, str(raised.exception))
 
+    def test_wrong_types_name_the_argument(self):
+        for kwargs, name in [(dict(scene=123, trajectory="tap"), "scene"), (dict(trajectory=5.0), "trajectory"),
+                             (dict(out_dir=7), "out_dir")]:
+            with self.subTest(name=name):
+                arguments = dict(scene=self.scene(), trajectory="tap")
+                arguments.update(kwargs)
+                with self.assertRaises(TypeError) as raised:
+                    impetus.run_trial(**arguments)
+                self.assertTrue(str(raised.exception).startswith(name + ":"), str(raised.exception))
+
     def test_bad_files_name_the_file(self):
         with self.assertRaises(FileNotFoundError):
             impetus.run_trial(OUT / "no-such-scene.json", "tap")
@@ -267,6 +277,21 @@ class Arguments(unittest.TestCase):
             warnings.simplefilter("always")
             impetus.run_trial(self.scene(), "tap", "local", logs=False)
         self.assertEqual([str(w.message) for w in caught], [])  # the shipped tap, local coupling: nothing to warn
+
+    def test_the_public_names_and_their_types(self):
+        # __all__ names what exists; the stub (PEP 561) declares each of them and every argument of run_trial.
+        import ast
+        import inspect
+        for name in impetus.__all__:
+            self.assertTrue(hasattr(impetus, name), name)
+        stub = ast.parse((pathlib.Path(impetus.__file__).parent / "__init__.pyi").read_text())
+        declared = {node.name for node in stub.body if isinstance(node, (ast.FunctionDef, ast.ClassDef))}
+        declared |= {node.target.id for node in stub.body if isinstance(node, ast.AnnAssign)}
+        self.assertLessEqual(set(impetus.__all__), declared)
+        self.assertTrue((pathlib.Path(impetus.__file__).parent / "py.typed").is_file())
+        stub_run = next(n for n in stub.body if isinstance(n, ast.FunctionDef) and n.name == "run_trial")
+        stub_args = [a.arg for a in stub_run.args.args + stub_run.args.kwonlyargs]
+        self.assertEqual(stub_args, list(inspect.signature(impetus.run_trial).parameters))
 
     def test_another_python_is_told_which_it_needs(self):
         # The package without its compiled module, imported by an interpreter that says it is CPython 3.99: the
