@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "viewer/request_check.h"
 
+#include "common/runtime/ascii.h"
+
 #include <boost/asio/ip/address.hpp>
 
 #include <algorithm>
@@ -9,12 +11,6 @@
 
 namespace impetus::view {
 namespace {
-
-std::string lower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
-  return out;
-}
 
 // At most this much of a header is quoted in a message: a header is the client's text.
 std::string quoted(std::string_view text) {
@@ -54,7 +50,7 @@ HostPort split(std::string_view host) {
     if (error != std::errc() || end != port.data() + port.size() || port.empty() || value > 65535) return out;
     out.port = value;
   }
-  out.name = lower(name);
+  out.name = ascii_lower(name);
   out.valid = true;
   return out;
 }
@@ -93,7 +89,7 @@ std::string host_problem(std::string_view host, const HostRule& rule) {
 
 std::string origin_problem(std::string_view origin, std::string_view host) {
   if (origin.empty()) return "";
-  if (lower(origin) == "http://" + lower(host)) return "";
+  if (ascii_lower(origin) == "http://" + ascii_lower(host)) return "";
   return "Origin " + quoted(origin) + " is not this viewer's page (http://" + std::string(host.substr(0, 80)) + ")";
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "viewer/view_server.h"
 
+#include "common/runtime/ascii.h"
 #include "common/runtime/loop_stats.h"
 #include "viewer/view_protocol.h"
 
@@ -13,7 +14,6 @@
 
 #include <unistd.h>
 
-#include <cctype>
 #include <chrono>
 #include <optional>
 
@@ -278,9 +278,7 @@ ViewServer::ViewServer(asio::io_context& io, const tcp::endpoint& endpoint, cons
   host_rule_.names = std::move(host_names);
   char machine[256] = {};
   if (gethostname(machine, sizeof machine - 1) == 0 && machine[0] != '\0') {
-    std::string name(machine);
-    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    host_rule_.names.push_back(name);
+    host_rule_.names.push_back(ascii_lower(machine));
   }
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "viewer/viewer_node.h"
 
+#include "common/runtime/ascii.h"
 #include "common/link/dds/dds_world_view.h"
 
 #include "common/runtime/process.h"
@@ -17,7 +18,6 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
-#include <cctype>
 #include <stdexcept>
 
 namespace impetus::view {
@@ -27,9 +27,7 @@ namespace asio = boost::asio;
 namespace {
 
 std::vector<std::string> lower_case(std::vector<std::string> names) {
-  for (std::string& name : names) {
-    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  }
+  for (std::string& name : names) name = ascii_lower(name);
   return names;
 }
 

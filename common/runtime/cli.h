@@ -6,6 +6,7 @@
 #include "common/contract/frames.h"
 #include "common/contract/limits.h"
 #include "common/link/link_options.h"
+#include "common/runtime/ascii.h"
 #include "common/runtime/lockstep.h"
 #include "common/runtime/message_text.h"
 #include "common/runtime/process.h"
@@ -13,7 +14,6 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <cctype>
 #include <cstdio>
 #include <exception>
 #include <map>
@@ -35,9 +35,7 @@ template <class T>
 CLI::Validator enum_names(const std::map<std::string, T>& names) {
   return CLI::Validator(
       [&names](std::string& value) {
-        std::string lower = value;
-        for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-        if (const auto found = names.find(lower); found != names.end()) {
+        if (const auto found = names.find(ascii_lower(value)); found != names.end()) {
           value = std::to_string(static_cast<long long>(found->second));
           return std::string();
         }

@@ -149,28 +149,26 @@ TEST_CASE("a report bringing more impulse than a device renders in the world tim
   CHECK(world->step_impulse_Ns(0).x() == Approx(10.0 * period_s).epsilon(1e-8));
   CHECK(world->clipped_reports() == 1);
   CHECK(world->clipped_impulse_Ns() == Approx(1.61 - 10.0 * period_s).epsilon(1e-8));
+  // The report of haptic tick `tick` (1 kHz) with the running total `total_Ns` along x, stepped once.
+  const auto step_with_total = [&](std::uint64_t tick, double total_Ns) {
+    report.tick = tick;
+    report.haptic_time_s = static_cast<double>(tick) * 1e-3;
+    report.entries[0].impulse_Ns = {total_Ns, 0.0, 0.0};
+    world->step(&report);
+  };
   // Within the bound: applied whole. The next report covers one step; 0.4 N·s more is within 0.5.
-  report.tick = 100;
-  report.haptic_time_s = 0.1;
-  report.entries[0].impulse_Ns = {2.01, 0.0, 0.0};
-  world->step(&report);
+  step_with_total(100, 2.01);
   CHECK(world->step_impulse_Ns(0).x() == Approx(0.4));
   CHECK(world->clipped_reports() == 1);
   // Three steps without a new report, then one covering them: four steps' worth of force may have gone in.
   for (int k = 0; k < 3; ++k) world->step(std::span<const HapticReport* const>{});
-  report.tick = 300;
-  report.haptic_time_s = 0.3;
-  report.entries[0].impulse_Ns = {2.01 + 1.9, 0.0, 0.0};
-  world->step(&report);
+  step_with_total(300, 2.01 + 1.9);
   CHECK(world->step_impulse_Ns(0).x() == Approx(1.9));
   CHECK(world->clipped_reports() == 1);
   // The same report again for three steps (a transport keeps the last one while its controller is silent, e.g. a
   // network link down), then a new one: it covers all four steps.
   for (int k = 0; k < 3; ++k) world->step(&report);
-  report.tick = 400;
-  report.haptic_time_s = 0.4;
-  report.entries[0].impulse_Ns = {3.91 + 1.9, 0.0, 0.0};
-  world->step(&report);
+  step_with_total(400, 3.91 + 1.9);
   CHECK(world->step_impulse_Ns(0).x() == Approx(1.9));
   CHECK(world->clipped_reports() == 1);
   // Shares on several contacts: |Σ ΔJ| ≤ F·T and Σ|ΔJ| ≤ √3·F·T. Two opposite shares of 0.6 N·s each (a pinch) sum
