@@ -22,9 +22,9 @@ constexpr std::size_t kLogRows = 2048;
 constexpr std::uint64_t kStatsEveryTicks = 100;
 
 constexpr const char* kLogHeader =
-    "time_s,tick,finger_x,finger_y,finger_z,proxy_x,proxy_y,proxy_z,force_x,force_y,force_z,"
-    "object_impulse_x,object_impulse_y,object_impulse_z,static_impulse_x,static_impulse_y,static_impulse_z,"
-    "weight,lateness_ns,active_planes,flags";
+    "time_s,tick,finger_x_m,finger_y_m,finger_z_m,proxy_x_m,proxy_y_m,proxy_z_m,force_x_N,force_y_N,force_z_N,"
+    "object_impulse_x_Ns,object_impulse_y_Ns,object_impulse_z_Ns,static_impulse_x_Ns,static_impulse_y_Ns,"
+    "static_impulse_z_Ns,interpolation_weight,lateness_ns,active_planes,flags";
 
 void format_row(std::ostream& out, const HapticLogRow& row) {
   CsvLine line(out);
@@ -269,6 +269,10 @@ int HapticNode::run() {
   } else {
     run_realtime();
   }
+  return close();
+}
+
+int HapticNode::close() {
   publish_stats(nullptr);
   bool log_failed = false;
   for (auto& endpoint : endpoints_) {

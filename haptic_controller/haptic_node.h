@@ -80,6 +80,9 @@ class HapticNode final : public FollowerStepper {
   // requested: the run is over; then finish_lockstep() ends it.
   bool lockstep_tick(std::uint64_t t);
   void finish_lockstep();
+  // After the last tick (run() calls it): the final statistics, the logs flushed and closed. Returns the exit status
+  // run() would (1 for a trial cut short or a failed log write).
+  int close();
   // A follower's tick `t` (another controller is the lockstep master): the frames the world published after the
   // master's tick t−1, taken at time (t−1)·T as the master took them, then tick t. False once its device has left or
   // a stop was requested (nothing was ticked).

@@ -8,6 +8,7 @@
 // coupling, run, read the summary.
 
 #include "common/contract/frames.h"
+#include "spidar_sim/trajectory.h"
 
 #include <nlohmann/json.hpp>
 
@@ -27,7 +28,12 @@ inline constexpr double kMaxLinkDelay_s = 1.0;
 
 struct InProcessTrialOptions {
   std::string scene_path;  // a scene file (world_manager/scene.h)
+  // Or a scene built in memory, as JSON text: when not empty it is the scene, and scene_path only names it in
+  // messages and the summary.
+  std::string scene_text;
   std::string trajectory;  // a trajectory CSV file or a built-in spec, as spidar_sim --trajectory takes
+  // Or the fingers themselves, trajectories already made (from arrays): when not empty, trajectory and fingers must be.
+  std::vector<NamedFinger> finger_paths;
   // Or a several-finger device: "NAME=TRAJECTORY" per finger, as spidar_sim --finger takes (then `trajectory` must be
   // empty). Finger k is endpoint k of the world; its logs are haptic.endpointK.csv and device.endpointK.csv.
   std::vector<std::string> fingers;

@@ -4,12 +4,16 @@
 // Python half chooses defaults, names the arguments and shapes the results.
 
 #include "loop/in_process_trial.h"
+#include "loop/simulation.h"
+#include "spidar_sim/trajectory.h"
 #include "world_manager/defaults.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -19,9 +23,12 @@
 #include <fstream>
 #include <mutex>
 #include <optional>
+#include <span>
+#include <utility>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 namespace py = pybind11;
@@ -36,17 +43,30 @@ impetus::Coupling parse_coupling(const std::string& name) {
   throw std::invalid_argument("coupling: must be impulse, position or local, not '" + name + "'");
 }
 
-// The trial's summary.json document as text (the Python half parses it into a dict).
-std::string run_trial(const std::string& scene, const std::string& trajectory, const std::vector<std::string>& fingers,
-                      const std::vector<std::vector<std::string>>& followers, const std::string& coupling,
-                      std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
-                      std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm, double link_delay_s,
-                      double duration_s, const std::string& out_dir) {
+// A trajectory from an N x 4 array of waypoints (t, x, y, z in s and m), named `description` in messages.
+impetus::Trajectory trajectory_from_array(const py::array_t<double, py::array::c_style | py::array::forcecast>& table,
+                                          const std::string& description) {
+  if (table.ndim() != 2 || table.shape(1) != 4 || table.shape(0) == 0) {
+    throw std::invalid_argument(description + ": must be an N x 4 array of waypoints (t_s, x_m, y_m, z_m), N >= 1");
+  }
+  std::vector<impetus::Waypoint> waypoints(static_cast<std::size_t>(table.shape(0)));
+  const auto rows = table.unchecked<2>();
+  for (py::ssize_t i = 0; i < table.shape(0); ++i) {
+    waypoints[static_cast<std::size_t>(i)] = {rows(i, 0), {rows(i, 1), rows(i, 2), rows(i, 3)}};
+  }
+  return impetus::Trajectory::from_waypoints(waypoints, description);
+}
+
+// What every in-process run takes from the Python half: the scene (a file, or JSON text named `scene` in messages),
+// the coupling, the rates, the contact spring and damper, the link delay and the log directory.
+impetus::InProcessTrialOptions trial_options(const std::string& scene, const std::string& scene_text,
+                                             const std::string& coupling, std::uint64_t phase_ticks,
+                                             std::optional<double> world_rate_hz, std::optional<int> substeps,
+                                             std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm,
+                                             double link_delay_s, const std::string& out_dir) {
   impetus::InProcessTrialOptions options;
   options.scene_path = scene;
-  options.trajectory = trajectory;
-  options.fingers = fingers;
-  options.followers = followers;
+  options.scene_text = scene_text;
   options.coupling = parse_coupling(coupling);
   options.phase_ticks = phase_ticks;
   options.world_rate_hz = world_rate_hz;
@@ -54,8 +74,34 @@ std::string run_trial(const std::string& scene, const std::string& trajectory, c
   if (stiffness_Npm) options.stiffness_Npm = *stiffness_Npm;
   if (damping_Nspm) options.damping_Nspm = *damping_Nspm;
   options.link_delay_s = link_delay_s;
-  options.duration_s = duration_s;
   options.out_dir = out_dir;
+  return options;
+}
+
+// The trial's summary.json document as text (the Python half parses it into a dict). The first user's fingers are
+// `trajectory`, or `fingers` (NAME=TRAJECTORY specs), or `finger_paths`: (name, spec, waypoints) per finger, each
+// played from its N x 4 waypoints when they are given and from its spec (a built-in or a CSV file) otherwise.
+using FingerPath = std::tuple<std::string, std::string, std::optional<py::array_t<double>>>;
+std::string run_trial(const std::string& scene, const std::string& scene_text, const std::string& trajectory,
+                      const std::vector<std::string>& fingers, const std::vector<FingerPath>& finger_paths,
+                      const std::vector<std::vector<std::string>>& followers, const std::string& coupling,
+                      std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
+                      std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm, double link_delay_s,
+                      double duration_s, const std::string& out_dir) {
+  impetus::InProcessTrialOptions options = trial_options(scene, scene_text, coupling, phase_ticks, world_rate_hz,
+                                                         substeps, stiffness_Npm, damping_Nspm, link_delay_s, out_dir);
+  options.trajectory = trajectory;
+  options.fingers = fingers;
+  for (const auto& [name, spec, table] : finger_paths) {
+    try {
+      impetus::Trajectory path = table ? trajectory_from_array(*table, "array") : impetus::load_trajectory(spec);
+      options.finger_paths.push_back({name, std::move(path)});
+    } catch (const std::exception& error) {
+      throw std::invalid_argument("trajectory '" + name + "': " + error.what());
+    }
+  }
+  options.followers = followers;
+  options.duration_s = duration_s;
   // The trial runs on a thread of its own and touches no Python object, so other Python threads run meanwhile. This
   // thread waits for it with the GIL released and, every kSignalCheck, takes the GIL to let Python run its signal
   // handlers: Ctrl-C in the main thread ends the trial between two ticks and raises KeyboardInterrupt here, however
@@ -137,6 +183,151 @@ py::tuple read_log(const std::string& path) {
   return py::make_tuple(header, table);
 }
 
+// The closed loop (loop/simulation.h) for the Python half: steps with the GIL released and hands back each tick's
+// records as numpy arrays, one per quantity, ticks x fingers (x 3).
+class ClosedLoop {
+ public:
+  ClosedLoop(const std::string& scene, const std::string& scene_text,
+             const std::vector<std::pair<std::string, std::array<double, 3>>>& fingers, const std::string& coupling,
+             std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
+             std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm, double link_delay_s,
+             const std::string& out_dir) {
+    impetus::SimulationOptions options;
+    options.trial = trial_options(scene, scene_text, coupling, phase_ticks, world_rate_hz, substeps, stiffness_Npm,
+                                  damping_Nspm, link_delay_s, out_dir);
+    for (const auto& [name, start_m] : fingers) options.fingers.push_back({name, start_m});
+    options.trial.stop = &stop_;
+    py::gil_scoped_release release;
+    simulation_ = std::make_unique<impetus::Simulation>(options);
+  }
+  ~ClosedLoop() {
+    py::gil_scoped_release release;
+    simulation_.reset();
+  }
+
+  // `targets`: None, or a ticks x fingers x 3 array (the Python half shapes it). Returns a dict of arrays.
+  py::dict step(std::uint64_t ticks, const std::optional<py::array_t<double, py::array::c_style |
+                                                                         py::array::forcecast>>& targets) {
+    const std::size_t fingers = simulation_->finger_count();
+    std::vector<impetus::Vec3> points;
+    if (targets) {
+      if (targets->ndim() != 3 || static_cast<std::uint64_t>(targets->shape(0)) != ticks ||
+          static_cast<std::size_t>(targets->shape(1)) != fingers || targets->shape(2) != 3) {
+        throw std::invalid_argument("targets: must be ticks x fingers x 3");
+      }
+      points.resize(ticks * fingers);
+      std::copy_n(targets->data(), points.size() * 3, points.front().data());
+    }
+    records_.resize(ticks * fingers);
+    // Long runs are cut into chunks so Ctrl-C is seen between them (KeyboardInterrupt, the ticks taken kept).
+    constexpr std::uint64_t kChunkTicks = 20000;
+    std::uint64_t done = 0;
+    while (done < ticks) {
+      const std::uint64_t chunk = std::min(kChunkTicks, ticks - done);
+      const std::span<const impetus::Vec3> chunk_targets =
+          points.empty() ? std::span<const impetus::Vec3>() : std::span(points).subspan(done * fingers, chunk * fingers);
+      const std::span<impetus::FingerTick> chunk_out = std::span(records_).subspan(done * fingers, chunk * fingers);
+      std::uint64_t taken = 0;
+      {
+        py::gil_scoped_release release;
+        taken = simulation_->step(chunk, chunk_targets, chunk_out);
+      }
+      done += taken;
+      if (taken < chunk || (done < ticks && PyErr_CheckSignals() != 0)) break;
+    }
+    if (PyErr_Occurred() != nullptr) throw py::error_already_set();
+    return records(done, fingers);
+  }
+
+  void set_target(std::size_t finger, const std::array<double, 3>& target_m) {
+    simulation_->set_target(finger, target_m);
+  }
+  void set_hand_force(std::size_t finger, const std::array<double, 3>& force_N) {
+    simulation_->set_hand_force(finger, force_N);
+  }
+
+  // Every object now: a dict of arrays, objects x 3 (x 4 for the orientation).
+  py::dict objects() const {
+    const std::vector<impetus::SimulationObject> objects = simulation_->objects();
+    const std::size_t n = objects.size();
+    py::array_t<double> position({n, std::size_t{3}}), orientation({n, std::size_t{4}}), velocity({n, std::size_t{3}}),
+        angular({n, std::size_t{3}}), impulse({n, std::size_t{3}});
+    for (std::size_t i = 0; i < n; ++i) {
+      std::copy_n(objects[i].position_m.data(), 3, position.mutable_data(i));
+      std::copy_n(objects[i].orientation_wxyz.data(), 4, orientation.mutable_data(i));
+      std::copy_n(objects[i].velocity_mps.data(), 3, velocity.mutable_data(i));
+      std::copy_n(objects[i].angular_velocity_radps.data(), 3, angular.mutable_data(i));
+      std::copy_n(objects[i].impulse_Ns.data(), 3, impulse.mutable_data(i));
+    }
+    py::dict out;
+    out["position_m"] = position;
+    out["orientation_wxyz"] = orientation;
+    out["velocity_mps"] = velocity;
+    out["angular_velocity_radps"] = angular;
+    out["impulse_Ns"] = impulse;
+    return out;
+  }
+
+  std::string finish() {
+    py::gil_scoped_release release;
+    return simulation_->finish().dump();
+  }
+
+  std::uint64_t ticks() const { return simulation_->ticks(); }
+  double tick_period_s() const { return simulation_->tick_period_s(); }
+  double device_time_s() const { return simulation_->device_time_s(); }
+  bool finished() const { return simulation_->finished(); }
+  std::vector<std::string> object_names() const { return simulation_->object_names(); }
+  std::vector<std::string> warnings() const { return simulation_->warnings(); }
+
+ private:
+  py::dict records(std::uint64_t ticks, std::size_t fingers) const {
+    const std::size_t n = static_cast<std::size_t>(ticks);
+    py::array_t<double> time(static_cast<py::ssize_t>(n));
+    py::array_t<std::int32_t> planes({n, fingers});
+    using Field = impetus::Vec3 impetus::FingerTick::*;
+    static constexpr std::pair<const char*, Field> kVectors[] = {
+        {"target_m", &impetus::FingerTick::target_m},
+        {"finger_m", &impetus::FingerTick::finger_m},
+        {"finger_velocity_mps", &impetus::FingerTick::finger_velocity_mps},
+        {"proxy_m", &impetus::FingerTick::proxy_m},
+        {"force_N", &impetus::FingerTick::force_N},
+        {"object_impulse_Ns", &impetus::FingerTick::object_impulse_Ns},
+    };
+    py::dict out;
+    for (std::size_t i = 0; i < n; ++i) {
+      time.mutable_data()[i] = records_[i * fingers].time_s;
+      for (std::size_t k = 0; k < fingers; ++k) planes.mutable_data()[i * fingers + k] = records_[i * fingers + k].active_planes;
+    }
+    out["time_s"] = time;
+    for (const auto& [name, field] : kVectors) {
+      py::array_t<double> values({n, fingers, std::size_t{3}});
+      double* cursor = values.mutable_data();
+      for (std::size_t r = 0; r < n * fingers; ++r, cursor += 3) std::copy_n((records_[r].*field).data(), 3, cursor);
+      out[name] = values;
+    }
+    out["active_planes"] = planes;
+    return out;
+  }
+
+  std::atomic<bool> stop_{false};
+  std::unique_ptr<impetus::Simulation> simulation_;
+  std::vector<impetus::FingerTick> records_;
+};
+
+// Where a trajectory (a built-in spec or a CSV file) puts the target at each of `times_s`: an N x 3 array (m).
+py::array_t<double> sample_trajectory(const std::string& spec, const py::array_t<double, py::array::c_style |
+                                                                                   py::array::forcecast>& times_s) {
+  const impetus::Trajectory trajectory = impetus::load_trajectory(spec);
+  const std::size_t n = static_cast<std::size_t>(times_s.size());
+  py::array_t<double> out({n, std::size_t{3}});
+  for (std::size_t i = 0; i < n; ++i) {
+    const impetus::Vec3 point = trajectory.position_at(times_s.data()[i]);
+    std::copy_n(point.data(), 3, out.mutable_data(i));
+  }
+  return out;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_impetus, module) {
@@ -147,10 +338,30 @@ PYBIND11_MODULE(_impetus, module) {
   // for the guard.
   py::module_::import("numpy");
   (void)py::dtype::of<double>();
-  module.def("run_trial", &run_trial, py::arg("scene"), py::arg("trajectory"), py::arg("fingers"), py::arg("followers"),
-             py::arg("coupling"),
+  module.def("run_trial", &run_trial, py::arg("scene"), py::arg("scene_text"), py::arg("trajectory"),
+             py::arg("fingers"), py::arg("finger_paths"), py::arg("followers"), py::arg("coupling"),
              py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("stiffness_Npm"),
              py::arg("damping_Nspm"), py::arg("link_delay_s"), py::arg("duration_s"), py::arg("out_dir"));
   module.def("read_log", &read_log, py::arg("path"));
+  module.def("sample_trajectory", &sample_trajectory, py::arg("spec"), py::arg("times_s"));
+  py::class_<ClosedLoop>(module, "ClosedLoop")
+      .def(py::init<const std::string&, const std::string&,
+                    const std::vector<std::pair<std::string, std::array<double, 3>>>&, const std::string&,
+                    std::uint64_t, std::optional<double>, std::optional<int>, std::optional<double>,
+                    std::optional<double>, double, const std::string&>(),
+           py::arg("scene"), py::arg("scene_text"), py::arg("fingers"), py::arg("coupling"), py::arg("phase_ticks"),
+           py::arg("world_rate_hz"), py::arg("substeps"), py::arg("stiffness_Npm"), py::arg("damping_Nspm"),
+           py::arg("link_delay_s"), py::arg("out_dir"))
+      .def("step", &ClosedLoop::step, py::arg("ticks"), py::arg("targets"))
+      .def("set_target", &ClosedLoop::set_target, py::arg("finger"), py::arg("target_m"))
+      .def("set_hand_force", &ClosedLoop::set_hand_force, py::arg("finger"), py::arg("force_N"))
+      .def("objects", &ClosedLoop::objects)
+      .def("finish", &ClosedLoop::finish)
+      .def_property_readonly("ticks", &ClosedLoop::ticks)
+      .def_property_readonly("tick_period_s", &ClosedLoop::tick_period_s)
+      .def_property_readonly("device_time_s", &ClosedLoop::device_time_s)
+      .def_property_readonly("finished", &ClosedLoop::finished)
+      .def_property_readonly("object_names", &ClosedLoop::object_names)
+      .def_property_readonly("warnings", &ClosedLoop::warnings);
   module.def("defaults", [] { return impetus::defaults_document().dump(); });
 }

@@ -16,6 +16,8 @@
 #   7. the world view: snapshot size and cost per world step, a viewer's read and encode   build/tests/bench_world_view
 #   8. world link one-way latency, shared memory and DDS, and DDS across a veth   build/tests/bench_dds_link
 #   9. ghost force, release, lost walls and pop-through in clutter and streams   build/tests/bench_ghost_force
+#  10. the closed loop from Python: ticks/s at 1 to 1000 ticks a call, free and in contact (goal: >= 200 k at 50)
+#      tests/bench/bench_closed_loop.py
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -25,7 +27,7 @@ world_args=()
 while (($#)); do
   case "$1" in
     --short) rt_seconds=5; world_args=(--quick); shift ;;
-    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -206,3 +208,11 @@ fi
 
 section "9. Ghost force between world frames in static clutter and in streams past the finger, scored against the true geometry (docs/ghost_force.md)"
 bench bench_ghost_force
+
+section "10. The closed loop from Python (impetus.Simulation): ticks per wall second by ticks per call"
+if [ -f "$build/python/impetus/__init__.py" ]; then
+  PYTHONPATH="$build/python" /usr/bin/python3 tests/bench/bench_closed_loop.py --seconds 2 ||
+    echo "(bench_closed_loop.py exited with status $?)"
+else
+  echo "(skipped: the Python package was not built)"
+fi

@@ -83,7 +83,7 @@ def main():
         top.grid(alpha=0.3)
         for name, log_name in (("thumb", logs.HAPTIC), ("index", "haptic.endpoint1.csv")):
             haptic = logs.read_log(out_dir / log_name)
-            force = np.linalg.norm(haptic.vectors("force_"), axis=1)
+            force = np.linalg.norm(haptic.vectors("force_", "_N"), axis=1)
             bottom.plot(haptic["time_s"], force, lw=0.8, label=f"{name}: |force| (N)")
         bottom.set_xlabel("time (s)")
         bottom.grid(alpha=0.3)

@@ -87,7 +87,7 @@ class Trial:
     def force_magnitudes_N(self):
         """|force on the finger| at each haptic tick."""
         h = self.haptic
-        return [math.sqrt(x ** 2 + y ** 2 + z ** 2) for x, y, z in h.vectors("force_").tolist()]
+        return [math.sqrt(x ** 2 + y ** 2 + z ** 2) for x, y, z in h.vectors("force_", "_N").tolist()]
 
 
 # ---------------------------------------------------------------------------------------------------------------------
@@ -149,7 +149,7 @@ def proxy_steps(trial):
     PROXY_SLOP_M) is a release, not a pop: the finger is in free space, where the god-object's proxy is the finger
     itself, however deep it was pressed the tick before (off an edge the exact god-object lets go at once too)."""
     h = trial.haptic
-    proxy, finger, times = h.vectors("proxy_").tolist(), h.vectors("finger_").tolist(), h["time_s"].tolist()
+    proxy, finger, times = h.vectors("proxy_", "_m").tolist(), h.vectors("finger_", "_m").tolist(), h["time_s"].tolist()
     steps = []
     for i in range(1, len(times)):
         if math.dist(proxy[i], finger[i]) <= PROXY_SLOP_M:
@@ -170,7 +170,7 @@ def check_edge_corner(trial):
     h = trial.haptic
     planes = [int(p) for p in h["active_planes"]]
     deepest = 0.0
-    for p in h.vectors("proxy_").tolist():
+    for p in h.vectors("proxy_", "_m").tolist():
         for obj in trial.objects.values():
             deepest = max(deepest, static_box_depth(obj, p))
         deepest = max(deepest, -p[2])  # the floor
@@ -205,9 +205,9 @@ def check_thin_plate(trial):
     near = plate["position_m"][0] - plate["size_m"][0] / 2
     far = plate["position_m"][0] + plate["size_m"][0] / 2
     h = trial.haptic
-    proxy_max = h["proxy_x"].max()
-    finger_max = h["finger_x"].max()
-    wrong = np.count_nonzero((h["finger_x"] > far) & ~(h["force_x"] < 0))
+    proxy_max = h["proxy_x_m"].max()
+    finger_max = h["finger_x_m"].max()
+    wrong = np.count_nonzero((h["finger_x_m"] > far) & ~(h["force_x_N"] < 0))
     ok = proxy_max <= near + PROXY_SLOP_M and wrong == 0
     return ok, (f"proxy max x - near face {1e6 * (proxy_max - near):+.1f} um; finger reached "
                 f"{1e3 * (finger_max - near):.1f} mm past the face"), [
@@ -225,7 +225,7 @@ def check_fast_finger(trial):
     first_force = next((i for i, f in enumerate(forces) if f > 0), None)
     if first_force is None:
         return False, "no contact force at all", []
-    depth = h["finger_x"][first_force] - face
+    depth = h["finger_x_m"][first_force] - face
     t = h["time_s"][first_force]
     speed = np.abs(d["finger_vx_mps"][d["time_s"] <= t + 1e-9]).max()
     pushed = trial.summary.impulse_Ns("cube")[0]
@@ -258,7 +258,7 @@ def force_swing_deg(trial, start_s, end_s):
     """Range (degrees) of the contact force's direction in the x-z plane over the ticks in [start_s, end_s] that
     carry a force of at least 0.2 N (below that the direction is quantisation noise)."""
     h = trial.haptic
-    ticks = zip(h["time_s"].tolist(), h["force_x"].tolist(), h["force_z"].tolist())
+    ticks = zip(h["time_s"].tolist(), h["force_x_N"].tolist(), h["force_z_N"].tolist())
     angles = [math.degrees(math.atan2(fx, fz)) for t, fx, fz in ticks
               if start_s <= t <= end_s and math.hypot(fx, fz) >= FORCE_NOISE_N]
     return (max(angles) - min(angles), min(angles), max(angles)) if angles else (0.0, 0.0, 0.0)
@@ -285,7 +285,7 @@ def check_normal_flip(trial):
     half = box["size_m"][0] / 2
     world_times, box_centres = w["time_s"].tolist(), w.vectors("box.", "_m").tolist()
     box_velocities = w.vectors("box.v", "_mps").tolist()
-    fingers, forces = d.vectors("finger_", "_m").tolist(), h.vectors("force_").tolist()
+    fingers, forces = d.vectors("finger_", "_m").tolist(), h.vectors("force_", "_N").tolist()
     worst_pull, pressed, passed_at, last_contact, edge_spread_s = 0.0, 0.0, None, None, 0.0
     j = 0
     for i, t in enumerate(d["time_s"].tolist()):
@@ -339,7 +339,7 @@ def check_press_hold(trial):
     w = trial.world
     dz = np.abs(w["cube.z_m"] - z0).max()
     dxy = max(math.hypot(x - x0, y - y0) for x, y in zip(w["cube.x_m"].tolist(), w["cube.y_m"].tolist()))
-    hold = [-f for t, f in zip(trial.haptic["time_s"].tolist(), trial.haptic["force_z"].tolist()) if t > 1.0]
+    hold = [-f for t, f in zip(trial.haptic["time_s"].tolist(), trial.haptic["force_z_N"].tolist()) if t > 1.0]
     press = sum(hold) / len(hold)
     ok = dz <= REST_TOLERANCE_M and dxy <= REST_TOLERANCE_M and trial.end_s >= 10.0
     return ok, (f"cube height off by at most {1e6 * dz:.1f} um, drift {1e6 * dxy:.1f} um over {trial.end_s:.1f} s, "
@@ -385,7 +385,7 @@ def check_static_push(trial):
     xs, ys = w[f"{name}.x_m"][settled], w[f"{name}.y_m"][settled]
     creep = max(math.hypot(x - xs[0], y - ys[0]) for x, y in zip(xs.tolist(), ys.tolist()))
     h = trial.haptic.rows(trial.haptic["time_s"] >= PUSH_SETTLED_S)
-    push = float(np.mean(np.hypot(h["force_x"], h["force_y"])))
+    push = float(np.mean(np.hypot(h["force_x_N"], h["force_y_N"])))
     mu = math.sqrt(obj["dynamic_friction"] * trial.scene.floor_dynamic_friction)
     holdable = mu * obj["mass_kg"] * abs(trial.scene.gravity_mps2[2])
     ratio = push / holdable
@@ -417,7 +417,7 @@ def check_arrival(trial):
     # The haptic row at each world frame's time (both logs are on the haptic clock).
     h = trial.haptic
     index = np.clip(np.searchsorted(h["time_s"], w["time_s"]), 0, len(h) - 1)
-    proxy = h.vectors("proxy_")[index]
+    proxy = h.vectors("proxy_", "_m")[index]
     velocity = w.vectors(f"{name}.v", "_mps")
     half_extent = obj["radius_m"] if obj["shape"] == "sphere" else 0.5 * float(np.abs(u) @ np.asarray(obj["size_m"]))
     # Depth of the proxy behind the near face (the face at centre + half_extent·u): < 0 in front of it.

@@ -63,7 +63,7 @@ def contact_episodes(force_N):
 
 
 def force_magnitude_N(haptic):
-    return np.linalg.norm(haptic.vectors("force_"), axis=1)
+    return np.linalg.norm(haptic.vectors("force_", "_N"), axis=1)
 
 
 def ledger_error_Ns(summary, out_dir):
@@ -84,7 +84,7 @@ def ledger_error_Ns(summary, out_dir):
     for k in range(len(summary.haptic["endpoints"])):
         applied_Ns = np.sum([v for v in applied[k]["impulse_by_object_Ns"].values()] or [[0.0, 0.0, 0.0]], axis=0)
         log = logs.read_log(out_dir / (logs.HAPTIC if k == 0 else f"haptic.endpoint{k}.csv"))
-        rendered_Ns = log.vectors("object_impulse_")[-tail_ticks:]
+        rendered_Ns = log.vectors("object_impulse_", "_Ns")[-tail_ticks:]
         errors = np.max(np.abs(rendered_Ns - applied_Ns) / (1.0 + np.abs(rendered_Ns)), axis=1)
         worst = max(worst, float(errors.min()))
     return worst

@@ -7,8 +7,8 @@ usage: log_digest.py [--out DIR] [--quiet]
 
 The set: the tap under each coupling; every hard case (tests/hard_cases/, scripts/hard_cases.py) under impulse and
 local coupling, at most 20 s each; and a scene of every shape kind (scenes/shapes.json) stirred by a circling
-finger under each coupling. A digest is the md5 of the trial's CSV logs, with world.csv's haptic_time_s column left
-out (the clock pairing, not physics). Runs in this process through the impetus package (PYTHONPATH=build/python).
+finger under each coupling. A digest is the md5 of the trial's CSV logs' rows, without their header rows (so renaming a
+column keeps the digest) and with world.csv's haptic_time_s column left out (the clock pairing, not physics). Runs in this process through the impetus package (PYTHONPATH=build/python).
 """
 import argparse
 import hashlib
@@ -42,7 +42,7 @@ def digest(trial_dir):
         lines = log.read_text().split("\n")
         if lines[0].endswith(",haptic_time_s"):
             lines = [line.rsplit(",", 1)[0] if line else line for line in lines]
-        h.update("\n".join(lines).encode())
+        h.update("\n".join(lines[1:]).encode())
     return h.hexdigest()
 
 

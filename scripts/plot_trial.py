@@ -47,8 +47,8 @@ def main():
     half_x = box_half_x_m(args.dir)
     # The finger is unknown while no device is attached (flags bit 0).
     attached = haptic["flags"].astype(int) & 1 == 1
-    finger_x = np.where(attached, haptic["finger_x"], np.nan)
-    proxy_x = np.where(attached, haptic["proxy_x"], np.nan)
+    finger_x = np.where(attached, haptic["finger_x_m"], np.nan)
+    proxy_x = np.where(attached, haptic["proxy_x_m"], np.nan)
 
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
     for name in objects:
@@ -62,8 +62,8 @@ def main():
     top.set_ylabel("x (m)")
     top.legend(fontsize=8, loc="lower right")
     top.grid(alpha=0.3)
-    bottom.plot(haptic["time_s"], haptic["force_x"], lw=1, label="force on finger, x")
-    bottom.plot(haptic["time_s"], haptic["force_z"], lw=1, label="force on finger, z")
+    bottom.plot(haptic["time_s"], haptic["force_x_N"], lw=1, label="force on finger, x")
+    bottom.plot(haptic["time_s"], haptic["force_z_N"], lw=1, label="force on finger, z")
     bottom.set_xlabel("time since the finger started (s)")
     bottom.set_ylabel("force (N)")
     bottom.legend(fontsize=8)

@@ -80,17 +80,48 @@ const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& comma
   for (int k = 0; k < substeps; ++k) {
     const double t_s = time_s_ + k * h_s;
     if (motor_lag) hardware_.apply(commanded_tension_N, h_s);
-    const Eigen::Vector3d force_N = hardware_.force_on_finger(finger_.position_m());
+    Eigen::Vector3d force_N = hardware_.force_on_finger(finger_.position_m());
     // The target over the sub-step as the chord from where it is now to where it will be: the finger's step takes it
-    // as moving in a straight line (Finger::step), and the chord ends the sub-step exactly on the trajectory.
-    const Eigen::Vector3d from_m = to_eigen(trajectory_.sample_at(t_s, segment_hint_).position_m);
-    const Eigen::Vector3d to_m = to_eigen(trajectory_.sample_at(t_s + h_s, segment_hint_).position_m);
+    // as moving in a straight line (Finger::step), and the chord ends the sub-step exactly on the trajectory (or, when
+    // steered, on the straight line to the steered point).
+    Eigen::Vector3d from_m;
+    Eigen::Vector3d to_m;
+    if (steered_) {
+      from_m = steered_point(k, substeps);
+      to_m = steered_point(k + 1, substeps);
+      // Only a push is added: adding a zero would turn a −0 into +0 and part a replay from the trajectory's run.
+      if (hand_force_N_ != Vec3{}) force_N += to_eigen(hand_force_N_);
+    } else {
+      from_m = to_eigen(trajectory_.sample_at(t_s, segment_hint_).position_m);
+      to_m = to_eigen(trajectory_.sample_at(t_s + h_s, segment_hint_).position_m);
+    }
     finger_.step(from_m, (to_m - from_m) / h_s, force_N, h_s);
   }
+  target_now_m_ = target_next_m_;
   time_s_ += dt_s;
   ++state_.tick;
   state_.encoder_counts = hardware_.encoder_counts(finger_.position_m());
   return state_;
+}
+
+void DeviceSim::steer(const Vec3& target_m) {
+  if (!steered_) target_now_m_ = trajectory_.position_at(time_s_);
+  steered_ = true;
+  target_next_m_ = target_m;
+}
+
+void DeviceSim::set_hand_force(const Vec3& force_N) {
+  if (!steered_) steer(trajectory_.position_at(time_s_));
+  hand_force_N_ = force_N;
+}
+
+// Point k of `substeps` along the tick's straight line from target_now_m_ to target_next_m_; the ends are the two
+// points themselves (not now + (next − now)·1, which may round off the point the caller gave).
+Eigen::Vector3d DeviceSim::steered_point(int k, int substeps) const {
+  if (k == 0) return to_eigen(target_now_m_);
+  if (k == substeps) return to_eigen(target_next_m_);
+  const Eigen::Vector3d now_m = to_eigen(target_now_m_);
+  return now_m + (to_eigen(target_next_m_) - now_m) * (static_cast<double>(k) / substeps);
 }
 
 const char* DeviceSim::log_header() {

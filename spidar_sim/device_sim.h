@@ -45,12 +45,25 @@ class DeviceSim {
   // device_session and seals the frame before publishing it.
   const DeviceState& tick(const std::array<double, kStringCount>& commanded_tension_N, double dt_s);
 
+  // Closed loop (loop/simulation.h): the caller moves the target instead of the trajectory. steer() says where the
+  // target is at the end of the next tick; over that tick it moves in a straight line from where it is now (a chord,
+  // as the trajectory's is over a sub-step), then holds there until steered again. From the first steer() on the
+  // trajectory is no longer played and the session never finishes: its owner ends it. A caller that steers to the
+  // trajectory's own points at the tick ends, position_at(time_s() + dt_s), gets bitwise the trajectory's run when a
+  // tick is one sub-step (the default finger and motors without lag). `target_m` must be finite (not checked here).
+  void steer(const Vec3& target_m);
+  // A force (N) the hand adds on the finger, on top of its impedance about the target, held until set again: a
+  // controller that pushes instead of aiming. Steers the target where it is, as steer() does. Finite (not checked).
+  void set_hand_force(const Vec3& force_N);
+  bool steered() const { return steered_; }
+
   // A realtime hiccup longer than this is a bug upstream, not a tick: the sub-step count would explode.
   static constexpr double kMaxTick_s = 1.0;
 
   const DeviceState& state() const { return state_; }
   double time_s() const { return time_s_; }
-  Vec3 target_m() const { return trajectory_.position_at(time_s_); }
+  Vec3 target_m() const { return steered_ ? target_now_m_ : trajectory_.position_at(time_s_); }
+  const Vec3& hand_force_N() const { return hand_force_N_; }
   Vec3 finger_m() const { return to_vec3(finger_.position_m()); }
   Vec3 finger_velocity_mps() const { return to_vec3(finger_.velocity_mps()); }
   // Net string force on the finger at the end of the last tick (N): Σ t_i·u_i.
@@ -58,7 +71,7 @@ class DeviceSim {
   const std::array<double, kStringCount>& tensions_N() const { return hardware_.tensions_N(); }
   const std::array<std::int64_t, kStringCount>& encoder_counts() const { return state_.encoder_counts; }
   // True once the session time reaches the end of the trajectory (the target then holds still).
-  bool finished() const { return time_s_ >= trajectory_.duration_s(); }
+  bool finished() const { return !steered_ && time_s_ >= trajectory_.duration_s(); }
 
   const Trajectory& trajectory() const { return trajectory_; }
   const SpidarHardware& hardware() const { return hardware_; }
@@ -73,12 +86,19 @@ class DeviceSim {
   void write_log_row(std::ostream& out) const { format_log_row(out, log_row()); }
 
  private:
+  Eigen::Vector3d steered_point(int k, int substeps) const;
+
   SpidarHardware hardware_;
   Trajectory trajectory_;
   std::size_t segment_hint_ = 0;  // the trajectory segment of the last sub-step (Trajectory::sample_at)
   Finger finger_;
   double time_s_ = 0.0;
   DeviceState state_{};
+  // Steered (closed loop): the target now and at the end of the next tick, and the hand's own push.
+  bool steered_ = false;
+  Vec3 target_now_m_{};
+  Vec3 target_next_m_{};
+  Vec3 hand_force_N_{};
 };
 
 }  // namespace impetus

@@ -33,6 +33,7 @@ class SimulatedFingers {
   // Finger k's node on `port` (which must outlive this), logging to endpoint_log_path(log_path, k) ("" for none).
   DeviceNode& attach(std::size_t k, DevicePortClient& port, const std::string& log_path, std::uint64_t device_session);
   DeviceNode& node(std::size_t k) { return *nodes_[k]; }
+  DeviceSim& sim(std::size_t k) { return *sims_[k]; }  // finger k's hand and strings (a closed loop steers them)
   // Runs every attached node until its trajectory ends: finger 0 on this thread, the others on threads of their own
   // (in lockstep each waits for its own turn, which the haptic controller gives in finger order). Returns the worst
   // exit status.

@@ -631,11 +631,33 @@ Trajectory load_trajectory(const std::string& spec_or_path) {
   return load_trajectory_csv(spec_or_path);
 }
 
-std::vector<NamedFinger> parse_fingers(const std::vector<std::string>& specs, std::size_t max_fingers) {
-  if (specs.empty() || specs.size() > max_fingers) {
+namespace {
+
+void check_finger_count(std::size_t count, std::size_t max_fingers) {
+  if (count == 0 || count > max_fingers) {
     throw TrajectoryError("a device has 1 to " + std::to_string(max_fingers) + " fingers, but " +
-                          std::to_string(specs.size()) + " were given");
+                          std::to_string(count) + " were given");
   }
+}
+
+void check_new_name(const std::string& name, const std::vector<NamedFinger>& fingers) {
+  if (name.empty()) throw TrajectoryError("a finger needs a name");
+  for (const NamedFinger& other : fingers) {
+    if (other.name == name) throw TrajectoryError("finger '" + name + "' is given twice");
+  }
+}
+
+}  // namespace
+
+void check_fingers(const std::vector<NamedFinger>& fingers, std::size_t max_fingers) {
+  check_finger_count(fingers.size(), max_fingers);
+  for (std::size_t k = 0; k < fingers.size(); ++k) {
+    check_new_name(fingers[k].name, std::vector<NamedFinger>(fingers.begin(), fingers.begin() + k));
+  }
+}
+
+std::vector<NamedFinger> parse_fingers(const std::vector<std::string>& specs, std::size_t max_fingers) {
+  check_finger_count(specs.size(), max_fingers);
   std::vector<NamedFinger> fingers;
   for (const std::string& spec : specs) {
     const std::size_t equals = spec.find('=');
@@ -643,9 +665,7 @@ std::vector<NamedFinger> parse_fingers(const std::vector<std::string>& specs, st
       throw TrajectoryError("finger '" + spec + "': expected NAME=TRAJECTORY (e.g. thumb=grasp_thumb.csv)");
     }
     const std::string name = spec.substr(0, equals);
-    for (const NamedFinger& other : fingers) {
-      if (other.name == name) throw TrajectoryError("finger '" + name + "' is given twice");
-    }
+    check_new_name(name, fingers);
     try {
       Trajectory trajectory = load_trajectory(spec.substr(equals + 1));  // apart from the braced element: see spidar_sim/main.cpp
       fingers.push_back({name, std::move(trajectory)});

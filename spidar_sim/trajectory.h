@@ -168,6 +168,9 @@ struct NamedFinger {
 // Parses "NAME=TRAJECTORY" specs (TRAJECTORY as load_trajectory takes it): 1 to `max_fingers` of them, names
 // non-empty and distinct. Throws TrajectoryError naming the spec.
 std::vector<NamedFinger> parse_fingers(const std::vector<std::string>& specs, std::size_t max_fingers);
+// Fingers made another way (trajectories from arrays): 1 to `max_fingers`, names non-empty and distinct. Throws
+// TrajectoryError as parse_fingers does.
+void check_fingers(const std::vector<NamedFinger>& fingers, std::size_t max_fingers);
 
 // The parts of load_trajectory, for callers that know which they have.
 Trajectory load_trajectory_csv(const std::string& path);

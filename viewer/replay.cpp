@@ -205,11 +205,17 @@ Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<View
     std::error_code missing;
     if (!fs::is_regular_file(haptic_path, missing)) break;
     const CsvTable haptic = read_csv(haptic_path);
-    static const char* const kHapticColumns[] = {"time_s",  "finger_x", "finger_y", "finger_z", "proxy_x",
-                                                 "proxy_y", "proxy_z",  "force_x",  "force_y",  "force_z"};
+    static const char* const kHapticColumns[] = {"time_s",    "finger_x_m", "finger_y_m", "finger_z_m",
+                                                 "proxy_x_m", "proxy_y_m",  "proxy_z_m",  "force_x_N",
+                                                 "force_y_N", "force_z_N"};
     std::array<int, 10> hc{};
     for (int v = 0; v < 10; ++v) {
       hc[v] = haptic.column(kHapticColumns[v]);
+      // Logs recorded before the columns carried their units name them without it ("force_x"): still replayed.
+      if (hc[v] < 0) {
+        const std::string name = kHapticColumns[v];
+        hc[v] = haptic.column(name.substr(0, name.rfind('_')));
+      }
       if (hc[v] < 0) throw ReplayError(haptic_path.string() + ": no column '" + kHapticColumns[v] + "'");
     }
     if (haptic.rows.empty()) break;

@@ -19,7 +19,8 @@ namespace impetus {
 namespace {
 
 Scene scene_with_overrides(const WorldNodeOptions& options) {
-  Scene scene = load_scene(options.scene_path);
+  Scene scene = options.scene_text.empty() ? load_scene(options.scene_path)
+                                            : parse_scene_text(options.scene_text, options.scene_path);
   if (options.substeps) scene.physics.substeps = *options.substeps;
   return scene;
 }

@@ -28,6 +28,9 @@ namespace impetus {
 
 struct WorldNodeOptions {
   std::string scene_path;
+  // A scene built in memory (its JSON text): when not empty it is the scene, and scene_path only names it in messages
+  // and the summary.
+  std::string scene_text;
   std::optional<double> rate_hz;  // default: the scene's physics.world_rate_hz
   std::optional<int> substeps;    // default: the scene's physics.substeps
   Coupling coupling = Coupling::impulse;

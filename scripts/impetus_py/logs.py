@@ -4,7 +4,8 @@
   world.csv   world_manager: one row per world step, the state after it; per object NAME.x_m .. NAME.z_m,
               NAME.qw .. NAME.qz, NAME.vx_mps .., NAME.wx_radps .., and the impulses NAME.jx_Ns .., NAME.jx_total_Ns ..;
               haptic_time_s: the haptic clock's time of the report the step applied (NaN before the first)
-  haptic.csv  haptic_controller: one row per tick: finger_x .., proxy_x .., force_x .. (N, on the finger),
+  haptic.csv  haptic_controller: one row per tick: finger_x_m .., proxy_x_m .., force_x_N .. (on the finger),
+              object_impulse_x_Ns .., static_impulse_x_Ns .. (running totals), interpolation_weight,
               active_planes, flags (bit 0: a device is attached, bit 1: the force was clamped), ...
   device.csv  spidar_sim: one row per device tick: target_x_m .., finger_x_m .., finger_vx_mps .., tensions, counts
 """
@@ -38,7 +39,7 @@ class Log:
         return all(np.isfinite(values).all() for name, values in self.columns.items() if name != "haptic_time_s")
 
     def vectors(self, prefix, suffix=""):
-        """The columns PREFIX{x,y,z}SUFFIX as one row per log row: vectors("finger_") for haptic.csv's finger,
+        """The columns PREFIX{x,y,z}SUFFIX as one row per log row: vectors("finger_", "_m") for haptic.csv's finger,
         vectors("cube.v", "_mps") for world.csv's velocity of the cube."""
         return np.stack([self.columns[f"{prefix}{axis}{suffix}"] for axis in "xyz"], axis=1)
 

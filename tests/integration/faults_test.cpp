@@ -180,8 +180,8 @@ TEST_CASE("a haptic controller stopped mid-press: the device lets go within its 
   }
   REQUIRE(gap > 0);
   const auto force_N = [&](std::size_t k) {
-    return std::sqrt(std::pow(haptic_log.at("force_x")[k], 2) + std::pow(haptic_log.at("force_y")[k], 2) +
-                     std::pow(haptic_log.at("force_z")[k], 2));
+    return std::sqrt(std::pow(haptic_log.at("force_x_N")[k], 2) + std::pow(haptic_log.at("force_y_N")[k], 2) +
+                     std::pow(haptic_log.at("force_z_N")[k], 2));
   };
   double before_N = 0.0;
   double after_N = 0.0;
@@ -345,7 +345,7 @@ TEST_CASE("two users on one world: one controller killed with kill -9 mid-squeez
   CHECK(summary_a["world_attaches"] == 1);
   const auto log_a = test::read_csv_columns(daemons.dir / "haptic_a.csv");
   const auto& time_a = log_a.at("time_s");
-  const auto& force_x = log_a.at("force_x");
+  const auto& force_x = log_a.at("force_x_N");
   REQUIRE(time_a.size() > 5000);
   double before_N = 0.0, after_N = 0.0;
   for (std::size_t i = 0; i < time_a.size(); ++i) {
@@ -437,7 +437,7 @@ TEST_CASE("two users grasp and lift a cube at a 200 Hz world and one controller 
   double before_N = 0.0, gone_N = 0.0;
   for (std::size_t i = 0; i < time_thumb.size(); ++i) {
     const double force_N =
-        std::hypot(log_thumb.at("force_x")[i], log_thumb.at("force_y")[i], log_thumb.at("force_z")[i]);
+        std::hypot(log_thumb.at("force_x_N")[i], log_thumb.at("force_y_N")[i], log_thumb.at("force_z_N")[i]);
     // The controller's clock starts with it, a little after the world's: the same windows with a margin.
     if (time_thumb[i] > 1.0 && time_thumb[i] < kill_s - 0.3) before_N = std::max(before_N, force_N);
     if (time_thumb[i] > kill_s + 0.1 && time_thumb[i] < kill_s + 0.9) gone_N = std::max(gone_N, force_N);

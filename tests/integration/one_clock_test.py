@@ -49,7 +49,7 @@ def main():
     world_log = logs.read_log(out / logs.WORLD)
     haptic_log = logs.read_log(out / logs.HAPTIC)
     ahead_s = logs.world_clock_offset_s(world_log)
-    pushed = haptic_log["time_s"][haptic_log["force_x"] < -PUSH_N]
+    pushed = haptic_log["time_s"][haptic_log["force_x_N"] < -PUSH_N]
     moved = abs(world_log["cube.x_m"] - world_log["cube.x_m"][0]) > MOVED_M
     if len(pushed) == 0 or not moved.any():
         sys.exit("one_clock_test: the finger never pushed the cube away")

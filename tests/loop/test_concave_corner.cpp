@@ -74,8 +74,8 @@ struct Log {
     FAIL("no column " << name);
     return 0;
   }
-  Vector3d vector(std::size_t row, const std::string& prefix) const {
-    return {rows[row][column(prefix + "x")], rows[row][column(prefix + "y")], rows[row][column(prefix + "z")]};
+  Vector3d vector(std::size_t row, const std::string& prefix, const std::string& suffix) const {
+    return {rows[row][column(prefix + "x" + suffix)], rows[row][column(prefix + "y" + suffix)], rows[row][column(prefix + "z" + suffix)]};
   }
 };
 
@@ -121,7 +121,7 @@ TEST_CASE("a finger pressed into a concave corner of touching boxes is held by a
     std::vector<std::size_t> held;  // ticks with a finger (the last row, after the device left, has none)
     for (std::size_t row = 0; row < haptic.rows.size(); ++row) {
       if ((static_cast<int>(haptic.rows[row][flags]) & 1) == 0) continue;
-      const Vector3d proxy = turn.conjugate() * (haptic.vector(row, "proxy_") - kCorner_m);
+      const Vector3d proxy = turn.conjugate() * (haptic.vector(row, "proxy_", "_m") - kCorner_m);
       deepest_m = std::max(deepest_m, depth_in_walls_m(proxy));
       held.push_back(row);
     }
@@ -129,8 +129,8 @@ TEST_CASE("a finger pressed into a concave corner of touching boxes is held by a
     // The last 0.2 s of the hold, in the corner frame: the finger's mean position and the mean force.
     Vector3d finger = Vector3d::Zero(), force = Vector3d::Zero();
     for (std::size_t k = held.size() - 200; k < held.size(); ++k) {
-      finger += turn.conjugate() * (haptic.vector(held[k], "finger_") - kCorner_m) / 200.0;
-      force += turn.conjugate() * haptic.vector(held[k], "force_") / 200.0;
+      finger += turn.conjugate() * (haptic.vector(held[k], "finger_", "_m") - kCorner_m) / 200.0;
+      force += turn.conjugate() * haptic.vector(held[k], "force_", "_N") / 200.0;
     }
     INFO("turn " << turn.coeffs().transpose() << ": proxy up to " << deepest_m * 1e3 << " mm inside the walls; finger "
                  << finger.transpose() * 1e3 << " mm, force " << force.transpose() << " N (corner frame)");

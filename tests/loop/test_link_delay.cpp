@@ -77,7 +77,7 @@ std::vector<std::array<double, 3>> rendered_by_tick(const std::filesystem::path&
     return std::size_t{0};
   };
   const std::size_t tick_column = column("tick");
-  const std::size_t x_column = column("object_impulse_x");
+  const std::size_t x_column = column("object_impulse_x_Ns");
   std::vector<std::array<double, 3>> rendered;
   for (std::string row; std::getline(text, row);) {
     std::vector<double> values;

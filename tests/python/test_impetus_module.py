@@ -57,7 +57,7 @@ class SameAsRunSh(unittest.TestCase):
                              else phase)
         # The arrays are the log's columns: as many rows as ticks, the same numbers as the file.
         haptic = trial.logs["haptic"]
-        self.assertEqual(len(haptic["force_x"]), trial.summary["haptic"]["ticks"])
+        self.assertEqual(len(haptic["force_x_N"]), trial.summary["haptic"]["ticks"])
         first_row = (trial.out_dir / "haptic.csv").read_text().splitlines()[1].split(",")
         header = (trial.out_dir / "haptic.csv").read_text().splitlines()[0].split(",")
         self.assertEqual([float(v) for v in first_row], [float(haptic[c][0]) for c in header])
@@ -312,13 +312,13 @@ class Arguments(unittest.TestCase):
     def test_read_log_refuses_a_damaged_file(self):
         damaged = OUT / "damaged.csv"
         damaged.parent.mkdir(parents=True, exist_ok=True)
-        damaged.write_text("time_s,force_x\n0.0,1.0\n0.001,oops\n")
+        damaged.write_text("time_s,force_x_N\n0.0,1.0\n0.001,oops\n")
         with self.assertRaises(RuntimeError) as raised:
             impetus.read_log(damaged)
         self.assertIn("line 3", str(raised.exception))
-        self.assertIn("force_x", str(raised.exception))
-        damaged.write_text("time_s,force_x\n0.0,1.0\n0.001,2.0\n")
-        self.assertTrue(np.array_equal(impetus.read_log(damaged)["force_x"], [1.0, 2.0]))
+        self.assertIn("force_x_N", str(raised.exception))
+        damaged.write_text("time_s,force_x_N\n0.0,1.0\n0.001,2.0\n")
+        self.assertTrue(np.array_equal(impetus.read_log(damaged)["force_x_N"], [1.0, 2.0]))
 
 
 class Defaults(unittest.TestCase):
