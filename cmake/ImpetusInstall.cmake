@@ -63,16 +63,20 @@ set(CPACK_DEBIAN_DEV_PACKAGE_NAME impetus-dev)
 set(CPACK_COMPONENT_RUNTIME_DESCRIPTION "Multi-rate haptic rendering with force integration: daemons, viewer, Python module")
 set(CPACK_COMPONENT_DEV_DESCRIPTION "Multi-rate haptic rendering with force integration: headers and static libraries")
 set(CPACK_PACKAGE_VENDOR "Impetus")
-set(CPACK_PACKAGE_CONTACT "Impetus developers <impetus@localhost>")
+# Whoever publishes the packages names themselves here (cmake -DIMPETUS_DEB_MAINTAINER="Name <address>"): the
+# default is the project's, for builds nobody redistributes.
+set(IMPETUS_DEB_MAINTAINER "Impetus developers <impetus@localhost>" CACHE STRING
+    "The DEB packages' Maintainer field: Name <address>")
+set(CPACK_PACKAGE_CONTACT "${IMPETUS_DEB_MAINTAINER}")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Multi-rate haptic rendering with force integration")
 set(CPACK_RESOURCE_FILE_LICENSE ${PROJECT_SOURCE_DIR}/LICENSE)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
-set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "libode8, libddsc0debian, libstdc++6, libc6")
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "libode8, libbullet3.24, libddsc0debian, libstdc++6, libc6")
 if(IMPETUS_PYTHON_DEB_DEPENDS)
   string(APPEND CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS ", ${IMPETUS_PYTHON_DEB_DEPENDS}")
 endif()
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
-    "impetus (= ${PROJECT_VERSION}), libode-dev, libeigen3-dev, libboost-dev, nlohmann-json3-dev, libcli11-dev")
+    "impetus (= ${PROJECT_VERSION}), libode-dev, libbullet-dev, libeigen3-dev, libboost-dev, nlohmann-json3-dev, libcli11-dev")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 include(CPack)

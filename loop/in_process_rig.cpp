@@ -95,6 +95,7 @@ InProcessRig::InProcessRig(const InProcessTrialOptions& options, std::vector<Nam
   world_options.scene_text = options.scene_text;
   world_options.rate_hz = options.world_rate_hz;
   world_options.substeps = options.substeps;
+  world_options.engine = options.engine;
   world_options.coupling = options.coupling;
   world_options.clock = ClockMode::lockstep;
   world_options.phase_ticks = options.phase_ticks;

@@ -46,6 +46,7 @@ struct InProcessTrialOptions {
   // Each has the range of the daemon flag it mirrors (common/contract/limits.h) and the same default.
   std::optional<double> world_rate_hz;  // world_manager --rate; default: the scene's physics.world_rate_hz
   std::optional<int> substeps;          // world_manager --substeps; default: the scene's physics.substeps
+  std::optional<std::string> engine;    // world_manager --engine; default: the scene's physics.engine
   double stiffness_Npm = std::numeric_limits<double>::quiet_NaN();  // haptic_controller --stiffness; NaN: the scene's
   double damping_Nspm = std::numeric_limits<double>::quiet_NaN();   // haptic_controller --damping; NaN: the scene's
   double duration_s = 0.0;  // haptic_controller --duration: the longest trial in seconds; 0: the whole trajectory

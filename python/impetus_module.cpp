@@ -62,6 +62,7 @@ impetus::Trajectory trajectory_from_array(const py::array_t<double, py::array::c
 impetus::InProcessTrialOptions trial_options(const std::string& scene, const std::string& scene_text,
                                              const std::string& coupling, std::uint64_t phase_ticks,
                                              std::optional<double> world_rate_hz, std::optional<int> substeps,
+                                             const std::optional<std::string>& engine,
                                              std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm,
                                              double link_delay_s, const std::string& out_dir) {
   impetus::InProcessTrialOptions options;
@@ -71,6 +72,7 @@ impetus::InProcessTrialOptions trial_options(const std::string& scene, const std
   options.phase_ticks = phase_ticks;
   options.world_rate_hz = world_rate_hz;
   options.substeps = substeps;
+  options.engine = engine;
   if (stiffness_Npm) options.stiffness_Npm = *stiffness_Npm;
   if (damping_Nspm) options.damping_Nspm = *damping_Nspm;
   options.link_delay_s = link_delay_s;
@@ -86,10 +88,12 @@ std::string run_trial(const std::string& scene, const std::string& scene_text, c
                       const std::vector<std::string>& fingers, const std::vector<FingerPath>& finger_paths,
                       const std::vector<std::vector<std::string>>& followers, const std::string& coupling,
                       std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
-                      std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm, double link_delay_s,
-                      double duration_s, const std::string& out_dir) {
+                      const std::optional<std::string>& engine, std::optional<double> stiffness_Npm,
+                      std::optional<double> damping_Nspm, double link_delay_s, double duration_s,
+                      const std::string& out_dir) {
   impetus::InProcessTrialOptions options = trial_options(scene, scene_text, coupling, phase_ticks, world_rate_hz,
-                                                         substeps, stiffness_Npm, damping_Nspm, link_delay_s, out_dir);
+                                                         substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s,
+                                                         out_dir);
   options.trajectory = trajectory;
   options.fingers = fingers;
   for (const auto& [name, spec, table] : finger_paths) {
@@ -190,11 +194,11 @@ class ClosedLoop {
   ClosedLoop(const std::string& scene, const std::string& scene_text,
              const std::vector<std::pair<std::string, std::array<double, 3>>>& fingers, const std::string& coupling,
              std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
-             std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm, double link_delay_s,
-             const std::string& out_dir) {
+             const std::optional<std::string>& engine, std::optional<double> stiffness_Npm,
+             std::optional<double> damping_Nspm, double link_delay_s, const std::string& out_dir) {
     impetus::SimulationOptions options;
-    options.trial = trial_options(scene, scene_text, coupling, phase_ticks, world_rate_hz, substeps, stiffness_Npm,
-                                  damping_Nspm, link_delay_s, out_dir);
+    options.trial = trial_options(scene, scene_text, coupling, phase_ticks, world_rate_hz, substeps, engine,
+                                  stiffness_Npm, damping_Nspm, link_delay_s, out_dir);
     for (const auto& [name, start_m] : fingers) options.fingers.push_back({name, start_m});
     options.trial.stop = &stop_;
     py::gil_scoped_release release;
@@ -340,17 +344,19 @@ PYBIND11_MODULE(_impetus, module) {
   (void)py::dtype::of<double>();
   module.def("run_trial", &run_trial, py::arg("scene"), py::arg("scene_text"), py::arg("trajectory"),
              py::arg("fingers"), py::arg("finger_paths"), py::arg("followers"), py::arg("coupling"),
-             py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("stiffness_Npm"),
-             py::arg("damping_Nspm"), py::arg("link_delay_s"), py::arg("duration_s"), py::arg("out_dir"));
+             py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("engine"),
+             py::arg("stiffness_Npm"), py::arg("damping_Nspm"), py::arg("link_delay_s"), py::arg("duration_s"),
+             py::arg("out_dir"));
   module.def("read_log", &read_log, py::arg("path"));
   module.def("sample_trajectory", &sample_trajectory, py::arg("spec"), py::arg("times_s"));
   py::class_<ClosedLoop>(module, "ClosedLoop")
       .def(py::init<const std::string&, const std::string&,
                     const std::vector<std::pair<std::string, std::array<double, 3>>>&, const std::string&,
-                    std::uint64_t, std::optional<double>, std::optional<int>, std::optional<double>,
-                    std::optional<double>, double, const std::string&>(),
+                    std::uint64_t, std::optional<double>, std::optional<int>, const std::optional<std::string>&,
+                    std::optional<double>, std::optional<double>, double, const std::string&>(),
            py::arg("scene"), py::arg("scene_text"), py::arg("fingers"), py::arg("coupling"), py::arg("phase_ticks"),
-           py::arg("world_rate_hz"), py::arg("substeps"), py::arg("stiffness_Npm"), py::arg("damping_Nspm"),
+           py::arg("world_rate_hz"), py::arg("substeps"), py::arg("engine"), py::arg("stiffness_Npm"),
+           py::arg("damping_Nspm"),
            py::arg("link_delay_s"), py::arg("out_dir"))
       .def("step", &ClosedLoop::step, py::arg("ticks"), py::arg("targets"))
       .def("set_target", &ClosedLoop::set_target, py::arg("finger"), py::arg("target_m"))

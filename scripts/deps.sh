@@ -14,7 +14,7 @@ case "${1:-}" in
   "") ;;
   *) echo "deps.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
 esac
-IMPETUS_PACKAGES=(cmake g++ make pkg-config libeigen3-dev libode-dev libboost-dev catch2 nlohmann-json3-dev
+IMPETUS_PACKAGES=(cmake g++ make pkg-config libeigen3-dev libode-dev libbullet-dev libboost-dev catch2 nlohmann-json3-dev
                   libcli11-dev python3-matplotlib python3-numpy python3-tqdm
                   pybind11-dev python3-dev  # the impetus Python module (python/)
                   cyclonedds-dev cyclonedds-tools  # the world link over DDS (common/link/dds; idlc)

@@ -12,6 +12,7 @@
 #include "world_manager/world_node.h"
 
 #include <memory>
+#include <string>
 
 namespace {
 // A phase is less than one world period in haptic ticks, and the longest period is the fastest haptic rate over the
@@ -26,13 +27,21 @@ int main(int argc, char** argv) {
   std::string summary_path;
   std::string shm = "impetus";
   LinkOptions link_options;
-  CLI::App app{"world_manager: the ODE world of Impetus. Steps a scene at the world rate, applies the haptic "
+  CLI::App app{"world_manager: the physics world of Impetus. Steps a scene at the world rate, applies the haptic "
                "controller's impulses and publishes the planes near the finger."};
   app.add_option("--scene", options.scene_path, "scene file (JSON, see scenes/)")->required()->check(CLI::ExistingFile);
   app.add_option("--rate", options.rate_hz, "world rate in Hz, 0.1 to 10000 (default: the scene's world_rate_hz)")
       ->check(number_in(limits::kMinWorldRate_Hz, limits::kMaxWorldRate_Hz));
-  app.add_option("--substeps", options.substeps, "ODE steps per world period (default: the scene's physics.substeps)")
+  app.add_option("--substeps", options.substeps,
+                 "engine steps per world period (default: the scene's physics.substeps)")
       ->check(whole_number_in(1, limits::kMaxSubsteps));
+  app.add_option("--engine", options.engine,
+                 "the rigid-body engine, " + engine_names() + " (default: the scene's physics.engine)")
+      ->check(CLI::Validator(
+          [](std::string& name) {
+            return find_engine(name) != nullptr ? std::string() : "must be " + engine_names() + ", not '" + name + "'";
+          },
+          "ENGINE"));
   app.add_option("--coupling", options.coupling, "impulse (paper §2.2), position (the previous method) or local")
       ->transform(enum_names(kCouplingNames));
   add_clock_flag(app, options.clock);

@@ -121,6 +121,12 @@ struct OdeParams {
   double max_correcting_velocity_mps = std::numeric_limits<double>::infinity();
 };
 
+// Bullet's own settings: the scene's "physics": {"bullet": {...}} (world_manager/engine/bullet_params.cpp).
+struct BulletParams {
+  // Sequential-impulse sweeps per substep: ODE's QuickStep count, so the two iterate alike (Bullet's default is 10).
+  int solver_iterations = 20;
+};
+
 // How the world is simulated: engine-neutral settings, and each engine's own block (docs/scene-format.md "physics").
 struct PhysicsParams {
   // The rigid-body engine, by its name in the registry (world_manager/engine/engine_registry.h).
@@ -150,6 +156,7 @@ struct PhysicsParams {
   bool auto_disable = true;
   std::uint64_t seed = 1;  // the engine's random stream, so runs are bitwise reproducible
   OdeParams ode;
+  BulletParams bullet;
 
   // What ODE is given for substeps of `substep_s`: its ERP and CFM as they are, or from the spring and damper.
   double erp_at(double substep_s) const;

@@ -7,6 +7,7 @@
 #include "common/runtime/realtime_clock.h"
 #include "common/runtime/staleness.h"
 #include "common/spidar/geometry.h"
+#include "world_manager/engine/engine_registry.h"
 #include "world_manager/impulse_limits.h"
 #include "world_manager/world_view.h"
 
@@ -22,6 +23,12 @@ Scene scene_with_overrides(const WorldNodeOptions& options) {
   Scene scene = options.scene_text.empty() ? load_scene(options.scene_path)
                                             : parse_scene_text(options.scene_text, options.scene_path);
   if (options.substeps) scene.physics.substeps = *options.substeps;
+  if (options.engine) {
+    if (find_engine(*options.engine) == nullptr) {
+      throw std::invalid_argument("engine: unknown engine '" + *options.engine + "', expected " + engine_names());
+    }
+    scene.physics.engine = *options.engine;
+  }
   return scene;
 }
 

@@ -33,6 +33,9 @@ struct WorldNodeOptions {
   std::string scene_text;
   std::optional<double> rate_hz;  // default: the scene's physics.world_rate_hz
   std::optional<int> substeps;    // default: the scene's physics.substeps
+  // The rigid-body engine by its registry name (engine/engine_registry.h); default: the scene's physics.engine. The
+  // scene's block for another engine is then not used.
+  std::optional<std::string> engine;
   Coupling coupling = Coupling::impulse;
   ClockMode clock = ClockMode::realtime;
   std::uint64_t phase_ticks = 0;

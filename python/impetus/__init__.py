@@ -41,7 +41,7 @@ except ImportError as _error:
     raise ImportError(f"impetus: its compiled module cannot be loaded: {_error}") from _error
 
 __version__ = "@PROJECT_VERSION@"
-__all__ = ["COUPLINGS", "LOG_FILES", "Simulation", "Step", "Trial", "defaults", "read_log", "run_trial",
+__all__ = ["COUPLINGS", "ENGINES", "LOG_FILES", "Simulation", "Step", "Trial", "defaults", "read_log", "run_trial",
            "sample_trajectory", "scene_dir", "shipped_scene"]
 
 
@@ -59,6 +59,9 @@ def defaults():
 #             whole world period;
 #   local     impulse coupling plus the paper's §6.3: the haptic side moves the touched objects between world steps.
 COUPLINGS = tuple(defaults()["couplings"])
+
+# The rigid-body engines a scene or a run can choose (world_manager --engine), the default first.
+ENGINES = tuple(defaults()["engines"])
 
 # The logs a trial writes, by the key Trial.logs uses.
 LOG_FILES = {"world": "world.csv", "haptic": "haptic.csv", "device": "device.csv"}
@@ -155,10 +158,12 @@ def _scene_argument(scene):
     return str(path), ""
 
 
-def _options(coupling, rate_hz, phase_ticks, substeps, stiffness_Npm, damping_Nspm, link_delay_s):
+def _options(coupling, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s):
     """The options every run takes, checked and converted (ValueError naming the argument)."""
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling: must be one of {', '.join(COUPLINGS)}, not {coupling!r}")
+    if engine is not None and engine not in ENGINES:
+        raise ValueError(f"engine: must be one of {', '.join(ENGINES)} or None, not {engine!r}")
     if isinstance(phase_ticks, bool) or not isinstance(phase_ticks, numbers.Integral) or not 0 <= phase_ticks < 2**64:
         raise ValueError(f"phase_ticks: must be a whole number of ticks, 0 or more, not {phase_ticks!r}")
     if substeps is not None:
@@ -167,7 +172,7 @@ def _options(coupling, rate_hz, phase_ticks, substeps, stiffness_Npm, damping_Ns
         if substeps >= 2**31:
             raise ValueError(f"substeps: {substeps} is beyond the world's range (world_manager --help states it)")
         substeps = int(substeps)
-    return (coupling, int(phase_ticks), _real("rate_hz", rate_hz, optional=True), substeps,
+    return (coupling, int(phase_ticks), _real("rate_hz", rate_hz, optional=True), substeps, engine,
             _real("stiffness_Npm", stiffness_Npm, optional=True), _real("damping_Nspm", damping_Nspm, optional=True),
             _real("link_delay_s", link_delay_s))
 
@@ -187,7 +192,8 @@ def _is_path_like(value):
 
 
 def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, phase_ticks=0, substeps=None,
-              stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, duration_s=60.0, out_dir=None, logs=True):
+              engine=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, duration_s=60.0, out_dir=None,
+              logs=True):
     """Runs one trial and returns its Trial.
 
     scene          a scene file (str or path; shipped_scene("tap") for a shipped one), or a dict in the scene file's
@@ -205,7 +211,8 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
                    summary["world"]["endpoints"])
     rate_hz        the world rate (world_manager --rate); None: the scene's
     phase_ticks    the world clock's lockstep phase in haptic ticks, within one world period (world_manager --phase)
-    substeps       ODE steps per world period (world_manager --substeps); None: the scene's
+    substeps       engine steps per world period (world_manager --substeps); None: the scene's
+    engine         the rigid-body engine, one of ENGINES (world_manager --engine); None: the scene's
     stiffness_Npm, damping_Nspm   the contact spring and damper (haptic_controller --stiffness, --damping); None:
                    the scene's
     link_delay_s   a one-way delay of the world link, the same both ways, 0 to 1 s, rounded to the nearest whole
@@ -230,8 +237,8 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
         raise TypeError(f"out_dir: must be a path or None, not {type(out_dir).__name__}")
     if isinstance(users, (str, dict)) or not all(isinstance(user, (str, dict, pathlib.Path)) for user in users):
         raise ValueError(f"users: must be a list of trajectories or {{name: trajectory}} dicts, not {users!r}")
-    coupling, phase_ticks, rate_hz, substeps, stiffness_Npm, damping_Nspm, link_delay_s = _options(
-        coupling, rate_hz, phase_ticks, substeps, stiffness_Npm, damping_Nspm, link_delay_s)
+    coupling, phase_ticks, rate_hz, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s = _options(
+        coupling, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s)
     duration_s = _real("duration_s", duration_s)
     # Specs and files go by name, as spidar_sim --finger NAME=PATH takes them; with an array among them every finger
     # goes as (name, spec, waypoints). One finger given as a spec or file keeps the single-trajectory form, so its
@@ -250,7 +257,8 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
                      else [f"finger={user}"] for user in users]
         summary = json.loads(_impetus.run_trial(scene_path, scene_text, str(trajectory) if single else "", fingers,
                                                 paths, followers, coupling, phase_ticks, rate_hz, substeps,
-                                                stiffness_Npm, damping_Nspm, float(link_delay_s), float(duration_s),
+                                                engine, stiffness_Npm, damping_Nspm, float(link_delay_s),
+                                                float(duration_s),
                                                 str(directory) if (out_dir is not None or logs) else ""))
         # What run.sh adds to the daemons' config (impetus_py/summary.py): the trial's own arguments.
         if single:
@@ -332,7 +340,8 @@ class Simulation:
     scene        a scene file or a dict in its schema (as run_trial takes it)
     start_m      where the one finger starts, at rest (x, y, z in metres); or fingers=
     fingers      several fingers: {name: start point} in endpoint order
-    coupling, rate_hz, phase_ticks, substeps, stiffness_Npm, damping_Nspm, link_delay_s   as run_trial takes them
+    coupling, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s   as run_trial
+                 takes them
     out_dir      a directory for world.csv, haptic.csv, device.csv and (at close) summary.json; None: no logs
 
     A Simulation holds a physics world: use it in a `with` block or call close() (which it also does when
@@ -341,7 +350,7 @@ class Simulation:
     """
 
     def __init__(self, scene, start_m=None, coupling="impulse", *, fingers=None, rate_hz=None, phase_ticks=0,
-                 substeps=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, out_dir=None):
+                 substeps=None, engine=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, out_dir=None):
         import numpy as np
         self._loop = None
         self.summary = None
@@ -358,7 +367,8 @@ class Simulation:
             starts.append((str(name), self._point(label, point)))
         if out_dir is not None and not isinstance(out_dir, (str, os.PathLike)):
             raise TypeError(f"out_dir: must be a path or None, not {type(out_dir).__name__}")
-        options = _options(coupling, rate_hz, phase_ticks, substeps, stiffness_Npm, damping_Nspm, link_delay_s)
+        options = _options(coupling, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm,
+                           link_delay_s)
         self.out_dir = pathlib.Path(out_dir) if out_dir is not None else None
         if self.out_dir is not None:
             self.out_dir.mkdir(parents=True, exist_ok=True)

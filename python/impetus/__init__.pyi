@@ -11,6 +11,7 @@ __version__: str
 __all__: list[str]
 
 COUPLINGS: tuple[str, ...]
+ENGINES: tuple[str, ...]
 LOG_FILES: dict[str, str]
 
 _Path = Union[str, os.PathLike[str]]
@@ -33,7 +34,8 @@ def read_log(path: _Path) -> dict[str, npt.NDArray[np.float64]]: ...
 def sample_trajectory(trajectory: _Path, times_s: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
 def run_trial(scene: _Scene, trajectory: _Trajectory, coupling: str = ..., *, users: Sequence[_Trajectory] = ...,
               rate_hz: float | None = ..., phase_ticks: int = ..., substeps: int | None = ...,
-              stiffness_Npm: float | None = ..., damping_Nspm: float | None = ..., link_delay_s: float = ...,
+              engine: str | None = ..., stiffness_Npm: float | None = ..., damping_Nspm: float | None = ...,
+              link_delay_s: float = ...,
               duration_s: float = ..., out_dir: _Path | None = ..., logs: bool = ...) -> Trial: ...
 
 class Step:
@@ -56,8 +58,8 @@ class Simulation:
     tick_period_s: float
     def __init__(self, scene: _Scene, start_m: _Point | None = ..., coupling: str = ..., *,
                  fingers: Mapping[str, _Point] | None = ..., rate_hz: float | None = ..., phase_ticks: int = ...,
-                 substeps: int | None = ..., stiffness_Npm: float | None = ..., damping_Nspm: float | None = ...,
-                 link_delay_s: float = ..., out_dir: _Path | None = ...) -> None: ...
+                 substeps: int | None = ..., engine: str | None = ..., stiffness_Npm: float | None = ...,
+                 damping_Nspm: float | None = ..., link_delay_s: float = ..., out_dir: _Path | None = ...) -> None: ...
     @property
     def ticks(self) -> int: ...
     @property

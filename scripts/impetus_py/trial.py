@@ -61,6 +61,12 @@ def backend():
     return "module" if _impetus_module() else "processes"
 
 
+def engine_choice():
+    """The rigid-body engine the scripts' trials run on: $IMPETUS_ENGINE if set (world_manager --engine, e.g. bullet),
+    else None (each scene's own). scripts/engines.py sets it to run the experiments on every engine."""
+    return os.environ.get("IMPETUS_ENGINE") or None
+
+
 def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=None, substeps=None,
               stiffness_Npm=None, damping_Nspm=None, link_delay_s=None):
     """Runs one lockstep trial of `scene` (a path) driven by `trajectory` (a spidar_sim --trajectory spec or file, or
@@ -68,15 +74,17 @@ def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=No
     into out_dir and returns its Summary. rate_hz, phase_ticks and substeps are world_manager's --rate, --phase and
     --substeps, stiffness_Npm and damping_Nspm haptic_controller's --stiffness and --damping (None: the scene's
     values, phase 0). link_delay_s is the world link's one-way delay (s, both ways; None or 0: none): only the
-    in-process link has a delay line, so a nonzero delay needs the impetus package. Raises RuntimeError naming the
-    trial if it failed."""
+    in-process link has a delay line, so a nonzero delay needs the impetus package. The engine is engine_choice().
+    Raises RuntimeError naming the trial if it failed."""
     out_dir.mkdir(parents=True, exist_ok=True)
     module = _impetus_module()
+    engine = engine_choice()
     if module:
         try:
             trial = module.run_trial(scene, trajectory, coupling, rate_hz=rate_hz, phase_ticks=phase_ticks or 0,
-                                     substeps=substeps, stiffness_Npm=stiffness_Npm, damping_Nspm=damping_Nspm,
-                                     link_delay_s=link_delay_s or 0.0, out_dir=out_dir, logs=False)
+                                     substeps=substeps, engine=engine, stiffness_Npm=stiffness_Npm,
+                                     damping_Nspm=damping_Nspm, link_delay_s=link_delay_s or 0.0, out_dir=out_dir,
+                                     logs=False)
         except (ValueError, RuntimeError, OSError) as error:
             raise RuntimeError(f"trial failed ({scene}, {trajectory}, {coupling} coupling, rate {rate_hz}, "
                                f"phase {phase_ticks}, link delay {link_delay_s or 0.0} s): {error}") from None
@@ -90,7 +98,7 @@ def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=No
         else [["--trajectory", str(trajectory)]]
     command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), *[arg for pair in fingers for arg in pair],
                "--coupling", coupling, "--clock", "lockstep", "--out", str(out_dir), "--quiet"]
-    for flag, value in (("--rate", rate_hz), ("--phase", phase_ticks), ("--substeps", substeps)):
+    for flag, value in (("--rate", rate_hz), ("--phase", phase_ticks), ("--substeps", substeps), ("--engine", engine)):
         if value is not None:
             command += [flag, str(value)]
     haptic_flags = []

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 // World manager benchmarks: printed, no assertions.
-//  1. World::step time for 20 / 200 / 2000 dynamic spheres on the floor (ODE dominates).
+//  1. World::step time for 20 / 200 / 2000 dynamic spheres on the floor, on every engine (the engine dominates).
 //  2. FeatureExtractor::extract time vs number of objects at a constant density around the finger: the query must
 //     cost what is near the finger, not the size of the world. index() (once per step, O(N log N)) is shown apart.
 //  3. Physics inside the 1 kHz loop (one 1 ms ODE step per haptic tick, as CHAI3D's ODE examples run it) against our
 //     20 Hz world (ten 5 ms substeps per 50 ms period): the most spheres each holds within its own period at p99.
 //  4. "Model only what a scene needs": a world of N resting spheres, 10 rolling ones and one a finger presses, with
 //     sleeping on (physics.auto_disable) and off: World::step once the resting ones sleep. The step should cost
-//     what moves, not what exists.
+//     what moves, not what exists. On every engine.
 // Uses world_manager symbols only.
 //
 // --quick: section 4 only up to 10 k objects (scripts/bench.sh --short).
@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace {
@@ -88,10 +89,15 @@ Percentiles step_percentiles(Scene scene, double rate_hz, int substeps, int step
 
 void bench_step() {
   std::printf("World::step (20 Hz, 10 substeps), spheres on the floor\n");
-  std::printf("%8s %12s %12s\n", "spheres", "p50 [us]", "p99 [us]");
-  for (int count : {20, 200, 2000}) {
-    const Percentiles p = step_percentiles(sphere_field(count, 0.05), 20.0, 10, count >= 2000 ? 40 : 200);
-    std::printf("%8d %12.1f %12.1f\n", count, p.p50_us, p.p99_us);
+  std::printf("%8s %8s %12s %12s %16s\n", "engine", "spheres", "p50 [us]", "p99 [us]", "p50 per body [us]");
+  for (const impetus::EngineEntry& entry : impetus::engine_entries()) {
+    for (int count : {20, 200, 2000}) {
+      Scene scene = sphere_field(count, 0.05);
+      scene.physics.engine = std::string(entry.name);
+      const Percentiles p = step_percentiles(scene, 20.0, 10, count >= 2000 ? 40 : 200);
+      std::printf("%8s %8d %12.1f %12.1f %16.2f\n", std::string(entry.name).c_str(), count, p.p50_us, p.p99_us,
+                  p.p50_us / count);
+    }
   }
 }
 
@@ -196,8 +202,9 @@ struct SleepingRun {
 
 // Builds the world, lets it settle for 1 s (resting bodies fall asleep after 0.5 s), then times `steps` steps with a
 // finger pressing sphere 0 down into the floor (a growing running total: a new impulse every step).
-SleepingRun run_sleeping(int resting, bool sleeping, int steps) {
-  const Scene scene = resting_field_with_rollers(resting, sleeping);
+SleepingRun run_sleeping(std::string_view engine, int resting, bool sleeping, int steps) {
+  Scene scene = resting_field_with_rollers(resting, sleeping);
+  scene.physics.engine = std::string(engine);
   auto start = Clock::now();
   impetus::World world(scene, impetus::WorldOptions{});
   const double build_s = std::chrono::duration<double>(Clock::now() - start).count();
@@ -239,23 +246,27 @@ SleepingRun run_sleeping(int resting, bool sleeping, int steps) {
 void bench_sleeping(bool quick) {
   std::printf("\nModel only what a scene needs: N resting spheres + 10 rolling + 1 pressed, World::step (20 Hz, 10 "
               "substeps) after 1 s of settling\n");
-  std::printf("%8s %9s %12s %12s %10s %10s %8s\n", "resting", "sleeping", "p50 [us]", "p99 [us]", "build [s]",
-              "settle [s]", "moving");
+  std::printf("%8s %8s %9s %12s %12s %10s %10s %8s\n", "engine", "resting", "sleeping", "p50 [us]", "p99 [us]",
+              "build [s]", "settle [s]", "moving");
   std::vector<int> counts{1000, 10000};
   if (!quick) counts.push_back(100000);
-  for (const int count : counts) {
-    for (const bool sleeping : {false, true}) {
-      if (!sleeping && count > 10000) {
-        // ODE's hash space clears an n×n bit matrix of tested pairs at every collide: 1.25 GB per substep here.
-        std::printf("%8d %9s %12s (not run: the hash space clears n^2 bits per substep, seconds per step)\n", count,
-                    "off", "-");
-        continue;
+  for (const impetus::EngineEntry& entry : impetus::engine_entries()) {
+    const std::string engine(entry.name);
+    for (const int count : counts) {
+      for (const bool sleeping : {false, true}) {
+        if (!sleeping && count > 10000) {
+          // Every body simulated: ODE's hash space clears an n×n bit matrix of tested pairs at every collide (1.25 GB
+          // per substep here), and any engine then pays for 100 k bodies in every substep.
+          std::printf("%8s %8d %9s %12s (not run: every body simulated, seconds per step)\n", engine.c_str(), count,
+                      "off", "-");
+          continue;
+        }
+        const int steps = !sleeping && count >= 10000 ? 10 : 100;
+        const SleepingRun run = run_sleeping(entry.name, count, sleeping, steps);
+        std::printf("%8s %8d %9s %12.1f %12.1f %10.2f %10.2f %8zu\n", engine.c_str(), count, sleeping ? "on" : "off",
+                    run.step.p50_us, run.step.p99_us, run.build_s, run.settle_s, run.awake);
+        std::fflush(stdout);
       }
-      const int steps = !sleeping && count >= 10000 ? 10 : 100;
-      const SleepingRun run = run_sleeping(count, sleeping, steps);
-      std::printf("%8d %9s %12.1f %12.1f %10.2f %10.2f %8zu\n", count, sleeping ? "on" : "off", run.step.p50_us,
-                  run.step.p99_us, run.build_s, run.settle_s, run.awake);
-      std::fflush(stdout);
     }
   }
 }

@@ -92,6 +92,18 @@ if dpkg-deb -f "$deb" Depends | grep -q -- "-dev"; then
 fi
 dpkg-deb -f "$dev_deb" Depends | grep -q "impetus (= " ||
   { echo "install_test: $(basename "$dev_deb") does not depend on impetus: $(dpkg-deb -f "$dev_deb" Depends)" >&2; exit 1; }
+# apt resolves both from this machine's repositories as `apt-get install ./impetus_*.deb ./impetus-dev_*.deb` would:
+# a dry run (nothing is installed), which fails on a dependency no configured repository has.
+if command -v apt-get >/dev/null; then
+  apt-get install --simulate --no-install-recommends "$deb" "$dev_deb" > "$scratch/apt.log" 2>&1 ||
+    { echo "install_test: apt-get cannot install the packages:" >&2; cat "$scratch/apt.log" >&2; exit 1; }
+  grep -q "^Inst impetus " "$scratch/apt.log" && grep -q "^Inst impetus-dev " "$scratch/apt.log" ||
+    { echo "install_test: apt-get's dry run does not install both:" >&2; cat "$scratch/apt.log" >&2; exit 1; }
+fi
+# Maintainer: a name and an address, as Debian's policy requires (§5.6.2).
+dpkg-deb -f "$deb" Maintainer | grep -Eq '^[^<]+ <[^@> ]+@[^> ]+>$' ||
+  { echo "install_test: $(basename "$deb") has no 'Name <address>' maintainer: $(dpkg-deb -f "$deb" Maintainer)" >&2
+    exit 1; }
 dpkg -x "$deb" "$scratch/root"
 "$scratch/root/usr/bin/impetus-world-manager" --help | grep -q -- "--scene"
 python_trial "$scratch/root/usr"

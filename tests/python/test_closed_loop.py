@@ -181,6 +181,23 @@ class Example(unittest.TestCase):
         self.assertLess(trace["force_x_N"].min(), -0.5, "the finger never pushed")
 
 
+class Engines(unittest.TestCase):
+    def test_every_engine_runs_the_trial_and_the_closed_loop_and_says_so(self):
+        self.assertEqual(impetus.ENGINES[0], "ode")
+        self.assertIn("bullet", impetus.ENGINES)
+        for engine in impetus.ENGINES:
+            with self.subTest(engine=engine):
+                trial = impetus.run_trial(TAP, "tap", "local", engine=engine, logs=False)
+                self.assertEqual(trial.summary["config"]["engine"], engine)
+                self.assertGreater(trial.summary["objects"]["cube"]["position"][0], 0.1)
+                with impetus.Simulation(TAP, start_m=[-0.03, 0, 0.025], engine=engine) as sim:
+                    sim.step(targets=np.linspace([-0.03, 0, 0.025], [0.01, 0, 0.025], 300))
+                    self.assertEqual(sim.close()["config"]["engine"], engine)
+        with self.assertRaises(ValueError) as raised:
+            impetus.run_trial(TAP, "tap", engine="havok")
+        self.assertIn("engine", str(raised.exception))
+
+
 class LogColumns(unittest.TestCase):
     # A column's name ends in its unit; the only names without one are counts, flags, ratios and unit quaternions.
     UNIT = re.compile(r"_(m|mps|radps|N|Ns|Nms|s|ns)$")

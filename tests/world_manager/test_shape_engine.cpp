@@ -8,7 +8,7 @@
 
 #include <string>
 
-TEST_CASE("the engine simulates each shape with the inertia the shape module gives it") {
+TEST_CASE("every engine simulates each shape with the inertia the shape module gives it") {
   using nlohmann::json;
   const json objects = json::array({
       {{"name", "brick"}, {"shape", "box"}, {"size_m", {0.1, 0.2, 0.3}}},
@@ -24,14 +24,17 @@ TEST_CASE("the engine simulates each shape with the inertia the shape module giv
     object["position_m"] = {0.5 * static_cast<double>(k), 0.0, 0.0};
     document["objects"].push_back(object);
   }
-  const impetus::Scene scene = impetus::parse_scene(document, "shapes.json");
-  auto world = impetus::test::make_world(scene);
-  for (std::size_t id = 0; id < scene.objects.size(); ++id) {
-    const impetus::SceneObject& object = scene.objects[id];
-    INFO(object.name);
-    const Eigen::Matrix3d simulated = world->states()[id].inverse_inertia_world.inverse();
-    const Eigen::Matrix3d modelled = impetus::inertia_kgm2(object.shape, object.mass_kg);
-    CHECK((simulated - modelled).norm() <= 1e-12 * modelled.norm());
-    CHECK(world->states()[id].inverse_mass_per_kg == Approx(1.0 / object.mass_kg).epsilon(1e-15));
+  for (const impetus::EngineEntry& entry : impetus::engine_entries()) {
+    document["physics"]["engine"] = std::string(entry.name);
+    const impetus::Scene scene = impetus::parse_scene(document, "shapes.json");
+    auto world = impetus::test::make_world(scene);
+    for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+      const impetus::SceneObject& object = scene.objects[id];
+      INFO(entry.name << ": " << object.name);
+      const Eigen::Matrix3d simulated = world->states()[id].inverse_inertia_world.inverse();
+      const Eigen::Matrix3d modelled = impetus::inertia_kgm2(object.shape, object.mass_kg);
+      CHECK((simulated - modelled).norm() <= 1e-12 * modelled.norm());
+      CHECK(world->states()[id].inverse_mass_per_kg == Approx(1.0 / object.mass_kg).epsilon(1e-15));
+    }
   }
 }

@@ -2,6 +2,7 @@
 #include "world_manager/engine/engine_registry.h"
 
 #include "common/runtime/message_text.h"
+#include "world_manager/engine/bullet_engine.h"
 #include "world_manager/engine/ode_engine.h"
 #include "world_manager/engine/ode_runtime.h"
 #include "world_manager/scene.h"
@@ -10,10 +11,12 @@ namespace impetus {
 namespace {
 
 std::unique_ptr<RigidBodyEngine> make_ode(const Scene& scene) { return std::make_unique<OdeEngine>(scene); }
+std::unique_ptr<RigidBodyEngine> make_bullet(const Scene& scene) { return std::make_unique<BulletEngine>(scene); }
 
 // The first is the default (PhysicsParams::engine).
 constexpr EngineEntry kEngines[] = {
     {"ode", parse_ode_block, make_ode},
+    {"bullet", parse_bullet_block, make_bullet},
 };
 
 }  // namespace

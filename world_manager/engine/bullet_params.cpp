@@ -1,0 +1,17 @@
+// SPDX-License-Identifier: Apache-2.0
+// Bullet's block of a scene's physics: "physics": {"bullet": {"solver_iterations"}} (docs/scene-format.md).
+#include "common/contract/limits.h"
+#include "common/runtime/json_node.h"
+#include "world_manager/engine/bullet_engine.h"
+#include "world_manager/scene.h"
+
+namespace impetus {
+
+void parse_bullet_block(const JsonNode& block, PhysicsParams& physics) {
+  block.expect_keys({"solver_iterations"});
+  if (block.has("solver_iterations")) {
+    physics.bullet.solver_iterations = block.child("solver_iterations").positive_int(limits::kMaxSolverIterations);
+  }
+}
+
+}  // namespace impetus
