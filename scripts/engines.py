@@ -64,8 +64,10 @@ NOTES = [
     "- **Bullet's own contact and friction were changed where they broke physics the scenes rely on** "
     "(`world_manager/engine/bullet_engine.cpp`): the floor is a box, not Bullet's plane (the plane meets a box at one "
     "point per substep, so a sliding box rocked corner to corner and its contacts carried about a fifth of its "
-    "weight); friction acts in both tangential directions (Bullet's default, one, let a cube pushed across it "
-    "creep); forces and torques enter as the velocity change of the substep (Bullet 3.24's friction rows leave out "
+    "weight); friction acts in two fixed tangential directions per contact point (Bullet's default, one along the "
+    "sliding velocity, let a cube pushed across it creep, and directions turning with the velocity flipped where a "
+    "slide reversed, which made the cube of hard case 12a spin on its ramp, tip and slide under the finger); forces "
+    "and torques enter as the velocity change of the substep (Bullet 3.24's friction rows leave out "
     "an external torque's spin, so a 5 cm cube on the floor given a 6 mN·m torque slid at 0.8 mm/s for ever, which "
     "the haptic side's sticking proxy then amplified into hard case 7 sliding 42 mm). Each is tested on every "
     "engine in `tests/world_manager/test_engines.cpp` (a sliding cube stops at v²/2μg within 2 %; a resting cube's "
@@ -74,13 +76,6 @@ NOTES = [
     "direct solver (`\"ode\": {\"solver\": \"direct\"}`); Bullet runs its sequential-impulse solver, which, "
     "like ODE's QuickStep, cannot carry a heavy box on a light one (the same scene with QuickStep: 894 mm "
     "displacement on ODE).",
-    "- **Case 12a (a cube sliding down a ramp into a still finger) fails on Bullet under both couplings, not yet "
-    "traced to its cause.** The finger catches the cube as on ODE (0.4–0.5 s, the same forces) and sends it back up "
-    "the 25° ramp. Where its sliding reverses, on Bullet it starts to spin about y (−0.12 rad/s at 0.7 s, in a step "
-    "with no impulse from the finger; 0 on ODE), pitches forward (its orientation's y component falls from 0.216 to "
-    "−0.01 by 1.1 s), slides under the finger and off the ramp, where on ODE it comes to rest against the finger. "
-    "So it is the box-on-incline contact at a reversal of sliding, not the coupling; the world log of "
-    "`OUT/bullet/case12a_local/` shows it.",
     "- Impulse coupling fails cases 10 and 14 on both engines, as docs/hard_cases.md reports for ODE.",
     "- **Cost.** `build/tests/bench_world` prints the world step per body on both (2 cores, measured 2026-11-27): "
     "ODE 13–15 µs per sphere per 20 Hz step (20 to 2000 spheres on the floor), Bullet 30–69 µs, growing with the "

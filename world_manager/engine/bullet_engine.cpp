@@ -205,10 +205,14 @@ BulletEngine::BulletEngine(const Scene& scene) : bullet_(std::make_unique<World>
   // impulse (a separate position correction) would be a second model.
   solver.m_splitImpulse = 0;
   solver.m_restitutionVelocityThreshold = kBounceThreshold_mps;
-  // Friction in both tangential directions of every contact (the sliding direction and its normal in the contact
-  // plane). Bullet's default is the sliding direction only, and for a body at rest an arbitrary one: a push across
-  // it meets no friction, so a cube pushed below its static friction creeps.
-  solver.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+  // Friction in two fixed tangential directions per contact point, kept for the point's life: a pyramid fixed to the
+  // contact, as ODE's. Bullet's default is one direction, along the sliding velocity (for a body at rest an arbitrary
+  // one): a push across it meets no friction, so a cube pushed below its static friction creeps. Directions that turn
+  // with the sliding velocity flip where a slide reverses, and the warm-started friction impulse then lands on the
+  // new directions: a cube whose slide reversed on a ramp started to spin, tipped and slid under a finger holding it
+  // (hard case 12a).
+  solver.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS | SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
+                         SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
   // Every contact is the scene's spring and damper (the engine-neutral default when the scene gives none: ODE's
   // default contact at 5 ms substeps, scene.h), which Bullet turns into ERP and CFM per substep as ODE's are.
   const PhysicsParams& physics = scene.physics;

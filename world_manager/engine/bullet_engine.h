@@ -9,8 +9,8 @@
 // (Bullet's per-contact stiffness and damping, which it maps to ERP and CFM by the same formulas ODE's numbers come
 // from), the materials combined by the scene's rules (scene.h combine_*), the rest thresholds (sleeping_bodies.h),
 // the escape guard (escape_guard.h). What is Bullet's own: its solver (sequential impulses with warm starting), its
-// friction (two directions per contact, the sliding one and its normal, a pyramid turned with the sliding velocity,
-// where ODE's Approx1 pyramid is fixed to the contact frame), its contact points
+// friction (a pyramid of two fixed directions per contact point, as ODE's Approx1, but solved by sequential impulses),
+// its contact points
 // (kept in persistent manifolds; a point not yet touching lets the pair close the gap and no more, Bullet's own
 // speculative contact), its island sleeping (a resting group of bodies sleeps together), its continuous collision
 // for fast bodies (where the scene asks for speculative contacts).
