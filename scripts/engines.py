@@ -7,6 +7,8 @@ dynamics, measured on each rigid-body engine Impetus has, with the same scenes.
              position, its spread over the phases (Fig. 5's sampling coherency problem) and its bias against that
              engine's own single-rate reference (the world at the haptic rate, 1 kHz, where the phase cannot matter),
              as docs/phase.md measures it on ODE
+  tap task   the paper's tap task (Figs. 7/8, scripts/tap_task.py): a simulated subject learns to tap the cube to a
+             mark over 30 trials at random phases; the mean absolute deviation of its last 20 taps per coupling
   hard       the stability suite (scripts/hard_cases.py, tests/hard_cases/) under impulse and local coupling: each
              case's verdict and key metric per engine
 
@@ -16,6 +18,8 @@ usage: engines.py [--phases N] [--jobs N] [--out DIR] [--doc FILE] [--quick] [--
 """
 import argparse
 import json
+import random
+import types
 import os
 import pathlib
 import sys
@@ -23,6 +27,7 @@ import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import hard_cases  # noqa: E402
+import tap_task  # noqa: E402
 from impetus_py import daemon_defaults  # noqa: E402
 from impetus_py.parallel import run_parallel  # noqa: E402
 from impetus_py.paths import ROOT  # noqa: E402
@@ -33,6 +38,9 @@ TAP_SCENE = ROOT / "scenes/tap.json"
 COUPLINGS = ("impulse", "position", "local")
 HARD_CASE_COUPLINGS = ("impulse", "local")
 START_X_M = 0.03  # the cube's centre at rest in scenes/tap.json
+TAP_TASK_TRIALS = 30       # scripts/tap_task.py's defaults: 30 trials, aiming at 15 cm, the last 20 scored
+TAP_TASK_TARGET_M = 0.15
+TAP_TASK_SCORED = 20
 
 
 def on_engine(engine, function, *args):
@@ -45,6 +53,12 @@ def on_engine(engine, function, *args):
 def tap(out_dir, coupling, phase_ticks, rate_hz):
     summary = run_trial(out_dir, TAP_SCENE, "tap", coupling, rate_hz=rate_hz, phase_ticks=phase_ticks)
     return summary.objects["cube"]["position"][0]
+
+
+def tap_subject(out_dir, coupling, phases):
+    """One simulated subject of the tap task (tap_task.subject) with its defaults: [(trial, speed, phase, travel)]."""
+    args = types.SimpleNamespace(scene=str(TAP_SCENE), out=out_dir, rate=20.0, target=TAP_TASK_TARGET_M)
+    return tap_task.subject(coupling, args, phases)
 
 
 def hard_case(case, out_dir, coupling):
@@ -77,6 +91,10 @@ NOTES = [
     "like ODE's QuickStep, cannot carry a heavy box on a light one (the same scene with QuickStep: 894 mm "
     "displacement on ODE).",
     "- Impulse coupling fails cases 10 and 14 on both engines, as docs/hard_cases.md reports for ODE.",
+    "- **Ghost force** (`build/tests/bench_ghost_force`, streams of objects past the finger, each coupling at 20 and "
+    "10 Hz, measured 2026-11-27): the same on both engines to the tick, ghost at most 0.45 % of the contact ticks, "
+    "except one row on Bullet: 16 objects, local coupling, 10 Hz, with 6 ticks of pop-through (0 on ODE), not yet "
+    "traced.",
     "- **Cost.** `build/tests/bench_world` prints the world step per body on both (2 cores, measured 2026-11-27): "
     "ODE 13–15 µs per sphere per 20 Hz step (20 to 2000 spheres on the floor), Bullet 30–69 µs, growing with the "
     "count. Sleeping does less for Bullet: it sleeps whole simulation islands, and its broadphase joins the "
@@ -100,6 +118,17 @@ def phase_rows(results, engines, phases):
                          f"{bias:+.2f} | {wall:.2f} |")
         lines.append(f"| {engine} | reference (1 kHz world) | {reference:.4f} | - | - | "
                      f"{results[('reference', engine)][1]:.2f} |")
+    return lines
+
+
+def tap_task_rows(results, engines):
+    lines = [f"| engine | coupling | mean abs deviation, last {TAP_TASK_SCORED} taps (mm) | mean travel (m) |",
+             "|---|---|---|---|"]
+    for engine in engines:
+        for coupling in COUPLINGS:
+            tail = [travel for _, _, _, travel in results[("task", engine, coupling)][0][-TAP_TASK_SCORED:]]
+            deviation_mm = 1000 * sum(abs(t - TAP_TASK_TARGET_M) for t in tail) / len(tail)
+            lines.append(f"| {engine} | {coupling} | {deviation_mm:.1f} | {sum(tail) / len(tail):.3f} |")
     return lines
 
 
@@ -133,6 +162,9 @@ def main():
         parser.error(f"--phases: 1 to {period_ticks}, not {count}")
     phases = sorted({round(k * period_ticks / count) for k in range(count)})
     cases = hard_cases.CASES[:5] if args.quick else hard_cases.CASES
+    # The tap task's random phases, the same for every engine and coupling (tap_task.py's seed 1).
+    rng = random.Random(1)
+    task_phases = [rng.randrange(period_ticks) for _ in range(5 if args.quick else TAP_TASK_TRIALS)]
 
     tasks = []
     for engine in engines:
@@ -142,6 +174,9 @@ def main():
             for p in phases:
                 tasks.append((("tap", engine, coupling, p), on_engine,
                               (engine, tap, args.out / engine / f"tap_{coupling}_{p}", coupling, p, None)))
+        for coupling in COUPLINGS:
+            tasks.append((("task", engine, coupling), on_engine,
+                          (engine, tap_subject, args.out / engine / f"task_{coupling}", coupling, task_phases)))
         for coupling in HARD_CASE_COUPLINGS:
             for case in cases:
                 tasks.append((("hard", engine, coupling, case[0]), on_engine,
@@ -150,11 +185,14 @@ def main():
 
     command = "/usr/bin/python3 scripts/engines.py" + ("" if count == 10 else f" --phases {count}")
     text = [f"# Engines side by side: {', '.join(engines)}", "",
-            f"Generated by `{command}` (PYTHONPATH is set by the script; about a minute per engine on 2 cores). "
+            f"Generated by `{command}` (under a minute on 2 cores). "
             "Every trial is a lockstep run, bitwise repeatable on each engine. What differs between the engines and "
             "why: `world_manager/engine/bullet_engine.h`.", "",
             f"## The tap over {len(phases)} world-clock phases (paper Fig. 5, docs/phase.md)", "",
             *phase_rows(results, engines, phases), "",
+            f"## The tap task (paper Figs. 7/8, docs/tap_task.md): a simulated subject aiming at "
+            f"{100 * TAP_TASK_TARGET_M:.0f} cm", "",
+            *tap_task_rows(results, engines), "",
             "## The stability suite (docs/hard_cases.md), each case's verdict and key metric", "",
             *hard_rows(results, engines, cases), "", *NOTES]
     args.out.mkdir(parents=True, exist_ok=True)
