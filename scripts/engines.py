@@ -9,6 +9,8 @@ dynamics, measured on each rigid-body engine Impetus has, with the same scenes.
              as docs/phase.md measures it on ODE
   tap task   the paper's tap task (Figs. 7/8, scripts/tap_task.py): a simulated subject learns to tap the cube to a
              mark over 30 trials at random phases; the mean absolute deviation of its last 20 taps per coupling
+  speed      speed against error (scripts/speed_vs_error.py --quick: the tap at 10 to 1000 Hz worlds, each
+             engine against its own 1 kHz reference): RMS error and world CPU per simulated second per coupling and rate
   hard       the stability suite (scripts/hard_cases.py, tests/hard_cases/) under impulse and local coupling: each
              case's verdict and key metric per engine
 
@@ -17,8 +19,10 @@ Writes OUT/engines.json and the tables to --doc (default docs/engines.md), and p
 usage: engines.py [--phases N] [--jobs N] [--out DIR] [--doc FILE] [--quick] [--quiet]
 """
 import argparse
+import csv
 import json
 import random
+import subprocess
 import types
 import os
 import pathlib
@@ -59,6 +63,14 @@ def tap_subject(out_dir, coupling, phases):
     """One simulated subject of the tap task (tap_task.subject) with its defaults: [(trial, speed, phase, travel)]."""
     args = types.SimpleNamespace(scene=str(TAP_SCENE), out=out_dir, rate=20.0, target=TAP_TASK_TARGET_M)
     return tap_task.subject(coupling, args, phases)
+
+
+def speed_sweep(out_dir):
+    """speed_vs_error.py's quick grid on this process's engine (IMPETUS_ENGINE); its CSV rows of the rate experiment."""
+    subprocess.run([sys.executable, str(ROOT / "scripts/speed_vs_error.py"), "--quick", "--no-plot", "--quiet",
+                    "--jobs", "1", "--out", str(out_dir)], check=True, capture_output=True, text=True)
+    with open(out_dir / "speed_vs_error.csv", newline="") as f:
+        return [row for row in csv.DictReader(f) if row["experiment"] == "rate"]
 
 
 def hard_case(case, out_dir, coupling):
@@ -132,6 +144,20 @@ def tap_task_rows(results, engines):
     return lines
 
 
+def speed_rows(results, engines):
+    rows = {engine: {(r["coupling"], float(r["rate_hz"])): r for r in results[("speed", engine)][0]}
+            for engine in engines}
+    keys = sorted(rows[engines[0]], key=lambda k: (COUPLINGS.index(k[0]), k[1]))
+    lines = ["| coupling | world Hz | " + " | ".join(f"{e}: RMS error (mm)" for e in engines) + " | " +
+             " | ".join(f"{e}: world CPU per simulated s (ms)" for e in engines) + " |",
+             "|---|---|" + "---|" * (2 * len(engines))]
+    for key in keys:
+        errors = " | ".join(f"{float(rows[e][key]['rms_mm']):.2f}" for e in engines)
+        costs = " | ".join(f"{float(rows[e][key]['world_cpu_ms_per_sim_s']):.2f}" for e in engines)
+        lines.append(f"| {key[0]} | {key[1]:g} | {errors} | {costs} |")
+    return lines
+
+
 def hard_rows(results, engines, cases):
     header = "| case | " + " | ".join(f"{engine}, {coupling}" for engine in engines for coupling in HARD_CASE_COUPLINGS)
     lines = [header + " |", "|---|" + "---|" * (len(engines) * len(HARD_CASE_COUPLINGS))]
@@ -174,6 +200,7 @@ def main():
             for p in phases:
                 tasks.append((("tap", engine, coupling, p), on_engine,
                               (engine, tap, args.out / engine / f"tap_{coupling}_{p}", coupling, p, None)))
+        tasks.append((("speed", engine), on_engine, (engine, speed_sweep, args.out / engine / "speed_vs_error")))
         for coupling in COUPLINGS:
             tasks.append((("task", engine, coupling), on_engine,
                           (engine, tap_subject, args.out / engine / f"task_{coupling}", coupling, task_phases)))
@@ -193,6 +220,9 @@ def main():
             f"## The tap task (paper Figs. 7/8, docs/tap_task.md): a simulated subject aiming at "
             f"{100 * TAP_TASK_TARGET_M:.0f} cm", "",
             *tap_task_rows(results, engines), "",
+            "## Speed against error (docs/speed_vs_error.md; its quick grid: the tap, 4 phases per rate), each "
+            "engine against its own 1 kHz reference", "",
+            *speed_rows(results, engines), "",
             "## The stability suite (docs/hard_cases.md), each case's verdict and key metric", "",
             *hard_rows(results, engines, cases), "", *NOTES]
     args.out.mkdir(parents=True, exist_ok=True)
