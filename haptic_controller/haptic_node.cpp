@@ -123,9 +123,7 @@ void HapticNode::log_tick(Endpoint& endpoint, std::uint64_t tick, double now_s, 
   row.finger_m = result.finger_m;
   row.proxy_m = result.proxy_m;
   row.force_N = result.force_N;
-  for (std::uint32_t k = 0; k < report.entry_count; ++k) {
-    for (int a = 0; a < 3; ++a) row.object_impulse_Ns[a] += report.entries[k].impulse_Ns[a];
-  }
+  row.object_impulse_Ns = object_impulse_total_Ns(report);
   row.static_impulse_Ns = report.static_impulse_Ns;
   row.interpolation_weight = result.interpolation_weight;
   row.lateness_ns = lateness_ns;

@@ -61,6 +61,16 @@ struct HapticLogRow {
   std::uint32_t flags;  // bit 0 finger valid, 1 saturated, 2 fault, 3 world stale, 4 sticking
 };
 
+// The running total of the reaction a report's endpoint has given all objects together (N·s): the sum of its
+// entries' totals, as the haptic log's object_impulse columns record it.
+inline Vec3 object_impulse_total_Ns(const HapticReport& report) {
+  Vec3 total{};
+  for (std::uint32_t k = 0; k < report.entry_count; ++k) {
+    for (int a = 0; a < 3; ++a) total[a] += report.entries[k].impulse_Ns[a];
+  }
+  return total;
+}
+
 // A haptic node serves one endpoint per finger of its device (HapticDevice::finger_count()): a servo each, ticked in
 // finger order every tick, their forces commanded to the device together.
 class HapticNode final : public FollowerStepper {

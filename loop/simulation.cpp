@@ -12,8 +12,6 @@
 namespace impetus {
 namespace {
 
-bool finite(const Vec3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
-
 std::string point_text(const Vec3& v) {
   char text[96];
   std::snprintf(text, sizeof text, "(%g, %g, %g)", v[0], v[1], v[2]);
@@ -34,7 +32,7 @@ void check_closed_loop(const InProcessTrialOptions& trial) {
 std::vector<NamedFinger> starting_fingers(const std::vector<SimulationFinger>& fingers) {
   std::vector<NamedFinger> out;
   for (const SimulationFinger& finger : fingers) {
-    if (!finite(finger.start_m)) {
+    if (!all_finite(finger.start_m)) {
       throw std::invalid_argument("finger '" + finger.name + "': start_m must be finite, not " +
                                   point_text(finger.start_m));
     }
@@ -84,13 +82,13 @@ void Simulation::check_finger(std::size_t finger) const {
 
 void Simulation::set_target(std::size_t finger, const Vec3& target_m) {
   check_finger(finger);
-  if (!finite(target_m)) throw std::invalid_argument("target_m: must be finite, not " + point_text(target_m));
+  if (!all_finite(target_m)) throw std::invalid_argument("target_m: must be finite, not " + point_text(target_m));
   rig_->fingers().sim(finger).steer(target_m);
 }
 
 void Simulation::set_hand_force(std::size_t finger, const Vec3& force_N) {
   check_finger(finger);
-  if (!finite(force_N)) throw std::invalid_argument("force_N: must be finite, not " + point_text(force_N));
+  if (!all_finite(force_N)) throw std::invalid_argument("force_N: must be finite, not " + point_text(force_N));
   rig_->fingers().sim(finger).set_hand_force(force_N);
 }
 
@@ -111,7 +109,7 @@ std::uint64_t Simulation::step(std::uint64_t count, std::span<const Vec3> target
                                 std::to_string(out.size()));
   }
   for (std::size_t i = 0; i < targets.size(); ++i) {
-    if (!finite(targets[i])) {
+    if (!all_finite(targets[i])) {
       throw std::invalid_argument("targets: tick " + std::to_string(i / finger_count_) + ", finger " +
                                   std::to_string(i % finger_count_) + ": " + point_text(targets[i]) +
                                   " is not finite");
@@ -133,7 +131,6 @@ std::uint64_t Simulation::step(std::uint64_t count, std::span<const Vec3> target
     for (std::size_t k = 0; k < finger_count_; ++k) {
       const HapticServo& servo = haptic.servo(static_cast<EndpointId>(k));
       const TickResult& result = servo.last_result();
-      const HapticReport& report = servo.report();
       FingerTick& record = out[done * finger_count_ + k];
       record.time_s = time_s;
       record.target_m = fingers.sim(k).target_m();
@@ -141,10 +138,7 @@ std::uint64_t Simulation::step(std::uint64_t count, std::span<const Vec3> target
       record.finger_velocity_mps = fingers.sim(k).finger_velocity_mps();
       record.proxy_m = result.proxy_m;
       record.force_N = result.force_N;
-      record.object_impulse_Ns = {};
-      for (std::uint32_t e = 0; e < report.entry_count; ++e) {
-        for (int a = 0; a < 3; ++a) record.object_impulse_Ns[a] += report.entries[e].impulse_Ns[a];
-      }
+      record.object_impulse_Ns = object_impulse_total_Ns(servo.report());
       record.active_planes = result.active_planes;
     }
   }

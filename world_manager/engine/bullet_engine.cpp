@@ -99,6 +99,7 @@ struct BulletEngine::World final : EscapeGuard::Engine {
   std::vector<Eigen::Matrix3d> inverse_inertia_body;  // per object; zero for static ones
   std::vector<std::size_t> dynamic_ids;               // ascending
   std::vector<std::size_t> moved;
+  std::vector<bool> awake_in_step;  // per object: awake at the start of the step or after one of its substeps
   std::vector<bool> parked;                           // taken out of the world by the escape guard
   // The forces and torques given for the next substep (add_force), per object: they enter as the velocity change
   // they cause over the substep, v += F·h/m and ω += I⁻¹·τ·h, set on the body before Bullet steps. Given to Bullet as
@@ -344,10 +345,10 @@ void BulletEngine::step(int substeps, double substep_s, bool record_contacts, Su
   World& w = *bullet_;
   // Moved: awake at the start of the step or after any substep.
   w.moved.clear();
-  std::vector<bool> awake(w.object_count(), false);
+  w.awake_in_step.assign(w.object_count(), false);
   const auto note_awake = [&] {
     for (const std::size_t id : w.dynamic_ids) {
-      if (!w.parked[id] && w.body(id).isActive()) awake[id] = true;
+      if (!w.parked[id] && w.body(id).isActive()) w.awake_in_step[id] = true;
     }
   };
   note_awake();
@@ -362,7 +363,7 @@ void BulletEngine::step(int substeps, double substep_s, bool record_contacts, Su
   w.escape_guard.check(w.dynamic_ids, w);  // the world reads the state next
   if (record_contacts) w.record_graph(substep_s);
   for (const std::size_t id : w.dynamic_ids) {
-    if (awake[id]) w.moved.push_back(id);
+    if (w.awake_in_step[id]) w.moved.push_back(id);
   }
 }
 
