@@ -78,8 +78,11 @@ PhysicsParams parse_physics(const Node& node) {
   }
   const std::string_view kNeutralKeys[] = {"engine", "world_rate_hz", "substeps", "contact_stiffness_Npm",
                                            "contact_damping_Nspm", "speculative_contacts", "auto_disable", "seed"};
-  const std::string_view block_key[] = {physics.engine};  // the chosen engine's block, and no other
-  node.expect_keys({std::span<const std::string_view>(kNeutralKeys), std::span<const std::string_view>(block_key)});
+  // Every engine's block may be given, each read by its own engine: a scene says what it needs on each engine (a direct
+  // solver for a stack of large mass ratios, say) and keeps it when a run chooses another engine (--engine).
+  std::vector<std::string_view> block_keys;
+  for (const EngineEntry& entry : engine_entries()) block_keys.push_back(entry.name);
+  node.expect_keys({std::span<const std::string_view>(kNeutralKeys), std::span<const std::string_view>(block_keys)});
   if (node.has("world_rate_hz")) {
     physics.world_rate_hz = node.child("world_rate_hz").in_range(limits::kMinWorldRate_Hz, limits::kMaxWorldRate_Hz, " Hz");
   }
@@ -103,10 +106,12 @@ PhysicsParams parse_physics(const Node& node) {
     physics.seed = seed.value().get<std::uint64_t>();
   }
   // After the neutral keys: an engine's block may depend on them (ODE's ERP and CFM exclude the contact spring).
-  if (node.has(physics.engine)) {
-    const Node block = node.child(physics.engine);
+  // Every block is checked, the chosen engine's or not, so a mistake shows whichever engine runs.
+  for (const EngineEntry& entry : engine_entries()) {
+    if (!node.has(entry.name)) continue;
+    const Node block = node.child(entry.name);
     block.expect_object();
-    find_engine(physics.engine)->parse_block(block, physics);
+    entry.parse_block(block, physics);
   }
   return physics;
 }

@@ -123,6 +123,11 @@ struct OdeParams {
 
 // Bullet's own settings: the scene's "physics": {"bullet": {...}} (world_manager/engine/bullet_params.cpp).
 struct BulletParams {
+  // Sequential impulses are Bullet's iterative solver, with QuickStep's weakness (a light body under a heavy one);
+  // direct is its MLCP solver with the Dantzig pivoting method, which solves each island's contact LCP exactly (cubic
+  // in the contact rows) and falls back to sequential impulses for a substep it cannot solve (counted by Bullet).
+  enum class Solver { sequential_impulse, direct };
+  Solver solver = Solver::sequential_impulse;
   // Sequential-impulse sweeps per substep: ODE's QuickStep count, so the two iterate alike (Bullet's default is 10).
   int solver_iterations = 20;
 };

@@ -34,7 +34,7 @@ struct WorldNodeOptions {
   std::optional<double> rate_hz;  // default: the scene's physics.world_rate_hz
   std::optional<int> substeps;    // default: the scene's physics.substeps
   // The rigid-body engine by its registry name (engine/engine_registry.h); default: the scene's physics.engine. The
-  // scene's block for another engine is then not used.
+  // engine reads its own block of the scene, if the scene has one.
   std::optional<std::string> engine;
   Coupling coupling = Coupling::impulse;
   ClockMode clock = ClockMode::realtime;

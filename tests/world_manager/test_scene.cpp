@@ -276,8 +276,8 @@ TEST_CASE("the engine is chosen by name from the registry, ODE by default, and i
   // An engine's own key at the top of the physics block says where it now goes.
   require_error(json{{"objects", json::array()}, {"physics", {{"solver_iterations", 30}}}},
                 "/physics/solver_iterations", "\"physics\": {\"ode\": {\"solver_iterations\": ...}}");
-  // Another engine's block than the chosen one is an unknown key, and so is a key the engine does not have.
-  require_error(json{{"objects", json::array()}, {"physics", {{"bullet", json::object()}}}}, "/physics/bullet",
+  // A block for an engine the registry does not hold is an unknown key, and so is a key the engine does not have.
+  require_error(json{{"objects", json::array()}, {"physics", {{"mujoco", json::object()}}}}, "/physics/mujoco",
                 "unknown key");
   require_error(json{{"objects", json::array()}, {"physics", {{"ode", {{"iterations", 30}}}}}},
                 "/physics/ode/iterations", "unknown key");

@@ -5,6 +5,8 @@
 #include "world_manager/engine/sleeping_bodies.h"
 #include "world_manager/engine/speculative_contacts.h"
 
+#include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
+#include <BulletDynamics/MLCPSolvers/btMLCPSolver.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
@@ -81,6 +83,12 @@ struct DeepestPoint final : btCollisionWorld::ContactResultCallback {
   }
 };
 
+// The scene's solver (BulletParams::Solver); `dantzig` is the direct solver's LCP method and must outlive it.
+std::unique_ptr<btSequentialImpulseConstraintSolver> make_solver(const BulletParams& params, btDantzigSolver& dantzig) {
+  if (params.solver == BulletParams::Solver::direct) return std::make_unique<btMLCPSolver>(&dantzig);
+  return std::make_unique<btSequentialImpulseConstraintSolver>();
+}
+
 }  // namespace
 
 struct BulletEngine::World final : EscapeGuard::Engine {
@@ -91,10 +99,11 @@ struct BulletEngine::World final : EscapeGuard::Engine {
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher{&configuration};
   btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
+  btDantzigSolver dantzig;
+  std::unique_ptr<btSequentialImpulseConstraintSolver> solver = make_solver(scene->physics.bullet, dantzig);
   std::vector<std::unique_ptr<btCollisionShape>> shapes;  // per object, the floor's last
   std::vector<std::unique_ptr<btRigidBody>> bodies;       // per object (static ones have no mass); the floor last
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &configuration};
+  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, solver.get(), &configuration};
 
   std::vector<Eigen::Matrix3d> inverse_inertia_body;  // per object; zero for static ones
   std::vector<std::size_t> dynamic_ids;               // ascending
@@ -110,6 +119,8 @@ struct BulletEngine::World final : EscapeGuard::Engine {
   std::vector<Eigen::Vector3d> pending_torque_Nm;
   std::vector<std::size_t> pushed;  // the objects with a pending force, in the order they were first given one
   ContactGraph contact_graph;
+  double contact_stiffness_Npm = 0.0;  // the scene's contact spring (or the engine-neutral default)
+  double contact_damping_Nspm = 0.0;
   EscapeGuard escape_guard{0};
 
   btRigidBody& body(std::size_t id) const { return *bodies[id]; }
@@ -202,6 +213,9 @@ BulletEngine::BulletEngine(const Scene& scene) : bullet_(std::make_unique<World>
   w.world.setForceUpdateAllAabbs(false);
   btContactSolverInfo& solver = w.world.getSolverInfo();
   solver.m_numIterations = scene.physics.bullet.solver_iterations;
+  // The direct solver solves each island alone (Bullet's default joins small islands into batches of 128 rows, which
+  // the iterative solver sweeps cheaply but a direct solve pays for cubically).
+  if (scene.physics.bullet.solver == BulletParams::Solver::direct) solver.m_minimumSolverBatchSize = 1;
   // The contact spring corrects penetration through the solver's velocities, as ODE's ERP does; Bullet's split
   // impulse (a separate position correction) would be a second model.
   solver.m_splitImpulse = 0;
@@ -222,6 +236,8 @@ BulletEngine::BulletEngine(const Scene& scene) : bullet_(std::make_unique<World>
   const double damping_Nspm = std::isnan(physics.contact_damping_Nspm) ? PhysicsParams::kDefaultContactDamping_Nspm
                                                                        : physics.contact_damping_Nspm;
 
+  w.contact_stiffness_Npm = stiffness_Npm;
+  w.contact_damping_Nspm = damping_Nspm;
   const std::size_t count = scene.objects.size();
   w.inverse_inertia_body.assign(count, Eigen::Matrix3d::Zero());
   w.parked.assign(count, false);
@@ -356,6 +372,15 @@ void BulletEngine::step(int substeps, double substep_s, bool record_contacts, Su
     hook.before_substep(substep);
     w.apply_pushes(substep_s);
     w.escape_guard.check(w.dynamic_ids, w);
+    if (w.scene->physics.bullet.solver == BulletParams::Solver::direct) {
+      // The direct solver's softness: Bullet 3.24's MLCP leaves out each contact's own CFM (the spring given by
+      // setContactStiffnessAndDamping, which the sequential solver uses) and adds the global CFM over h to the
+      // diagonal of every row instead. ODE's world CFM, 1/(k·h + c), likewise softens every row of a contact, the
+      // normal and the friction ones: so a resting load sits at weight/k as on the sequential solver and on ODE, and
+      // a face resting on four points stays a regular system the pivoting solves (rigid rows make it singular, and
+      // the solver falls back to sequential impulses).
+      w.world.getSolverInfo().m_globalCfm = 1.0 / (w.contact_stiffness_Npm * substep_s + w.contact_damping_Nspm);
+    }
     // One substep of exactly substep_s (no fixed-step interpolation); Bullet clears the forces after it.
     w.world.stepSimulation(substep_s, 0);
     note_awake();

@@ -8,7 +8,8 @@
 // module's exact ones, not Bullet's box approximations), the scene's contact spring and damper on every contact
 // (Bullet's per-contact stiffness and damping, which it maps to ERP and CFM by the same formulas ODE's numbers come
 // from), the materials combined by the scene's rules (scene.h combine_*), the rest thresholds (sleeping_bodies.h),
-// the escape guard (escape_guard.h). What is Bullet's own: its solver (sequential impulses with warm starting), its
+// the escape guard (escape_guard.h). What is Bullet's own: its solver (sequential impulses with warm starting, or
+// where the scene asks for a direct one its MLCP solver with Dantzig pivoting, as ODE's direct solver pivots), its
 // friction (a pyramid of two fixed directions per contact point, as ODE's Approx1, but solved by sequential impulses),
 // its contact points
 // (kept in persistent manifolds; a point not yet touching lets the pair close the gap and no more, Bullet's own
