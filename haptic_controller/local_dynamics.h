@@ -40,7 +40,8 @@
 //       into the floor, as the world's corner contacts keep it, yet tips if the push lifts a side. Without it the
 //       model's box pitched freely under a finger sliding over its top (1.2 mm of rim in a period at 1.7 N), and the
 //       finger was let go 3 ms after the world's edge instead of at once.
-//     ω otherwise free (a rolling ball keeps its spin)
+//     ω otherwise free (a rolling ball keeps its spin): a turning body keeps its angular momentum L = I·ω while
+//     its inertia turns with it, I ← R·I·Rᵀ each tick, and ω = I⁻¹·L (torque-free precession, as the engines have it)
 //   each tick, before the planes are rendered:
 //     u ← u + v·Δt                                              CoM displacement since the frame
 //   after the force of the tick (§3.4 share J, angular share L about the CoM):
@@ -104,7 +105,9 @@ namespace impetus {
 struct LocalBody {
   std::int32_t object_id = -1;
   double inverse_mass_per_kg = 0.0;
-  Eigen::Matrix3d inverse_inertia_world = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d inverse_inertia_world = Eigen::Matrix3d::Zero();  // turned with the body (turn)
+  Eigen::Matrix3d inertia_world = Eigen::Matrix3d::Zero();          // its inverse, where `precesses`
+  bool precesses = false;  // ω follows the kept angular momentum as the body turns (header, "ω otherwise free")
   Eigen::Vector3d com_frame_m = Eigen::Vector3d::Zero();  // at the frame
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();

@@ -254,14 +254,6 @@ void bench_sleeping(bool quick) {
     const std::string engine(entry.name);
     for (const int count : counts) {
       for (const bool sleeping : {false, true}) {
-        if (engine == "bullet" && count > 1000) {
-          // Bullet sleeps whole simulation islands, and its broadphase joins these spheres (1 cm apart) into islands
-          // across the grid, so the one pressed sphere keeps them all awake (the 1000 rows show it): a step then costs
-          // every body at any size, seconds per step here.
-          std::printf("%8s %8d %9s %12s (not run: Bullet keeps the grid in islands the pressed sphere wakes)\n",
-                      engine.c_str(), count, sleeping ? "on" : "off", "-");
-          continue;
-        }
         if (!sleeping && count > 10000) {
           // Every body simulated: ODE's hash space clears an n×n bit matrix of tested pairs at every collide (1.25 GB
           // per substep here), and any engine then pays for 100 k bodies in every substep.

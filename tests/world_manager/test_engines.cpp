@@ -163,5 +163,31 @@ TEST_CASE("on every engine the direct solver holds a 1000:1 stack that the itera
   }
 }
 
+TEST_CASE("on every engine a push wakes the body it pushes and what touches it, not resting bodies nearby") {
+  // Three 2 cm balls on the floor: a and b touching, c 1 cm from b (within Bullet's 2 cm broadphase margin, so a
+  // grouping by bounding boxes would join it). All three fall asleep; a push on a wakes a and b, and c sleeps on.
+  json document{{"objects", json::array()}};
+  for (const double x : {0.0, 0.04, 0.09}) {
+    document["objects"].push_back({{"name", "ball" + std::to_string(document["objects"].size())}, {"shape", "sphere"},
+                                   {"radius_m", 0.02}, {"dynamic", true}, {"mass_kg", 0.03},
+                                   {"position_m", {x, 0.0, 0.02}}});
+  }
+  for (const EngineEntry& entry : engine_entries()) {
+    INFO(entry.name);
+    const Scene scene = engine_scene(document, entry.name);
+    prepare_engines();
+    auto engine = make_engine(scene);
+    NoForces none;
+    for (int step = 0; step < 30; ++step) engine->step(10, 0.005, false, none);  // 1.5 s at rest
+    for (std::size_t id = 0; id < 3; ++id) CHECK(engine->asleep(id));
+    // Towards b, for one substep: 0.3 mN·s on 30 g, 1 cm/s.
+    engine->add_force(0, Eigen::Vector3d(0.06, 0.0, 0.0), Eigen::Vector3d::Zero());
+    engine->step(10, 0.005, false, none);
+    CHECK_FALSE(engine->asleep(0));
+    CHECK_FALSE(engine->asleep(1));
+    CHECK(engine->asleep(2));
+  }
+}
+
 }  // namespace
 }  // namespace impetus

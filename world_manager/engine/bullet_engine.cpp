@@ -5,6 +5,7 @@
 #include "world_manager/engine/sleeping_bodies.h"
 #include "world_manager/engine/speculative_contacts.h"
 
+#include <BulletCollision/CollisionDispatch/btSimulationIslandManager.h>
 #include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
 #include <BulletDynamics/MLCPSolvers/btMLCPSolver.h>
 #include <btBulletDynamicsCommon.h>
@@ -83,6 +84,46 @@ struct DeepestPoint final : btCollisionWorld::ContactResultCallback {
   }
 };
 
+// Simulation islands joined by contact, as ODE's are by its contact joints. Bullet's own island manager joins every
+// pair whose bounding boxes overlap, and Bullet widens each box by its contact breaking threshold (2 cm): resting
+// bodies a centimetre apart that never touch become one island, which sleeps and wakes as one, so one pressed sphere
+// in a field of resting ones keeps the whole field awake. Here a pair joins an island only when its manifold holds a
+// contact point (a point leaves the manifold once the pair is apart by more than the threshold).
+class ContactIslands final : public btSimulationIslandManager {
+ public:
+  void updateActivationState(btCollisionWorld* world, btDispatcher* dispatcher) override {
+    btSimulationIslandManager::updateActivationState(world, dispatcher);  // tags every body with its index ...
+    initUnionFind(getUnionFind().getNumElements());                        // ... and forgets the boxes' unions
+    for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
+      const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
+      if (manifold->getNumContacts() == 0) continue;
+      const btCollisionObject* a = manifold->getBody0();
+      const btCollisionObject* b = manifold->getBody1();
+      if (a->mergesSimulationIslands() && b->mergesSimulationIslands()) {
+        getUnionFind().unite(a->getIslandTag(), b->getIslandTag());
+      }
+    }
+  }
+};
+
+// Bullet's discrete world with ContactIslands for its island manager.
+class ContactIslandWorld final : public btDiscreteDynamicsWorld {
+ public:
+  ContactIslandWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase, btConstraintSolver* solver,
+                     btCollisionConfiguration* configuration)
+      : btDiscreteDynamicsWorld(dispatcher, broadphase, solver, configuration) {
+    if (m_ownsIslandManager) {
+      m_islandManager->~btSimulationIslandManager();
+      btAlignedFree(m_islandManager);
+    }
+    m_islandManager = &islands_;
+    m_ownsIslandManager = false;
+  }
+
+ private:
+  ContactIslands islands_;
+};
+
 // The scene's solver (BulletParams::Solver); `dantzig` is the direct solver's LCP method and must outlive it.
 std::unique_ptr<btSequentialImpulseConstraintSolver> make_solver(const BulletParams& params, btDantzigSolver& dantzig) {
   if (params.solver == BulletParams::Solver::direct) return std::make_unique<btMLCPSolver>(&dantzig);
@@ -103,7 +144,7 @@ struct BulletEngine::World final : EscapeGuard::Engine {
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver = make_solver(scene->physics.bullet, dantzig);
   std::vector<std::unique_ptr<btCollisionShape>> shapes;  // per object, the floor's last
   std::vector<std::unique_ptr<btRigidBody>> bodies;       // per object (static ones have no mass); the floor last
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, solver.get(), &configuration};
+  ContactIslandWorld world{&dispatcher, &broadphase, solver.get(), &configuration};
 
   std::vector<Eigen::Matrix3d> inverse_inertia_body;  // per object; zero for static ones
   std::vector<std::size_t> dynamic_ids;               // ascending
