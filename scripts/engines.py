@@ -9,8 +9,9 @@ dynamics, measured on each rigid-body engine Impetus has, with the same scenes.
              as docs/phase.md measures it on ODE
   tap task   the paper's tap task (Figs. 7/8, scripts/tap_task.py): a simulated subject learns to tap the cube to a
              mark over 30 trials at random phases; the mean absolute deviation of its last 20 taps per coupling
-  speed      speed against error (scripts/speed_vs_error.py --quick: the tap at 10 to 1000 Hz worlds, each
-             engine against its own 1 kHz reference): RMS error and world CPU per simulated second per coupling and rate
+  speed      speed against error (scripts/speed_vs_error.py's rate experiment: the tap and the spheres at 10 to
+             1000 Hz worlds, each engine against its own 1 kHz reference): RMS error, phase spread and world CPU per
+             simulated second per scene, coupling and rate (--quick: its quick grid)
   hard       the stability suite (scripts/hard_cases.py, tests/hard_cases/) under impulse and local coupling: each
              case's verdict and key metric per engine
 
@@ -65,9 +66,11 @@ def tap_subject(out_dir, coupling, phases):
     return tap_task.subject(coupling, args, phases)
 
 
-def speed_sweep(out_dir):
-    """speed_vs_error.py's quick grid on this process's engine (IMPETUS_ENGINE); its CSV rows of the rate experiment."""
-    subprocess.run([sys.executable, str(ROOT / "scripts/speed_vs_error.py"), "--quick", "--no-plot", "--quiet",
+def speed_sweep(out_dir, quick):
+    """speed_vs_error.py's rate experiment on this process's engine (IMPETUS_ENGINE): its full grid (both scenes, every
+    rate, 10 phases), or with `quick` its quick one; its CSV rows of the rate experiment."""
+    grid = ["--quick"] if quick else ["--substeps", ""]
+    subprocess.run([sys.executable, str(ROOT / "scripts/speed_vs_error.py"), *grid, "--no-plot", "--quiet",
                     "--jobs", "1", "--out", str(out_dir)], check=True, capture_output=True, text=True)
     with open(out_dir / "speed_vs_error.csv", newline="") as f:
         return [row for row in csv.DictReader(f) if row["experiment"] == "rate"]
@@ -98,20 +101,40 @@ NOTES = [
     "the haptic side's sticking proxy then amplified into hard case 7 sliding 42 mm). Each is tested on every "
     "engine in `tests/world_manager/test_engines.cpp` (a sliding cube stops at v²/2μg within 2 %; a resting cube's "
     "contacts carry its weight).",
-    "- **Case 8 (a 1000:1 stack) fails on Bullet as it fails on ODE's iterative solver.** The scene asks ODE for its "
-    "direct solver (`\"ode\": {\"solver\": \"direct\"}`); Bullet runs its sequential-impulse solver, which, "
-    "like ODE's QuickStep, cannot carry a heavy box on a light one (the same scene with QuickStep: 894 mm "
-    "displacement on ODE).",
+    "- **Case 8 (a 1000:1 stack) holds on each engine's direct solver.** The scene asks every engine for one "
+    "(`\"ode\": {\"solver\": \"direct\"}, \"bullet\": {\"solver\": \"direct\"}`); each engine reads its own "
+    "block. On their iterative solvers (QuickStep, sequential impulses) both drop it: a light box under a heavy one "
+    "is a system an iterative solver converges on too slowly (ODE QuickStep 894 mm, Bullet's sequential impulses "
+    "373 mm). Bullet's direct solver is its MLCP solver with Dantzig pivoting; as shipped it leaves out each contact's "
+    "own softness, so its rows were rigid, a face resting on four points a singular system, and it fell back to "
+    "sequential impulses in 547 substeps of the trial (2638 mm). Given ODE's world CFM, 1/(k·h + c), on every row, it "
+    "falls back once (the first substep of contact) and holds the stack (the table above). "
+    "`tests/world_manager/test_engines.cpp` checks both solvers on both engines.",
     "- Impulse coupling fails cases 10 and 14 on both engines, as docs/hard_cases.md reports for ODE.",
+    "- **Speed against error.** The tap (one cube sliding on the floor) agrees between the engines to a few hundredths "
+    "of a millimetre at every rate and coupling. The spheres (balls driven into each other) agree only in size: "
+    "collisions between round bodies amplify the first difference in rounding or contact order, so each engine's "
+    "run at a rate ends in a different arrangement and the columns differ by up to a factor of two (both far above "
+    "what local coupling leaves on the tap). Bullet's world costs 2 to 3 times ODE's on the spheres (its collision "
+    "pipeline per substep, sleeping aside) and about the same on the tap.",
     "- **Ghost force** (`build/tests/bench_ghost_force`, streams of objects past the finger, each coupling at 20 and "
-    "10 Hz, measured 2026-11-27): the same on both engines to the tick, ghost at most 0.45 % of the contact ticks, "
-    "except one row on Bullet: 16 objects, local coupling, 10 Hz, with 6 ticks of pop-through (0 on ODE), not yet "
-    "traced.",
+    "10 Hz): the same on both engines to the tick, ghost at most 0.45 % of the contact ticks, except one row on "
+    "Bullet, 16 objects, local coupling, 10 Hz: 6 ticks of pop-through (0.50–0.59 mm), traced: the finger, held at the "
+    "servo's 10 N clamp for seconds, pushed one 100 kg stream box into another inside a world period (ticks "
+    "6600–6699), which the haptic side's local model cannot know of until the next frame; the box's predicted pose "
+    "drifted 1.6 mm from the world's by the period's end. Not an engine difference: the two engines' runs part "
+    "chaotically earlier (each integrates a free rotation its own way: a box spun at 2.7 rad/s off its principal axes differs by 8·10⁻³ rad/s between them after one 10 Hz period), and on ODE "
+    "that collision does not happen. Of 40 stream seeds at this row, that is the only pop-through but one (seed 15, "
+    "on both engines: the finger starts inside an object, which the stream's placement does not avoid).",
     "- **Cost.** `build/tests/bench_world` prints the world step per body on both (2 cores, measured 2026-11-27): "
     "ODE 13–15 µs per sphere per 20 Hz step (20 to 2000 spheres on the floor), Bullet 30–69 µs, growing with the "
-    "count. Sleeping does less for Bullet: it sleeps whole simulation islands, and its broadphase joins the "
-    "benchmark's resting spheres (1 cm apart) into islands across the grid, so one pressed sphere keeps 1000 of them "
-    "awake (65 ms a step, against ODE's 0.15 ms with 11 awake); larger grids are not run on Bullet.",
+    "count. With sleeping (N resting spheres, 10 rolling, one pressed; `bench_world --sleeping`), ODE's step stays "
+    "at 0.15–0.20 ms from 10³ to 10⁵ resting spheres; Bullet's grows with them, 2.3 ms, 44 ms and 1.3 s: its island "
+    "pass walks every body and every broadphase pair at every substep, asleep or not (62 % of the step in a profile "
+    "of 5000 sleeping spheres: building the islands and joining them), and its 2 cm broadphase margin gives each "
+    "sphere of this grid (1 cm apart) about five pairs. Bullet's own island manager also joined bodies whose "
+    "bounding boxes overlap, so one pressed sphere kept the whole field awake (1010 moving); islands here are joined "
+    "by contact points, as ODE's are by contact joints (11 moving on both engines).",
     "", "Regenerate: `/usr/bin/python3 scripts/engines.py` (the world step cost per body on both engines: "
     "`bash scripts/bench.sh`, section 2).", ""]
 
@@ -145,16 +168,18 @@ def tap_task_rows(results, engines):
 
 
 def speed_rows(results, engines):
-    rows = {engine: {(r["coupling"], float(r["rate_hz"])): r for r in results[("speed", engine)][0]}
+    rows = {engine: {(r["scene"], r["coupling"], float(r["rate_hz"])): r for r in results[("speed", engine)][0]}
             for engine in engines}
-    keys = sorted(rows[engines[0]], key=lambda k: (COUPLINGS.index(k[0]), k[1]))
-    lines = ["| coupling | world Hz | " + " | ".join(f"{e}: RMS error (mm)" for e in engines) + " | " +
+    keys = sorted(rows[engines[0]], key=lambda k: (k[0], COUPLINGS.index(k[1]), k[2]))
+    lines = ["| scene | coupling | world Hz | " + " | ".join(f"{e}: RMS error (mm)" for e in engines) + " | " +
+             " | ".join(f"{e}: phase spread (mm)" for e in engines) + " | " +
              " | ".join(f"{e}: world CPU per simulated s (ms)" for e in engines) + " |",
-             "|---|---|" + "---|" * (2 * len(engines))]
+             "|---|---|---|" + "---|" * (3 * len(engines))]
     for key in keys:
         errors = " | ".join(f"{float(rows[e][key]['rms_mm']):.2f}" for e in engines)
+        spreads = " | ".join(f"{float(rows[e][key]['spread_mm']):.2f}" for e in engines)
         costs = " | ".join(f"{float(rows[e][key]['world_cpu_ms_per_sim_s']):.2f}" for e in engines)
-        lines.append(f"| {key[0]} | {key[1]:g} | {errors} | {costs} |")
+        lines.append(f"| {key[0]} | {key[1]} | {key[2]:g} | {errors} | {spreads} | {costs} |")
     return lines
 
 
@@ -200,7 +225,8 @@ def main():
             for p in phases:
                 tasks.append((("tap", engine, coupling, p), on_engine,
                               (engine, tap, args.out / engine / f"tap_{coupling}_{p}", coupling, p, None)))
-        tasks.append((("speed", engine), on_engine, (engine, speed_sweep, args.out / engine / "speed_vs_error")))
+        tasks.append((("speed", engine), on_engine,
+                      (engine, speed_sweep, args.out / engine / "speed_vs_error", args.quick)))
         for coupling in COUPLINGS:
             tasks.append((("task", engine, coupling), on_engine,
                           (engine, tap_subject, args.out / engine / f"task_{coupling}", coupling, task_phases)))
@@ -212,7 +238,7 @@ def main():
 
     command = "/usr/bin/python3 scripts/engines.py" + ("" if count == 10 else f" --phases {count}")
     text = [f"# Engines side by side: {', '.join(engines)}", "",
-            f"Generated by `{command}` (under a minute on 2 cores). "
+            f"Generated by `{command}` (about a minute and a half on 2 cores). "
             "Every trial is a lockstep run, bitwise repeatable on each engine. What differs between the engines and "
             "why: `world_manager/engine/bullet_engine.h`.", "",
             f"## The tap over {len(phases)} world-clock phases (paper Fig. 5, docs/phase.md)", "",
@@ -220,8 +246,10 @@ def main():
             f"## The tap task (paper Figs. 7/8, docs/tap_task.md): a simulated subject aiming at "
             f"{100 * TAP_TASK_TARGET_M:.0f} cm", "",
             *tap_task_rows(results, engines), "",
-            "## Speed against error (docs/speed_vs_error.md; its quick grid: the tap, 4 phases per rate), each "
-            "engine against its own 1 kHz reference", "",
+            "## Speed against error (docs/speed_vs_error.md's rate experiment, " +
+            ("its quick grid: the tap, 4 phases per rate" if args.quick else
+             "its full grid: the tap and the spheres, 10 phases per rate (fewer where a period has fewer ticks)") +
+            "), each engine against its own 1 kHz reference", "",
             *speed_rows(results, engines), "",
             "## The stability suite (docs/hard_cases.md), each case's verdict and key metric", "",
             *hard_rows(results, engines, cases), "", *NOTES]

@@ -6,6 +6,7 @@
 #include "world_manager/engine/speculative_contacts.h"
 
 #include <BulletCollision/CollisionDispatch/btSimulationIslandManager.h>
+#include <BulletCollision/CollisionDispatch/btUnionFind.h>
 #include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
 #include <BulletDynamics/MLCPSolvers/btMLCPSolver.h>
 #include <btBulletDynamicsCommon.h>
@@ -84,6 +85,8 @@ struct DeepestPoint final : btCollisionWorld::ContactResultCallback {
   }
 };
 
+static_assert(STATIC_SIMULATION_ISLAND_OPTIMIZATION, "ContactIslands numbers islands as this Bullet build does");
+
 // Simulation islands joined by contact, as ODE's are by its contact joints. Bullet's own island manager joins every
 // pair whose bounding boxes overlap, and Bullet widens each box by its contact breaking threshold (2 cm): resting
 // bodies a centimetre apart that never touch become one island, which sleeps and wakes as one, so one pressed sphere
@@ -92,8 +95,16 @@ struct DeepestPoint final : btCollisionWorld::ContactResultCallback {
 class ContactIslands final : public btSimulationIslandManager {
  public:
   void updateActivationState(btCollisionWorld* world, btDispatcher* dispatcher) override {
-    btSimulationIslandManager::updateActivationState(world, dispatcher);  // tags every body with its index ...
-    initUnionFind(getUnionFind().getNumElements());                        // ... and forgets the boxes' unions
+    // Each dynamic body's island starts as its own index, as Bullet's manager (built with its static-island
+    // optimisation) numbers them: static bodies take no index and join no island.
+    int index = 0;
+    for (int i = 0; i < world->getCollisionObjectArray().size(); ++i) {
+      btCollisionObject* object = world->getCollisionObjectArray()[i];
+      if (!object->isStaticOrKinematicObject()) object->setIslandTag(index++);
+      object->setCompanionId(-1);
+      object->setHitFraction(1.0);
+    }
+    initUnionFind(index);
     for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
       const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
       if (manifold->getNumContacts() == 0) continue;

@@ -10,11 +10,11 @@
 // from), the materials combined by the scene's rules (scene.h combine_*), the rest thresholds (sleeping_bodies.h),
 // the escape guard (escape_guard.h). What is Bullet's own: its solver (sequential impulses with warm starting, or
 // where the scene asks for a direct one its MLCP solver with Dantzig pivoting, as ODE's direct solver pivots), its
-// friction (a pyramid of two fixed directions per contact point, as ODE's Approx1, but solved by sequential impulses),
-// its contact points
-// (kept in persistent manifolds; a point not yet touching lets the pair close the gap and no more, Bullet's own
-// speculative contact), its island sleeping (a resting group of bodies sleeps together), its continuous collision
-// for fast bodies (where the scene asks for speculative contacts).
+// friction (a pyramid of two fixed directions per contact point, as ODE's Approx1, but solved by sequential
+// impulses), its contact points (kept in persistent manifolds; a point not yet touching lets the pair close the gap
+// and no more, Bullet's own speculative contact), its island sleeping (a resting group of touching bodies sleeps
+// together; islands are joined by contact points, as ODE's by contact joints), its continuous collision for fast
+// bodies (where the scene asks for speculative contacts).
 //
 // Each engine is its own Bullet world; Bullet keeps no random state, so runs are bitwise reproducible. The combining
 // rules and the rest time are Bullet's process-wide settings, set to the same values by every engine. Used from one
