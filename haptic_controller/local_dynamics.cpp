@@ -73,6 +73,71 @@ double LocalDynamics::yield_scale(const PlaneSet& planes, const ProxySolution& c
   return std::isfinite(compliance) ? 1.0 / (1.0 + compliance) : 1.0;
 }
 
+LocalDynamics::LocalDynamics(std::uint64_t haptic_session)
+    : haptic_session_(haptic_session), log_(kLoggedTicks) {}
+
+void LocalDynamics::log_tick(double advanced_s) {
+  LoggedTick& record = log_[log_next_];
+  if (log_size_ == log_.size()) overwritten_tick_ = record.tick;
+  record.tick = tick_;
+  record.advanced_s = advanced_s;
+  record.share_count = 0;
+  log_next_ = (log_next_ + 1) % log_.size();
+  log_size_ = std::min(log_size_ + 1, log_.size());
+}
+
+void LocalDynamics::log_share(const ImpulseShare& share) {
+  if (log_size_ == 0) return;
+  LoggedTick& record = log_[(log_next_ + log_.size() - 1) % log_.size()];
+  if (record.tick != tick_ || record.share_count == kLoggedSharesPerTick) {
+    ++unlogged_shares_;
+    return;
+  }
+  record.shares[record.share_count++] = {share.object_id, share.impulse_Ns, share.angular_impulse_Nms};
+}
+
+std::uint64_t LocalDynamics::catch_up(std::uint64_t applied_tick) {
+  if (log_size_ == 0 || log_[(log_next_ + log_.size() - 1) % log_.size()].tick <= applied_tick) return 0;
+  if (overwritten_tick_ > applied_tick) {  // the ring no longer holds the first ticks to replay
+    ++replay_gaps_;
+    return 0;
+  }
+  std::uint64_t replayed = 0;
+  for (std::size_t k = 0; k < log_size_; ++k) {
+    const LoggedTick& record = log_[(log_next_ + log_.size() - log_size_ + k) % log_.size()];
+    if (record.tick <= applied_tick) continue;
+    if (record.advanced_s > 0.0) advance(record.advanced_s);
+    for (std::uint32_t j = 0; j < record.share_count; ++j) {
+      const LoggedShare& share = record.shares[j];
+      apply_impulse(share.object_id, share.impulse_Ns, share.angular_impulse_Nms);
+    }
+    ++replayed;
+  }
+  // The replayed motion becomes the frame's: its planes move to where the bodies now are, and the bodies start again
+  // from there (displacement and turn zero), so the blend and the ticks to come build on the present.
+  for (std::uint32_t k = 0; k < plane_count_; ++k) {
+    const int b = body_of_plane_[k];
+    if (b < 0) continue;
+    const LocalBody& body = bodies_[static_cast<std::size_t>(b)];
+    Plane& plane = frame_.planes[k];
+    plane.point_m = to_vec3(body.carry_point(to_eigen(plane.point_m)));
+    plane.normal = to_vec3(body.carry_normal(to_eigen(plane.normal)));
+    plane.com_m = to_vec3(body.com_m());
+    if (traits(plane.shape.kind).carries_axes) {
+      plane.body_axis_x = to_vec3(body.carry_axis(to_eigen(plane.body_axis_x)));
+      plane.body_axis_y = to_vec3(body.carry_axis(to_eigen(plane.body_axis_y)));
+    }
+  }
+  for (std::uint32_t b = 0; b < body_count_; ++b) {
+    LocalBody& body = bodies_[b];
+    if (body.turns || body.turns_shape) body.axes = body.turn.toRotationMatrix() * body.axes;
+    body.com_frame_m = body.com_m();
+    body.displacement_m.setZero();
+    body.turn = Eigen::Quaterniond::Identity();
+  }
+  return replayed;
+}
+
 void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* displayed,
                                    const Eigen::Vector3d& proxy_m) {
   // Which objects the finger was touching when the frame arrived: they keep the passivity hold (local_dynamics.h).
@@ -142,6 +207,9 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
     }
     body_of_plane_[k] = index;
   }
+
+  // Over a delayed link, the pushes the world has not seen yet (header, "Delay").
+  last_replayed_ticks_ = frame.report_session_applied == haptic_session_ ? catch_up(frame.report_tick_applied) : 0;
 
   // Blend from the plane the finger was feeling (C) to the world's (P), see the header.
   for (std::uint32_t k = 0; k < plane_count_; ++k) {

@@ -87,6 +87,19 @@
 // moves with the world's motion and with the finger's own impulse, which moves it away from the finger.
 // The model is restarted from the world's state at every frame, so a local deviation does not outlive the contact.
 //
+// Delay. A frame's state is the world's after it applied the report of tick a (PlaneFrame::report_tick_applied, this
+// haptic session's): it holds every impulse rendered up to tick a and none after. Without delay the frame arrives
+// right after tick a and the model starts from it. Over a link that holds frames and reports (a network) the frame
+// arrives at a later tick b, and the servo has rendered ticks a+1 … b meanwhile; a model restarted from the frame
+// alone would be the object as it was before those pushes, behind and slower than the one the finger has been
+// pushing (the world gets those impulses later and then overshoots: docs/latency.md). So the model keeps a log of
+// what it did each tick (the tick's length, whether it advanced, the shares it took) and, after restarting from a
+// frame, replays ticks a+1 … b on the frame's state: the model the finger then feels is the world's state carried
+// forward by exactly the pushes the world has not seen yet. The replayed motion is then folded into the frame's
+// planes (they are moved to where the model carried them), so the blend from the plane the finger was feeling starts
+// from the present. The log holds kLoggedTicks ticks (a round trip plus a world period of up to about half a second);
+// a frame whose missing ticks it no longer holds restarts without the replay, and is counted (replay_gaps).
+//
 // Allocation-free after construction; owned by the servo thread.
 
 #include "common/contract/frames.h"
@@ -98,7 +111,9 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace impetus {
 
@@ -153,18 +168,33 @@ struct LocalBody {
 
 class LocalDynamics final : public PlaneMotion {
  public:
+  // Ticks the delay log holds: a round trip plus a world period of 1 ms ticks (2·200 ms + 100 ms at 10 Hz).
+  static constexpr std::size_t kLoggedTicks = 512;
+  // Shares a logged tick holds: the finger's own and other endpoints' of one controller (the rest are counted).
+  static constexpr std::size_t kLoggedSharesPerTick = 16;
+
+  // Serves `haptic_session` (whose reports a frame's report_tick_applied must name for the replay). Allocates the
+  // delay log; nothing after.
+  explicit LocalDynamics(std::uint64_t haptic_session = 0);
+
+  // The servo's tick about to be rendered (its report's tick): stamps the log.
+  void note_tick(std::uint64_t tick) { tick_ = tick; }
+
   // PlaneMotion: the steps below in the servo's order.
   void on_frame(const PlaneFrame&, const PlaneFrame& frame, const PlaneSet* displayed,
                 const Eigen::Vector3d& proxy_m) override {
     on_plane_frame(frame, displayed, proxy_m);
   }
   void planes_for_tick(double w, double dt_s, bool stale, const Eigen::Vector3d& pivot_m, PlaneSet& out) override {
+    log_tick(stale ? 0.0 : dt_s);
     if (!stale) advance(dt_s);  // a stale world: the model holds still
     render(w, pivot_m, out);
   }
   void take_shares(const ImpulseShare* shares, int count) override {
     for (int k = 0; k < count; ++k) {
-      if (shares[k].dynamic) apply_impulse(shares[k].object_id, shares[k].impulse_Ns, shares[k].angular_impulse_Nms);
+      if (!shares[k].dynamic) continue;
+      log_share(shares[k]);
+      apply_impulse(shares[k].object_id, shares[k].impulse_Ns, shares[k].angular_impulse_Nms);
     }
   }
   double frame_disagreement_m() const override { return last_model_error_m(); }
@@ -204,6 +234,10 @@ class LocalDynamics final : public PlaneMotion {
   // At the last frame: the largest difference, at the finger's proxy, between the plane the finger was feeling and
   // the world's new plane, over touched objects (m): how far the world and the model disagreed.
   double last_model_error_m() const { return last_model_error_m_; }
+  // Ticks replayed after the last frame (the delay the model caught up on), and frames that could not be replayed.
+  std::uint64_t last_replayed_ticks() const { return last_replayed_ticks_; }
+  std::uint64_t replay_gaps() const { return replay_gaps_; }
+  std::uint64_t unlogged_shares() const { return unlogged_shares_; }
 
   void reset() { body_count_ = 0; plane_count_ = 0; }
 
@@ -220,6 +254,24 @@ class LocalDynamics final : public PlaneMotion {
   static double hold_box_corners(LocalBody& body, const Eigen::Vector3d& n);
   // The inelastic share with moving loose neighbours (header): after the drift and after each push.
   static void share_with_neighbours(LocalBody& body);
+
+  // The delay log (header, "Delay"): one record per rendered tick, in a ring.
+  struct LoggedShare {
+    std::int32_t object_id = -1;
+    Eigen::Vector3d impulse_Ns = Eigen::Vector3d::Zero();
+    Eigen::Vector3d angular_impulse_Nms = Eigen::Vector3d::Zero();
+  };
+  struct LoggedTick {
+    std::uint64_t tick = 0;
+    double advanced_s = 0.0;  // what advance() was given (0: a stale world, the model held still)
+    std::uint32_t share_count = 0;
+    std::array<LoggedShare, kLoggedSharesPerTick> shares{};
+  };
+  void log_tick(double advanced_s);
+  void log_share(const ImpulseShare& share);
+  // Replays the logged ticks after `applied_tick` on the restarted bodies and folds their motion into the frame's
+  // planes; returns the ticks replayed.
+  std::uint64_t catch_up(std::uint64_t applied_tick);
 
   struct PlaneBlend {
     Eigen::Vector3d from_point_m = Eigen::Vector3d::Zero();  // C
@@ -239,6 +291,16 @@ class LocalDynamics final : public PlaneMotion {
   double elapsed_s_ = 0.0;       // model time since the frame
   double next_drift_s_ = 0.0;    // start of the next substep whose drift is still to apply
   double last_model_error_m_ = 0.0;
+
+  std::uint64_t haptic_session_ = 0;
+  std::uint64_t tick_ = 0;
+  std::vector<LoggedTick> log_;   // kLoggedTicks records, a ring
+  std::size_t log_next_ = 0;      // where the next record goes
+  std::size_t log_size_ = 0;
+  std::uint64_t overwritten_tick_ = 0;  // the newest tick the ring has dropped
+  std::uint64_t last_replayed_ticks_ = 0;
+  std::uint64_t replay_gaps_ = 0;
+  std::uint64_t unlogged_shares_ = 0;
 };
 
 }  // namespace impetus

@@ -22,7 +22,7 @@ double signed_distance_m(const Eigen::Vector3d& x_m, const Eigen::Vector3d& poin
 }  // namespace
 
 HapticServo::HapticServo(const ServoOptions& options, std::uint64_t haptic_session, EndpointId endpoint)
-    : options_(options), renderer_(options.max_force_N), accumulator_(haptic_session, endpoint) {}
+    : options_(options), renderer_(options.max_force_N), accumulator_(haptic_session, endpoint), local_(haptic_session) {}
 
 void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   // Interpolate from the previous frame of the same world session only; the first frame starts where it is.
@@ -103,6 +103,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   HapticReport& report = accumulator_.report();
   report.tick = counters_.ticks;
   report.haptic_time_s = now_s;
+  local_.note_tick(counters_.ticks);
 
   // 1. Finger position C_j.
   const bool finger_valid = finger != nullptr && finger->valid && finger->position_m.allFinite();

@@ -52,8 +52,8 @@ CONTACT_FORCE_N = 0.1
 # The ledger holds to rounding: a running total of ~1e3 tick impulses, each exact to 1e-16 relative.
 LEDGER_TOLERANCE = 1e-9
 
-FULL_DELAYS_MS = (0, 1, 2, 5, 10, 20, 50, 100)
-FULL_GRASP_DELAYS_MS = (0, 5, 20, 50, 100)
+FULL_DELAYS_MS = (0, 1, 2, 5, 10, 20, 50, 100, 150)
+FULL_GRASP_DELAYS_MS = (0, 5, 20, 50, 100, 150)
 
 
 def contact_episodes(force_N):

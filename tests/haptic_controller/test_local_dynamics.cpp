@@ -487,3 +487,77 @@ TEST_CASE("local dynamics: a free box spun off its principal axes precesses as a
   const Eigen::AngleAxisd off(body->turn.toRotationMatrix().transpose() * r);
   CHECK(std::abs(off.angle()) < 1e-3);
 }
+
+namespace {
+
+// Ticks 1…last of a free 1 kg body pushed by `push` along +x every tick (the servo's order: note the tick, advance
+// and render, then take the tick's share).
+void push_ticks(LocalDynamics& model, std::uint64_t first, std::uint64_t last, const Vector3d& push_Ns) {
+  PlaneSet planes;
+  for (std::uint64_t tick = first; tick <= last; ++tick) {
+    model.note_tick(tick);
+    model.planes_for_tick(1.0, kTick_s, false, Vector3d(-0.01, 0, 0.05), planes);
+    impetus::ImpulseShare share;
+    share.object_id = 1;
+    share.dynamic = true;
+    share.impulse_Ns = push_Ns;
+    model.take_shares(&share, 1);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("local dynamics over a delayed link: a frame of the world before the last pushes is carried forward by "
+          "them, so the model is where the finger has been pushing it") {
+  constexpr std::uint64_t kSession = 7;
+  const Vector3d push_Ns(0.001, 0.0, 0.0);  // 1 mN·s a tick on 1 kg: +1 mm/s per tick
+  // Symplectic Euler of the model: after tick n the body moves at n·J/m and has moved J·Δt·n(n−1)/2 / m.
+  const auto moved_m = [&](double n) { return push_Ns.x() * kTick_s * n * (n - 1.0) / 2.0; };
+
+  // The finger pushed for 10 ticks; the world has applied the reports up to tick 4 only (a link delay), and its
+  // frame, arriving now, says so: the cube where 4 pushes put it, at 4 mm/s.
+  LocalDynamics model(kSession);
+  PlaneFrame start = local_frame({cube_face()});
+  model.on_plane_frame(start, nullptr, Vector3d::Zero());
+  push_ticks(model, 1, 10, push_Ns);
+  Plane late = cube_face();
+  late.point_m = {moved_m(4), 0.0, 0.05};
+  late.com_m = {0.025 + moved_m(4), 0.0, 0.05};
+  late.velocity_mps = {4.0 * push_Ns.x(), 0.0, 0.0};
+  PlaneFrame frame = local_frame({late}, 1);
+  frame.report_tick_applied = 4;
+  frame.report_session_applied = kSession;
+
+  SECTION("the six pushes the world has not seen are replayed on its state") {
+    model.on_plane_frame(frame, nullptr, Vector3d::Zero());
+    CHECK(model.last_replayed_ticks() == 6);
+    const LocalBody* body = model.find(1);
+    REQUIRE(body != nullptr);
+    CHECK(body->velocity_mps.x() == Approx(10.0 * push_Ns.x()).epsilon(1e-12));
+    CHECK(body->com_m().x() == Approx(0.025 + moved_m(10)).epsilon(1e-12));
+    // The frame's plane is moved with it: the face the finger feels is where the ten pushes put it.
+    PlaneSet planes;
+    model.note_tick(11);
+    model.planes_for_tick(1.0, kTick_s, false, Vector3d(-0.01, 0, 0.05), planes);
+    CHECK(planes.planes[0].point_m.x() == Approx(moved_m(11)).epsilon(1e-12));
+  }
+  SECTION("a frame naming another haptic session's report is taken as it is") {
+    frame.report_session_applied = kSession + 1;
+    model.on_plane_frame(frame, nullptr, Vector3d::Zero());
+    CHECK(model.last_replayed_ticks() == 0);
+    CHECK(model.find(1)->velocity_mps.x() == Approx(4.0 * push_Ns.x()));
+  }
+  SECTION("without delay (the frame applied the last tick rendered) nothing is replayed") {
+    frame.report_tick_applied = 10;
+    model.on_plane_frame(frame, nullptr, Vector3d::Zero());
+    CHECK(model.last_replayed_ticks() == 0);
+    CHECK(model.find(1)->velocity_mps.x() == Approx(4.0 * push_Ns.x()));
+  }
+  SECTION("a delay longer than the log holds restarts from the frame alone, and is counted") {
+    push_ticks(model, 11, 10 + LocalDynamics::kLoggedTicks, push_Ns);
+    model.on_plane_frame(frame, nullptr, Vector3d::Zero());
+    CHECK(model.last_replayed_ticks() == 0);
+    CHECK(model.replay_gaps() == 1);
+    CHECK(model.find(1)->velocity_mps.x() == Approx(4.0 * push_Ns.x()));
+  }
+}
