@@ -97,8 +97,8 @@
 // frame, replays ticks a+1 … b on the frame's state: the model the finger then feels is the world's state carried
 // forward by exactly the pushes the world has not seen yet. The replayed motion is then folded into the frame's
 // planes (they are moved to where the model carried them), so the blend from the plane the finger was feeling starts
-// from the present. The log holds kLoggedTicks ticks (a round trip plus a world period of up to about half a second);
-// a frame whose missing ticks it no longer holds restarts without the replay, and is counted (replay_gaps).
+// from the present. The log holds kLoggedTicks ticks (a round trip of up to two seconds); a frame whose missing ticks
+// it no longer holds restarts without the replay, and is counted (replay_gaps).
 //
 // Allocation-free after construction; owned by the servo thread.
 
@@ -168,10 +168,12 @@ struct LocalBody {
 
 class LocalDynamics final : public PlaneMotion {
  public:
-  // Ticks the delay log holds: a round trip plus a world period of 1 ms ticks (2·200 ms + 100 ms at 10 Hz).
-  static constexpr std::size_t kLoggedTicks = 512;
-  // Shares a logged tick holds: the finger's own and other endpoints' of one controller (the rest are counted).
-  static constexpr std::size_t kLoggedSharesPerTick = 16;
+  // Ticks the delay log holds: a frame replays the round trip, 2d, so 2048 ticks of 1 ms cover the link delays the
+  // in-process link takes (up to 1 s each way) with room for a late world step.
+  static constexpr std::size_t kLoggedTicks = 2048;
+  // Shares a logged tick holds: a finger's own (at most one per active constraint and the plane it slides on) and
+  // one other endpoint's of the same controller; more are counted (unlogged_shares).
+  static constexpr std::size_t kLoggedSharesPerTick = 2 * (kMaxActiveConstraints + 1);
 
   // Serves `haptic_session` (whose reports a frame's report_tick_applied must name for the replay). Allocates the
   // delay log; nothing after.

@@ -35,6 +35,11 @@ void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   if (continues) {
     counters_.local_model_error_max_m = std::max(counters_.local_model_error_max_m, motion_->frame_disagreement_m());
   }
+  if (motion_ == &local_) {
+    counters_.local_replayed_ticks_max = std::max(counters_.local_replayed_ticks_max, local_.last_replayed_ticks());
+    counters_.local_replay_gaps = local_.replay_gaps();
+    counters_.local_unlogged_shares = local_.unlogged_shares();
+  }
   frame_since_last_tick_ = true;
   copy_used(frame, current_frame_);
   have_frame_ = true;

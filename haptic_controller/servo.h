@@ -70,6 +70,12 @@ struct ServoCounters {
   // Local coupling: the largest disagreement, at the proxy, between the plane the finger was feeling and the world's
   // new plane of a touched object when a frame arrived (before the blend hides it; local_dynamics.h).
   double local_model_error_max_m = 0.0;
+  // Local coupling over a delayed link (local_dynamics.h, "Delay"): the most ticks one frame's replay caught up on
+  // (the link's round trip plus the world's step, as the servo saw it), frames whose missing ticks the model's log no
+  // longer held, and shares the log had no room for.
+  std::uint64_t local_replayed_ticks_max = 0;
+  std::uint64_t local_replay_gaps = 0;
+  std::uint64_t local_unlogged_shares = 0;
 };
 
 class HapticServo {
