@@ -420,19 +420,19 @@ void BulletEngine::step(int substeps, double substep_s, bool record_contacts, Su
     }
   };
   note_awake();
+  if (w.scene->physics.bullet.solver == BulletParams::Solver::direct) {
+    // The direct solver's softness: Bullet 3.24's MLCP leaves out each contact's own CFM (the spring given by
+    // setContactStiffnessAndDamping, which the sequential solver uses) and adds the global CFM over h to the
+    // diagonal of every row instead. ODE's world CFM, 1/(k·h + c), likewise softens every row of a contact, the
+    // normal and the friction ones: so a resting load sits at weight/k as on the sequential solver and on ODE, and
+    // a face resting on four points stays a regular system the pivoting solves (rigid rows make it singular, and
+    // the solver falls back to sequential impulses).
+    w.world.getSolverInfo().m_globalCfm = 1.0 / (w.contact_stiffness_Npm * substep_s + w.contact_damping_Nspm);
+  }
   for (int substep = 0; substep < substeps; ++substep) {
     hook.before_substep(substep);
     w.apply_pushes(substep_s);
     w.escape_guard.check(w.dynamic_ids, w);
-    if (w.scene->physics.bullet.solver == BulletParams::Solver::direct) {
-      // The direct solver's softness: Bullet 3.24's MLCP leaves out each contact's own CFM (the spring given by
-      // setContactStiffnessAndDamping, which the sequential solver uses) and adds the global CFM over h to the
-      // diagonal of every row instead. ODE's world CFM, 1/(k·h + c), likewise softens every row of a contact, the
-      // normal and the friction ones: so a resting load sits at weight/k as on the sequential solver and on ODE, and
-      // a face resting on four points stays a regular system the pivoting solves (rigid rows make it singular, and
-      // the solver falls back to sequential impulses).
-      w.world.getSolverInfo().m_globalCfm = 1.0 / (w.contact_stiffness_Npm * substep_s + w.contact_damping_Nspm);
-    }
     // One substep of exactly substep_s (no fixed-step interpolation); Bullet clears the forces after it.
     w.world.stepSimulation(substep_s, 0);
     note_awake();
