@@ -69,7 +69,8 @@ void check_accepted(const HapticReport& report) {
   for (std::uint32_t k = 0; k < report.entry_count; ++k) {
     const ObjectImpulse& entry = report.entries[k];
     FUZZ_CHECK(all_finite(entry.impulse_Ns) && all_finite(entry.angular_impulse_Nms) &&
-               all_finite(entry.impulse_moment_Nss) && all_finite(entry.angular_impulse_moment_Nmss));
+               all_finite(entry.impulse_moment_Nss) && all_finite(entry.angular_impulse_moment_Nmss) &&
+               std::isfinite(entry.hand_input_J));
   }
 }
 

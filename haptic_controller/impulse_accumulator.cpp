@@ -85,6 +85,7 @@ void ImpulseAccumulator::on_plane_frame(const PlaneFrame& frame) {
     report_.entry_count = 0;
     report_.static_impulse_Ns = {};
     report_.world_session = frame.world_session;
+
   }
   applied_this_session_ = frame.report_session_applied == report_.haptic_session;
   applied_tick_ = applied_this_session_ ? frame.report_tick_applied : 0;
@@ -117,6 +118,16 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
                              const Eigen::Vector3d& force_on_finger_N, double dt_s, std::uint64_t tick) {
   const Eigen::Vector3d reaction_Ns = -force_on_finger_N * dt_s;  // paper §3.4: the user's push on the world
   total_Ns_ += reaction_Ns;
+  // The hand's input (header): this tick's force, J_k/Δt_k per object, against the finger's displacement over the
+  // tick that led to it, Δx_k (the rectangle rule of a time-domain passivity observer, f_k·v_k·Δt), where positive.
+  // Known now, so the world's budget holds this tick's push as soon as the push itself. Only from the tick just
+  // before: across a gap (no finger, a stalled servo) there is no displacement to pair.
+  const Eigen::Vector3d finger_m = to_eigen(report_.finger_m);
+  const bool paired = tick == hand_tick_ + 1 && dt_s > 0.0 && finger_m.allFinite() && hand_finger_m_.allFinite();
+  const Eigen::Vector3d finger_velocity_mps =
+      paired ? Eigen::Vector3d((finger_m - hand_finger_m_) / dt_s) : Eigen::Vector3d::Zero();
+  hand_tick_ = tick;
+  hand_finger_m_ = finger_m;
   last_share_count_ = 0;
   if (reaction_Ns.isZero(0.0)) return;  // nothing to share (and no multiplier is trusted when the force was zeroed)
 
@@ -153,6 +164,7 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     // First moments in time (common/contract/frames.h ObjectImpulse): where in the world period this impulse belongs.
     add_to(entry->impulse_moment_Nss, impulse_Ns * report_.haptic_time_s);
     add_to(entry->angular_impulse_moment_Nmss, angular_Nms * report_.haptic_time_s);
+    entry->hand_input_J += std::max(0.0, impulse_Ns.dot(finger_velocity_mps));
     entry->last_tick = tick;
   }
 }

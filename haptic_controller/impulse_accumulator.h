@@ -28,6 +28,10 @@
 // scene, is given only what is rendered against its own frames. Invariant:
 //     Σ entries + static + evicted + dropped + abandoned == Σ −f·Δt rendered.
 //
+// Each entry also carries the energy the hand put in behind its impulse (ObjectImpulse::hand_input_J): each tick, its
+// share times the finger's velocity over the tick before (report().finger_m, which the servo sets before add()), where
+// positive, so the world can keep what it receives within what the hand put in.
+//
 // Each entry also carries the first moments Σ impulse_k·t_k (t_k = report().haptic_time_s, which the servo sets before
 // add()), so the world can place the impulse in time (local coupling, world.h). The shares of the last add() are kept
 // for the local model (local_dynamics.h), which moves the touched objects tick by tick.
@@ -95,6 +99,9 @@ class ImpulseAccumulator {
   std::uint64_t dropped_shares_ = 0;
   std::array<ImpulseShare, kMaxActiveConstraints + 1> last_shares_{};
   int last_share_count_ = 0;
+  // The tick and finger position of the last add(): the next add() pairs its force with the displacement since.
+  std::uint64_t hand_tick_ = 0;
+  Eigen::Vector3d hand_finger_m_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace impetus

@@ -97,6 +97,7 @@ InProcessRig::InProcessRig(const InProcessTrialOptions& options, std::vector<Nam
   world_options.substeps = options.substeps;
   world_options.engine = options.engine;
   world_options.coupling = options.coupling;
+  world_options.passivity = options.passivity;
   world_options.clock = ClockMode::lockstep;
   world_options.phase_ticks = options.phase_ticks;
   world_options.log_path = log_path(options.out_dir, "world.csv");

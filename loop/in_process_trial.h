@@ -42,6 +42,7 @@ struct InProcessTrialOptions {
   // userU.device.csv (u = 1, 2, ...), its summary under "followers".
   std::vector<std::vector<std::string>> followers;
   Coupling coupling = Coupling::impulse;
+  bool passivity = false;  // world_manager --passivity
   std::uint64_t phase_ticks = 0;  // lockstep phase of the world clock, in haptic ticks (< one world period)
   // Each has the range of the daemon flag it mirrors (common/contract/limits.h) and the same default.
   std::optional<double> world_rate_hz;  // world_manager --rate; default: the scene's physics.world_rate_hz

@@ -60,7 +60,7 @@ impetus::Trajectory trajectory_from_array(const py::array_t<double, py::array::c
 // What every in-process run takes from the Python half: the scene (a file, or JSON text named `scene` in messages),
 // the coupling, the rates, the contact spring and damper, the link delay and the log directory.
 impetus::InProcessTrialOptions trial_options(const std::string& scene, const std::string& scene_text,
-                                             const std::string& coupling, std::uint64_t phase_ticks,
+                                             const std::string& coupling, bool passivity, std::uint64_t phase_ticks,
                                              std::optional<double> world_rate_hz, std::optional<int> substeps,
                                              const std::optional<std::string>& engine,
                                              std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm,
@@ -69,6 +69,7 @@ impetus::InProcessTrialOptions trial_options(const std::string& scene, const std
   options.scene_path = scene;
   options.scene_text = scene_text;
   options.coupling = parse_coupling(coupling);
+  options.passivity = passivity;
   options.phase_ticks = phase_ticks;
   options.world_rate_hz = world_rate_hz;
   options.substeps = substeps;
@@ -87,11 +88,11 @@ using FingerPath = std::tuple<std::string, std::string, std::optional<py::array_
 std::string run_trial(const std::string& scene, const std::string& scene_text, const std::string& trajectory,
                       const std::vector<std::string>& fingers, const std::vector<FingerPath>& finger_paths,
                       const std::vector<std::vector<std::string>>& followers, const std::string& coupling,
-                      std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
+                      bool passivity, std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
                       const std::optional<std::string>& engine, std::optional<double> stiffness_Npm,
                       std::optional<double> damping_Nspm, double link_delay_s, double duration_s,
                       const std::string& out_dir) {
-  impetus::InProcessTrialOptions options = trial_options(scene, scene_text, coupling, phase_ticks, world_rate_hz,
+  impetus::InProcessTrialOptions options = trial_options(scene, scene_text, coupling, passivity, phase_ticks, world_rate_hz,
                                                          substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s,
                                                          out_dir);
   options.trajectory = trajectory;
@@ -193,11 +194,11 @@ class ClosedLoop {
  public:
   ClosedLoop(const std::string& scene, const std::string& scene_text,
              const std::vector<std::pair<std::string, std::array<double, 3>>>& fingers, const std::string& coupling,
-             std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
+             bool passivity, std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
              const std::optional<std::string>& engine, std::optional<double> stiffness_Npm,
              std::optional<double> damping_Nspm, double link_delay_s, const std::string& out_dir) {
     impetus::SimulationOptions options;
-    options.trial = trial_options(scene, scene_text, coupling, phase_ticks, world_rate_hz, substeps, engine,
+    options.trial = trial_options(scene, scene_text, coupling, passivity, phase_ticks, world_rate_hz, substeps, engine,
                                   stiffness_Npm, damping_Nspm, link_delay_s, out_dir);
     for (const auto& [name, start_m] : fingers) options.fingers.push_back({name, start_m});
     options.trial.stop = &stop_;
@@ -344,17 +345,18 @@ PYBIND11_MODULE(_impetus, module) {
   (void)py::dtype::of<double>();
   module.def("run_trial", &run_trial, py::arg("scene"), py::arg("scene_text"), py::arg("trajectory"),
              py::arg("fingers"), py::arg("finger_paths"), py::arg("followers"), py::arg("coupling"),
-             py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("engine"),
+             py::arg("passivity"), py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("engine"),
              py::arg("stiffness_Npm"), py::arg("damping_Nspm"), py::arg("link_delay_s"), py::arg("duration_s"),
              py::arg("out_dir"));
   module.def("read_log", &read_log, py::arg("path"));
   module.def("sample_trajectory", &sample_trajectory, py::arg("spec"), py::arg("times_s"));
   py::class_<ClosedLoop>(module, "ClosedLoop")
       .def(py::init<const std::string&, const std::string&,
-                    const std::vector<std::pair<std::string, std::array<double, 3>>>&, const std::string&,
+                    const std::vector<std::pair<std::string, std::array<double, 3>>>&, const std::string&, bool,
                     std::uint64_t, std::optional<double>, std::optional<int>, const std::optional<std::string>&,
                     std::optional<double>, std::optional<double>, double, const std::string&>(),
-           py::arg("scene"), py::arg("scene_text"), py::arg("fingers"), py::arg("coupling"), py::arg("phase_ticks"),
+           py::arg("scene"), py::arg("scene_text"), py::arg("fingers"), py::arg("coupling"), py::arg("passivity"),
+           py::arg("phase_ticks"),
            py::arg("world_rate_hz"), py::arg("substeps"), py::arg("engine"), py::arg("stiffness_Npm"),
            py::arg("damping_Nspm"),
            py::arg("link_delay_s"), py::arg("out_dir"))

@@ -51,12 +51,13 @@ HAPTIC_PERIOD_S = 1.0 / HAPTIC_RATE_HZ
 # Running trials
 
 
-def run_case_trial(out_dir, scene, trajectory, coupling, rate_hz, stiffness_Npm=None, damping_Nspm=None):
+def run_case_trial(out_dir, scene, trajectory, coupling, rate_hz, stiffness_Npm=None, damping_Nspm=None,
+                   passivity=False):
     """run_trial into out_dir; returns None, or the RuntimeError of a trial that failed (the suite reports it in the
     case's row rather than stopping)."""
     try:
         run_trial(out_dir, scene, trajectory, coupling, rate_hz=rate_hz, stiffness_Npm=stiffness_Npm,
-                  damping_Nspm=damping_Nspm)
+                  damping_Nspm=damping_Nspm, passivity=passivity)
     except RuntimeError as error:
         return error
     return None
@@ -706,7 +707,10 @@ def main():
     parser.add_argument("--cases", default="", help="comma-separated case ids (default: all)")
     parser.add_argument("--coupling", default="impulse", choices=COUPLINGS,
                         help="coupling every case runs with (default impulse, the paper's method)")
+    parser.add_argument("--passivity", default="off", choices=("on", "off"),
+                        help="the world's passivity layer (world_manager --passivity; default off)")
     args = parser.parse_args()
+    passivity = args.passivity == "on"
     wanted = set(args.cases.split(",")) if args.cases else None
     cases = [c for c in CASES if wanted is None or c[0] in wanted]
     args.out.mkdir(parents=True, exist_ok=True)
@@ -717,7 +721,8 @@ def main():
         cid, _, scene, trajectory, rate, _ = case
         out_dirs[("case", cid)] = args.out / f"case{cid}"
         tasks.append((("case", cid), run_case_trial, (out_dirs[("case", cid)], CASES_DIR / scene,
-                                                      resolve_trajectory(trajectory), args.coupling, rate)))
+                                                      resolve_trajectory(trajectory), args.coupling, rate,
+                                                      None, None, passivity)))
     sweep = wanted is None or "1" in wanted
     policies = damping_policies(Scene(WALL_SCENE))
     if sweep:
@@ -726,7 +731,8 @@ def main():
                 out_dirs[("sweep", policy, k)] = args.out / "sweep" / f"{policy}-K{int(k)}"
                 tasks.append((("sweep", policy, k), run_case_trial, (out_dirs[("sweep", policy, k)], WALL_SCENE,
                                                                      WALL_TRAJECTORY, args.coupling, None, k,
-                                                                     damping(k) if explicit else None)))
+                                                                     damping(k) if explicit else None,
+                                                                     passivity)))
 
     results, sweep_results, failures = {}, {}, []
     # A trial's cost is about its trajectory's length; the cases' and the sweep's are alike, so the bar counts them.

@@ -8,7 +8,9 @@ have no delay line, so the package must be built (scripts/build.sh).
 
   tap    scenes/tap.json, trajectory tap with a rest at the start (--rest-s: the first frames reach the haptic side
          a round trip after the start, and a finger that strikes before would meet a cube nobody told it about),
-         world 20 Hz, PHASES world-clock phases per (coupling, delay) for position, impulse and local coupling: the
+         world 20 Hz, PHASES world-clock phases per (coupling, delay) for position, impulse and local coupling, and
+         position and impulse coupling with the world's passivity layer (COUPLING+layer, world_manager --passivity
+         on; the energy it withheld from pushes or damped out of bodies is the "layer withheld" column): the
          cube's stop position (mean, phase spread, bias against the zero-delay single-rate 1 kHz reference as
          scripts/phase_experiment.py computes it), and stability: the largest energy
          gain beyond the hand's work (impetus_py/energy.py), the largest finger force, and how many separate contacts
@@ -39,7 +41,7 @@ from impetus_py.parallel import run_parallel  # noqa: E402
 from impetus_py.paths import ROOT  # noqa: E402
 from impetus_py.progress import track  # noqa: E402
 from impetus_py.scene import Scene  # noqa: E402
-from impetus_py.trial import backend, run_trial  # noqa: E402
+from impetus_py.trial import COUPLINGS, backend, run_trial  # noqa: E402
 
 TAP_SCENE = ROOT / "scenes/tap.json"
 GRASP_SCENE = ROOT / "scenes/grasp.json"
@@ -102,24 +104,34 @@ def energy_gain(out_dir, summary, scene, devices, phase_ticks):
     return balance["excess_J"], balance["tolerance_J"]
 
 
-def tap_trial(out_dir, trajectory, coupling, rate_hz, phase_ticks, delay_ms):
+def coupling_and_layer(label):
+    """A coupling label, COUPLING or COUPLING+layer: (coupling, whether the world's passivity layer is on)."""
+    coupling, _, variant = label.partition("+")
+    return coupling, variant == "layer"
+
+
+def tap_trial(out_dir, trajectory, label, rate_hz, phase_ticks, delay_ms):
     """One tap trial; returns its row of measurements."""
-    summary = run_trial(out_dir, TAP_SCENE, trajectory, coupling, rate_hz, phase_ticks, link_delay_s=delay_ms * 1e-3)
+    coupling, layer = coupling_and_layer(label)
+    summary = run_trial(out_dir, TAP_SCENE, trajectory, coupling, rate_hz, phase_ticks, link_delay_s=delay_ms * 1e-3,
+                        passivity=layer)
     haptic = logs.read_log(out_dir / logs.HAPTIC)
     device = logs.read_log(out_dir / logs.DEVICE)
     force = force_magnitude_N(haptic)
     gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(TAP_SCENE), [device], phase_ticks)
     return {"stop_x_m": summary.final_position_m("cube")[0], "energy_gain_J": gain_J,
             "energy_tolerance_J": tolerance_J, "max_force_N": float(force.max()),
+            "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
             "contacts": contact_episodes(force), "ledger_error": ledger_error_Ns(summary, out_dir),
             "delay_ticks": summary.link["delay_ticks"],
             "link_dropped": summary.link["dropped"]}
 
 
-def grasp_trial(out_dir, coupling, phase_ticks, delay_ms):
+def grasp_trial(out_dir, label, phase_ticks, delay_ms):
     """One grasp trial; returns its row of measurements."""
+    coupling, layer = coupling_and_layer(label)
     summary = run_trial(out_dir, GRASP_SCENE, GRASP_FINGERS, coupling, None, phase_ticks,
-                        link_delay_s=delay_ms * 1e-3)
+                        link_delay_s=delay_ms * 1e-3, passivity=layer)
     world = logs.read_log(out_dir / logs.WORLD)
     t, z = world["time_s"], world["cube.z_m"]
     hold = z[(t >= GRASP_HOLD_S[0]) & (t <= GRASP_HOLD_S[1])]
@@ -135,6 +147,7 @@ def grasp_trial(out_dir, coupling, phase_ticks, delay_ms):
     return {"lift_mm": 1e3 * (hold[0] - z[0]), "lift_end_mm": 1e3 * (hold[-1] - z[0]),
             "slip_mm": 1e3 * (hold.max() - hold.min()),
             "hold_force_p2p_N": max(ripple), "max_force_N": largest, "energy_gain_J": gain_J,
+            "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
             "energy_tolerance_J": tolerance_J, "ledger_error": ledger_error_Ns(summary, out_dir),
             "delay_ticks": summary.link["delay_ticks"],
             "link_dropped": summary.link["dropped"]}
@@ -161,7 +174,9 @@ def main():
     parser.add_argument("--out", type=pathlib.Path, default=ROOT / "out/latency")
     parser.add_argument("--delays-ms", default=",".join(map(str, FULL_DELAYS_MS)),
                         help="one-way link delays of the tap sweep, ms (default %(default)s)")
-    parser.add_argument("--couplings", default="position,impulse,local", help="tap couplings (default %(default)s)")
+    parser.add_argument("--couplings", default="position,impulse,local,position+layer,impulse+layer",
+                        help="tap couplings, COUPLING or COUPLING+layer (the world's passivity layer on; default "
+                             "%(default)s)")
     parser.add_argument("--phases", type=int, default=10, help="world-clock phases per tap cell (default 10)")
     parser.add_argument("--rate", type=float, default=20.0, help="world rate under test, Hz (default 20)")
     parser.add_argument("--rest-s", type=float, default=None,
@@ -171,7 +186,8 @@ def main():
                              "plain tap of scripts/phase_experiment.py, whose finger moves at once")
     parser.add_argument("--grasp-delays-ms", default=",".join(map(str, FULL_GRASP_DELAYS_MS)),
                         help="delays of the grasp, ms (default %(default)s; empty: no grasp)")
-    parser.add_argument("--grasp-couplings", default="impulse,local", help="grasp couplings (default %(default)s)")
+    parser.add_argument("--grasp-couplings", default="impulse,local",
+                        help="grasp couplings, as --couplings (default %(default)s)")
     parser.add_argument("--grasp-phases", type=int, default=5, help="world-clock phases per grasp cell (default 5)")
     parser.add_argument("--quick", action="store_true",
                         help="a small sweep for CTest: the tap at delays 0 and 20 ms, 2 phases, and the grasp at 20 ms "
@@ -196,6 +212,11 @@ def main():
     grasp_delays = parse_ms(args.grasp_delays_ms, "--grasp-delays-ms") if args.grasp_delays_ms.strip() else []
     couplings = [c for c in args.couplings.split(",") if c]
     grasp_couplings = [c for c in args.grasp_couplings.split(",") if c] if grasp_delays else []
+    for label in couplings + grasp_couplings:
+        coupling, _ = coupling_and_layer(label)
+        if coupling not in COUPLINGS or label not in (coupling, coupling + "+layer"):
+            sys.exit(f"latency_experiment: a coupling must be one of {', '.join(COUPLINGS)}, optionally with "
+                     f"'+layer', not '{label}'")
 
     ticks_per_step = round(HAPTIC_RATE_HZ / args.rate)
     phases = sorted({round(k * ticks_per_step / args.phases) for k in range(args.phases)})
@@ -254,6 +275,7 @@ def main():
                           "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
                           "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
                           "max_force_N": max(r["max_force_N"] for r in rows),
+                          "layer_withheld_max_J": max(r["layer_withheld_J"] for r in rows),
                           "contacts_max": max(r["contacts"] for r in rows),
                           "contacts_mean": sum(r["contacts"] for r in rows) / len(rows),
                           "ledger_error_max": max(ledger) if ledger else math.nan,
@@ -281,7 +303,8 @@ def main():
     fields = ["scene", "coupling", "delay_ms", "delay_ticks", "trials", "stop_x_mean_m", "phase_spread_m", "bias_m",
               "bias_pct_of_travel", "lift_mm", "lift_end_mm", "held", "slip_mm", "hold_force_p2p_N",
               "energy_gain_max_J",
-              "energy_tolerance_J", "energy_over_tolerance", "max_force_N", "contacts_max", "contacts_mean",
+              "energy_tolerance_J", "energy_over_tolerance", "max_force_N", "layer_withheld_max_J", "contacts_max",
+              "contacts_mean",
               "ledger_error_max", "link_dropped"]
     with open(args.out / "latency.csv", "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=fields, restval="")
@@ -290,7 +313,7 @@ def main():
     with open(args.out / "latency_trials.csv", "w", newline="") as f:
         trial_fields = ["scene", "coupling", "delay_ms", "phase_ticks", "delay_ticks", "stop_x_m", "lift_mm",
                         "lift_end_mm", "slip_mm", "hold_force_p2p_N", "energy_gain_J", "energy_tolerance_J",
-                        "max_force_N",
+                        "max_force_N", "layer_withheld_J",
                         "contacts", "ledger_error", "link_dropped"]
         writer = csv.DictWriter(f, fieldnames=trial_fields, restval="")
         writer.writeheader()
@@ -302,11 +325,11 @@ def main():
              f"{reference_x:.4f} m, travel {travel:.4f} m)", "",
              "| coupling | delay (ms) | stop x mean (m) | phase spread (mm) | bias vs reference (mm) | "
              "bias (% of travel) | energy gain, worst phase (mJ) | phases over tolerance | max force (N) | "
-             "contacts per stroke (mean, max) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "layer withheld, worst phase (mJ) | contacts per stroke (mean, max) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     ref = trials[("tap", "reference", 0.0, 0)]
     lines.append(f"| reference (1 kHz world) | 0 | {reference_x:.4f} | – | – | – | {1e3 * ref['energy_gain_J']:+.2f} | "
-                 f"{int(ref['energy_gain_J'] > ref['energy_tolerance_J'])}/1 | {ref['max_force_N']:.2f} | "
+                 f"{int(ref['energy_gain_J'] > ref['energy_tolerance_J'])}/1 | {ref['max_force_N']:.2f} | – | "
                  f"{ref['contacts']:.1f}, {ref['contacts']} |")
     for c in cells:
         if c["scene"] != "tap":
@@ -314,7 +337,8 @@ def main():
         lines.append(f"| {c['coupling']} | {ms_label(c['delay_ms'])} | {c['stop_x_mean_m']:.4f} | "
                      f"{1e3 * c['phase_spread_m']:.2f} | {1e3 * c['bias_m']:+.2f} | {c['bias_pct_of_travel']:+.1f} | "
                      f"{1e3 * c['energy_gain_max_J']:+.2f} | {c['energy_over_tolerance']}/{c['trials']} | "
-                     f"{c['max_force_N']:.2f} | {c['contacts_mean']:.1f}, {c['contacts_max']} |")
+                     f"{c['max_force_N']:.2f} | "
+                     f"{1e3 * c['layer_withheld_max_J']:.1f} | {c['contacts_mean']:.1f}, {c['contacts_max']} |")
     if grasp_couplings:
         lines += ["", f"Grasp and lift (thumb and index), {len(grasp_phases)} world-clock phases per cell, worst phase "
                   f"shown; hold window {GRASP_HOLD_S[0]:g}–{GRASP_HOLD_S[1]:g} s; held: the cube still at least half "
@@ -362,8 +386,9 @@ def main():
                     pairs = [(axis_delays.index(c["delay_ms"]), scale * c[field]) for c in cells
                              if c["scene"] == kind and c["coupling"] == coupling]
                     if pairs:
-                        ax.plot(*zip(*pairs), style, ms=4, lw=1.2, color=colours.get(coupling),
-                                label=f"{kind}, {coupling}")
+                        base, layer = coupling_and_layer(coupling)
+                        ax.plot(*zip(*pairs), ("^:" if kind == "tap" else "v:") if layer else style, ms=4, lw=1.2,
+                                color=colours.get(base), label=f"{kind}, {coupling}")
             if linear_within is not None:
                 ax.set_yscale("symlog", linthresh=linear_within)
             ax.set_xticks(range(len(axis_delays)), [ms_label(d) for d in axis_delays])

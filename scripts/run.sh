@@ -4,7 +4,7 @@
 # DIR, prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
 #
 #   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ...) [--user SPEC ...]
-#                  [--coupling impulse|position|local]
+#                  [--coupling impulse|position|local] [--passivity on|off]
 #                  [--rate HZ] [--phase TICKS] [--substeps N] [--engine ode|bullet]
 #                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet] [--no-logs]
 #                  [--view [--view-listen HOST:PORT] [--view-wait S]]
@@ -29,7 +29,7 @@ usage() { sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "run.sh: $*" >&2; exit 2; }
 
 view=0 view_listen="127.0.0.1:8080" view_wait=0 logs=1
-substeps="" engine="" scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
+substeps="" engine="" passivity="" scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
 haptic_extra=()
 fingers=()
 users=()
@@ -43,6 +43,7 @@ while (($#)); do
     --rate) rate="${2:?}"; shift 2 ;;
     --substeps) substeps="${2:?}"; shift 2 ;;
     --engine) engine="${2:?}"; shift 2 ;;
+    --passivity) passivity="${2:?}"; shift 2 ;;
     --phase) phase="${2:?}"; shift 2 ;;
     --clock) clock="${2:?}"; shift 2 ;;
     --duration) duration="${2:?}"; shift 2 ;;
@@ -89,6 +90,7 @@ add_log world_args world
 [ -n "$rate" ] && world_args+=(--rate "$rate")
 [ -n "$substeps" ] && world_args+=(--substeps "$substeps")
 [ -n "$engine" ] && world_args+=(--engine "$engine")
+[ -n "$passivity" ] && world_args+=(--passivity "$passivity")
 haptic_args=(--clock "$clock" --duration "$duration" --shm "$shm" --summary "$out/haptic.json" "${haptic_extra[@]}")
 add_log haptic_args haptic
 device_args=(--clock "$clock" --shm "$shm" --summary "$out/device.json")

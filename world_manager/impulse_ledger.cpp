@@ -15,13 +15,15 @@ ImpulseDelta ImpulseLedger::take(const CounterOwner& owner, const ObjectImpulse&
   Baseline& baseline = baselines_of(owner).objects[static_cast<std::size_t>(entry.object_id)];
   if (!baseline.seen || baseline.epoch != entry.epoch) {
     // A new counter starts at zero (contract/frames.h, ObjectImpulse::epoch).
-    baseline = Baseline{true, entry.epoch, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    baseline = Baseline{true, entry.epoch, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0};
   }
   const Eigen::Vector3d total_Ns = to_eigen(entry.impulse_Ns);
   const Eigen::Vector3d total_angular_Nms = to_eigen(entry.angular_impulse_Nms);
-  ImpulseDelta delta{total_Ns - baseline.impulse_Ns, total_angular_Nms - baseline.angular_impulse_Nms};
+  ImpulseDelta delta{total_Ns - baseline.impulse_Ns, total_angular_Nms - baseline.angular_impulse_Nms,
+                     entry.hand_input_J - baseline.hand_input_J};
   baseline.impulse_Ns = total_Ns;
   baseline.angular_impulse_Nms = total_angular_Nms;
+  baseline.hand_input_J = entry.hand_input_J;
   return delta;
 }
 

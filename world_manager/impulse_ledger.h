@@ -4,8 +4,8 @@
 //
 // Each endpoint of each haptic session publishes, per object, a running total of impulse since its entry for that
 // object was (re)allocated, keyed by (haptic session, endpoint, object, epoch). The ledger remembers the last total it
-// saw per (haptic session, endpoint, object) and hands out the difference. A counter it has not seen, or whose epoch
-// changed, has restarted from zero, so its baseline is zero: a restarted haptic controller never causes a burst, a
+// saw per (haptic session, endpoint, object) and hands out the difference (of the hand's input behind it too). A
+// counter it has not seen, or whose epoch changed, has restarted from zero, so its baseline is zero: a restarted haptic controller never causes a burst, a
 // repeated report yields nothing, and two endpoints pushing the same object never cancel each other's baselines.
 
 #include "common/contract/frames.h"
@@ -22,6 +22,7 @@ namespace impetus {
 struct ImpulseDelta {
   Eigen::Vector3d impulse_Ns = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_impulse_Nms = Eigen::Vector3d::Zero();  // about the centre of mass, world frame
+  double hand_input_J = 0.0;  // the energy the hand put in behind it (ObjectImpulse::hand_input_J)
 };
 
 // Whose counters: one endpoint of one haptic session.
@@ -48,6 +49,7 @@ class ImpulseLedger {
     std::uint32_t epoch = 0;
     Eigen::Vector3d impulse_Ns = Eigen::Vector3d::Zero();
     Eigen::Vector3d angular_impulse_Nms = Eigen::Vector3d::Zero();
+    double hand_input_J = 0.0;
   };
   struct OwnerBaselines {
     std::vector<Baseline> objects;

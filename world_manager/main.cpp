@@ -44,6 +44,10 @@ int main(int argc, char** argv) {
           "ENGINE"));
   app.add_option("--coupling", options.coupling, "impulse (paper §2.2), position (the previous method) or local")
       ->transform(enum_names(kCouplingNames));
+  app.add_option("--passivity", options.passivity,
+                 "on: the energy the couplings give a body never exceeds what the hands put in "
+                 "(docs/latency.md); off: the paper's couplings as they are (default: off)")
+      ->transform(enum_names(kOnOffNames));
   add_clock_flag(app, options.clock);
   app.add_option("--phase", options.phase_ticks, "lockstep: world step i happens at haptic tick i*n + PHASE")
       ->check(whole_number_in(0, kMaxPhaseTicks));

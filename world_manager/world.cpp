@@ -38,7 +38,8 @@ World::World(const Scene& scene, const WorldOptions& options)
 
   engine_ = make_engine(scene_);
   start_overlaps_ = engine_->overlaps(kStartOverlap_m);
-  const CouplingContext context{scene_, period_s_, scene_.physics.substeps, *engine_, states_, applied_};
+  port_ = std::make_unique<PassivityLayer>(states_, *engine_, options.passivity);
+  const CouplingContext context{scene_, period_s_, scene_.physics.substeps, *engine_, states_, applied_, *port_};
   coupling_ = make_coupling(options.coupling, context, stiffness_Npm, damping_Nspm);
 
   for (std::size_t id = 0; id < states_.size(); ++id) {
@@ -104,10 +105,12 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
     fingers_[slot] = slot < reports.size() ? endpoints_[slot].finger : FingerState{};
   }
   coupling_->before_step(std::span<const FingerState>(fingers_.data(), reports.size()), features_);
+  port_->settle();  // the velocity changes the reports made, against the hand input they brought
 
-  // Step 3: the engine, with the coupling's forces before every substep.
+  // Step 3: the engine, with the coupling's forces before every substep (and the port's books after each).
   engine_->step(scene_.physics.substeps, period_s_ / scene_.physics.substeps, coupling_->needs_contacts(), *coupling_);
   coupling_->after_step();
+  port_->settle();
   ++steps_taken_;
   time_s_ = static_cast<double>(steps_taken_) * period_s_;  // no drift from summing periods
   refresh_states(engine_->moved());
@@ -224,6 +227,8 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
       t.moment.angular_impulse_Nms *= scale;
     }
     const std::size_t id = t.id;
+    // The hand's input counts whole, clipped or not: the hand put it in.
+    if (id < floor_id && scene_.objects[id].dynamic) port_->add_hand_input(id, t.delta.hand_input_J);
     // Position coupling moves nothing by the reports (its penalty comes from the sampled finger): nothing applied.
     if (options_.coupling != Coupling::position) applied[id] += t.delta.impulse_Ns;
     // An entry whose total has not grown since the last report brings nothing new: handing it on would only wake a

@@ -44,6 +44,11 @@ struct WorldOptions {
   // The largest force a controller's device renders, N (the SPIDAR's, common/spidar/geometry.h): no report may bring
   // a step more impulse than that force could in the world time since the endpoint's last applied report (take_report).
   double report_force_limit_N = SpidarGeometry{}.max_force_N;
+  // The passivity layer on the impulse port (couplings/passivity_layer.h): the energy the couplings give a body never
+  // exceeds what the hands put in. Off: the paper's couplings exactly as the paper has them. The port's books are kept
+  // either way. Off by default: it removes impulse and position coupling's energy gains (docs/latency.md) but, as the
+  // haptic side does not yet learn what it withheld, a finger can end up inside an object it could not push back.
+  bool passivity = false;
 };
 
 class World {
@@ -128,6 +133,9 @@ class World {
   // their impulses are not.
   std::uint64_t foreign_reports() const { return foreign_reports_; }
 
+  // The impulse port's energy books per dynamic object and their sum (couplings/passivity_layer.h).
+  const PassivityLayer& port() const { return *port_; }
+
   // Kinetic + gravitational potential energy of the dynamic objects (J), potential measured from the origin.
   double mechanical_energy_J() const;
 
@@ -164,6 +172,7 @@ class World {
   ImpulseLedger moment_ledger_;
   FeatureExtractor features_;
   AppliedImpulses applied_;
+  std::unique_ptr<PassivityLayer> port_;
   std::unique_ptr<CouplingStrategy> coupling_;
   Eigen::Vector3d total_static_impulse_Ns_ = Eigen::Vector3d::Zero();
   std::map<CounterOwner, std::vector<Eigen::Vector3d>> applied_by_owner_;  // per object (scene ids and the floor)

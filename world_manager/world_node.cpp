@@ -35,6 +35,7 @@ Scene scene_with_overrides(const WorldNodeOptions& options) {
 WorldOptions world_options(const WorldNodeOptions& options) {
   WorldOptions world;
   world.coupling = options.coupling;
+  world.passivity = options.passivity;
   world.world_rate_hz = options.rate_hz;
   world.world_session = options.world_session != 0 ? options.world_session : new_session_id();
   return world;
@@ -262,9 +263,31 @@ nlohmann::json WorldNode::summary() const {
     endpoints.push_back({{"haptic_session", owner.haptic_session}, {"endpoint", owner.endpoint},
                          {"impulse_by_object_Ns", impulses}});
   }
+  // The impulse port's energy books (couplings/passivity_layer.h), per dynamic object that was pushed and summed.
+  auto port_json = [](const PortEnergy& books) {
+    return nlohmann::json{{"hand_input_J", books.hand_input_J},
+                          {"port_work_J", books.port_work_J},
+                          {"overdraft_J", books.overdraft_J()},
+                          {"withheld_J", books.withheld_J},
+                          {"damped_J", books.damped_J},
+                          {"unrecovered_J", books.unrecovered_J},
+                          {"removed_impulse_Ns", books.removed_impulse_Ns},
+                          {"interventions", books.interventions}};
+  };
+  nlohmann::json port_objects = nlohmann::json::object();
+  for (std::size_t id = 0; id < scene_.objects.size(); ++id) {
+    const PortEnergy& books = world_.port().energy(id);
+    if (books.hand_input_J != 0.0 || books.port_work_J != 0.0 || books.interventions != 0) {
+      port_objects[scene_.objects[id].name] = port_json(books);
+    }
+  }
+  nlohmann::json port = port_json(world_.port().total());
+  port["layer"] = world_.port().enabled();
+  port["objects"] = port_objects;
   return {{"objects", objects},
           {"world",
            {{"steps", world_.steps_taken()},
+            {"port", port},
             {"endpoints", endpoints},
             {"time_s", world_.time_s()},
             {"period_s", world_.world_period_s()},
@@ -296,6 +319,7 @@ nlohmann::json WorldNode::summary() const {
            {{"scene", options_.scene_path},
             {"world_rate_hz", 1.0 / world_.world_period_s()},
             {"coupling", to_string(world_.coupling())},
+            {"passivity", world_.port().enabled()},
             {"clock", to_string(options_.clock)},
             {"phase_ticks", options_.phase_ticks},
             {"substeps", scene_.physics.substeps},

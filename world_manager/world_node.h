@@ -37,6 +37,7 @@ struct WorldNodeOptions {
   // engine reads its own block of the scene, if the scene has one.
   std::optional<std::string> engine;
   Coupling coupling = Coupling::impulse;
+  bool passivity = false;  // the passivity layer on the impulse port (WorldOptions::passivity)
   ClockMode clock = ClockMode::realtime;
   std::uint64_t phase_ticks = 0;
   double duration_s = 0.0;  // 0: until stopped

@@ -131,6 +131,11 @@ struct ObjectImpulse {
   // applies it at that time and the world's next state agrees with what the haptic side showed (world.h).
   Vec3 impulse_moment_Nss{};
   Vec3 angular_impulse_moment_Nmss{};
+  // The energy the hand put in behind this impulse, J: Σ max(0, J_k·v_k), each tick's share J_k times the finger's
+  // velocity over the tick before (the hand's work against the displayed force, by a passivity observer's rectangle
+  // rule), where it pushed. The world holds what its couplings give the object to it
+  // (world_manager/couplings/passivity_layer.h).
+  double hand_input_J = 0.0;
   std::uint64_t last_tick = 0;    // last haptic tick that added to this entry
 };
 

@@ -79,6 +79,7 @@ void visit_entry(A& a, B& b, F&& f) {
   f(a.angular_impulse_Nms, b.angular_impulse_Nms);
   f(a.impulse_moment_Nss, b.impulse_moment_Nss);
   f(a.angular_impulse_moment_Nmss, b.angular_impulse_moment_Nmss);
+  f(a.hand_input_J, b.hand_input_J);
   f(a.last_tick, b.last_tick);
 }
 

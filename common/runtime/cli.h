@@ -28,6 +28,7 @@ inline const std::map<std::string, ClockMode> kClockNames{{"realtime", ClockMode
                                                           {"lockstep", ClockMode::lockstep}};
 inline const std::map<std::string, Coupling> kCouplingNames{
     {"impulse", Coupling::impulse}, {"position", Coupling::position}, {"local", Coupling::local}};
+inline const std::map<std::string, bool> kOnOffNames{{"on", true}, {"off", false}};
 
 // A CLI11 transform for an enum flag: its name (any case) becomes the enum's value; another text is refused with
 // "must be a, b or c, not 'x'" (CLI11's own CheckedTransformer prints its mapping table).

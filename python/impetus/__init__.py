@@ -158,10 +158,12 @@ def _scene_argument(scene):
     return str(path), ""
 
 
-def _options(coupling, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s):
+def _options(coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s):
     """The options every run takes, checked and converted (ValueError naming the argument)."""
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling: must be one of {', '.join(COUPLINGS)}, not {coupling!r}")
+    if not isinstance(passivity, bool):
+        raise ValueError(f"passivity: must be True or False, not {passivity!r}")
     if engine is not None and engine not in ENGINES:
         raise ValueError(f"engine: must be one of {', '.join(ENGINES)} or None, not {engine!r}")
     if isinstance(phase_ticks, bool) or not isinstance(phase_ticks, numbers.Integral) or not 0 <= phase_ticks < 2**64:
@@ -172,7 +174,7 @@ def _options(coupling, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, da
         if substeps >= 2**31:
             raise ValueError(f"substeps: {substeps} is beyond the world's range (world_manager --help states it)")
         substeps = int(substeps)
-    return (coupling, int(phase_ticks), _real("rate_hz", rate_hz, optional=True), substeps, engine,
+    return (coupling, passivity, int(phase_ticks), _real("rate_hz", rate_hz, optional=True), substeps, engine,
             _real("stiffness_Npm", stiffness_Npm, optional=True), _real("damping_Nspm", damping_Nspm, optional=True),
             _real("link_delay_s", link_delay_s))
 
@@ -191,9 +193,9 @@ def _is_path_like(value):
     return isinstance(value, (str, os.PathLike))
 
 
-def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, phase_ticks=0, substeps=None,
-              engine=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, duration_s=60.0, out_dir=None,
-              logs=True):
+def run_trial(scene, trajectory, coupling="impulse", *, passivity=False, users=(), rate_hz=None, phase_ticks=0,
+              substeps=None, engine=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, duration_s=60.0,
+              out_dir=None, logs=True):
     """Runs one trial and returns its Trial.
 
     scene          a scene file (str or path; shipped_scene("tap") for a shipped one), or a dict in the scene file's
@@ -204,6 +206,9 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
                    in finger order (spidar_sim --finger NAME=PATH), each finger an endpoint of the world (Trial.logs
                    holds the first finger's logs)
     coupling       one of COUPLINGS
+    passivity      the passivity layer on the impulse port (world_manager --passivity): True, the energy the
+                   couplings give a body never exceeds what the hand put in; False (default), the paper's couplings
+                   exactly as the paper has them. summary["world"]["port"] keeps the books either way
     users          other users on the same world, each a haptic controller of its own following this trial's lockstep
                    ticks: a list whose items are a trajectory (one finger) or a dict {name: trajectory} (several).
                    User u's logs are userU.haptic.csv and userU.device.csv in out_dir, its summary
@@ -237,8 +242,8 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
         raise TypeError(f"out_dir: must be a path or None, not {type(out_dir).__name__}")
     if isinstance(users, (str, dict)) or not all(isinstance(user, (str, dict, pathlib.Path)) for user in users):
         raise ValueError(f"users: must be a list of trajectories or {{name: trajectory}} dicts, not {users!r}")
-    coupling, phase_ticks, rate_hz, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s = _options(
-        coupling, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s)
+    coupling, passivity, phase_ticks, rate_hz, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s = _options(
+        coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s)
     duration_s = _real("duration_s", duration_s)
     # Specs and files go by name, as spidar_sim --finger NAME=PATH takes them; with an array among them every finger
     # goes as (name, spec, waypoints). One finger given as a spec or file keeps the single-trajectory form, so its
@@ -256,7 +261,8 @@ def run_trial(scene, trajectory, coupling="impulse", *, users=(), rate_hz=None, 
         followers = [[f"{name}={path}" for name, path in user.items()] if isinstance(user, dict)
                      else [f"finger={user}"] for user in users]
         summary = json.loads(_impetus.run_trial(scene_path, scene_text, str(trajectory) if single else "", fingers,
-                                                paths, followers, coupling, phase_ticks, rate_hz, substeps,
+                                                paths, followers, coupling, passivity, phase_ticks, rate_hz,
+                                                substeps,
                                                 engine, stiffness_Npm, damping_Nspm, float(link_delay_s),
                                                 float(duration_s),
                                                 str(directory) if (out_dir is not None or logs) else ""))
@@ -340,7 +346,8 @@ class Simulation:
     scene        a scene file or a dict in its schema (as run_trial takes it)
     start_m      where the one finger starts, at rest (x, y, z in metres); or fingers=
     fingers      several fingers: {name: start point} in endpoint order
-    coupling, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s   as run_trial
+    coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s
+                 as run_trial
                  takes them
     out_dir      a directory for world.csv, haptic.csv, device.csv and (at close) summary.json; None: no logs
 
@@ -349,8 +356,9 @@ class Simulation:
     own state, so several may be interleaved.
     """
 
-    def __init__(self, scene, start_m=None, coupling="impulse", *, fingers=None, rate_hz=None, phase_ticks=0,
-                 substeps=None, engine=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, out_dir=None):
+    def __init__(self, scene, start_m=None, coupling="impulse", *, passivity=False, fingers=None, rate_hz=None,
+                 phase_ticks=0, substeps=None, engine=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0,
+                 out_dir=None):
         import numpy as np
         self._loop = None
         self.summary = None
@@ -367,8 +375,8 @@ class Simulation:
             starts.append((str(name), self._point(label, point)))
         if out_dir is not None and not isinstance(out_dir, (str, os.PathLike)):
             raise TypeError(f"out_dir: must be a path or None, not {type(out_dir).__name__}")
-        options = _options(coupling, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm,
-                           link_delay_s)
+        options = _options(coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm,
+                           damping_Nspm, link_delay_s)
         self.out_dir = pathlib.Path(out_dir) if out_dir is not None else None
         if self.out_dir is not None:
             self.out_dir.mkdir(parents=True, exist_ok=True)

@@ -32,7 +32,8 @@ def scene_dir() -> pathlib.Path: ...
 def shipped_scene(name: str) -> pathlib.Path: ...
 def read_log(path: _Path) -> dict[str, npt.NDArray[np.float64]]: ...
 def sample_trajectory(trajectory: _Path, times_s: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
-def run_trial(scene: _Scene, trajectory: _Trajectory, coupling: str = ..., *, users: Sequence[_Trajectory] = ...,
+def run_trial(scene: _Scene, trajectory: _Trajectory, coupling: str = ..., *, passivity: bool = ...,
+              users: Sequence[_Trajectory] = ...,
               rate_hz: float | None = ..., phase_ticks: int = ..., substeps: int | None = ...,
               engine: str | None = ..., stiffness_Npm: float | None = ..., damping_Nspm: float | None = ...,
               link_delay_s: float = ...,
@@ -56,7 +57,7 @@ class Simulation:
     finger_names: tuple[str, ...]
     object_names: tuple[str, ...]
     tick_period_s: float
-    def __init__(self, scene: _Scene, start_m: _Point | None = ..., coupling: str = ..., *,
+    def __init__(self, scene: _Scene, start_m: _Point | None = ..., coupling: str = ..., *, passivity: bool = ...,
                  fingers: Mapping[str, _Point] | None = ..., rate_hz: float | None = ..., phase_ticks: int = ...,
                  substeps: int | None = ..., engine: str | None = ..., stiffness_Npm: float | None = ...,
                  damping_Nspm: float | None = ..., link_delay_s: float = ..., out_dir: _Path | None = ...) -> None: ...

@@ -68,20 +68,22 @@ def engine_choice():
 
 
 def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=None, substeps=None,
-              stiffness_Npm=None, damping_Nspm=None, link_delay_s=None):
+              stiffness_Npm=None, damping_Nspm=None, link_delay_s=None, passivity=False):
     """Runs one lockstep trial of `scene` (a path) driven by `trajectory` (a spidar_sim --trajectory spec or file, or
     a dict {finger name: spec or file} for a device of several fingers)
     into out_dir and returns its Summary. rate_hz, phase_ticks and substeps are world_manager's --rate, --phase and
     --substeps, stiffness_Npm and damping_Nspm haptic_controller's --stiffness and --damping (None: the scene's
     values, phase 0). link_delay_s is the world link's one-way delay (s, both ways; None or 0: none): only the
-    in-process link has a delay line, so a nonzero delay needs the impetus package. The engine is engine_choice().
+    in-process link has a delay line, so a nonzero delay needs the impetus package. passivity is world_manager's
+    --passivity (False: the paper's couplings as they are). The engine is engine_choice().
     Raises RuntimeError naming the trial if it failed."""
     out_dir.mkdir(parents=True, exist_ok=True)
     module = _impetus_module()
     engine = engine_choice()
     if module:
         try:
-            trial = module.run_trial(scene, trajectory, coupling, rate_hz=rate_hz, phase_ticks=phase_ticks or 0,
+            trial = module.run_trial(scene, trajectory, coupling, passivity=passivity, rate_hz=rate_hz,
+                                     phase_ticks=phase_ticks or 0,
                                      substeps=substeps, engine=engine, stiffness_Npm=stiffness_Npm,
                                      damping_Nspm=damping_Nspm, link_delay_s=link_delay_s or 0.0, out_dir=out_dir,
                                      logs=False)
@@ -97,7 +99,8 @@ def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=No
     fingers = [["--finger", f"{name}={each}"] for name, each in trajectory.items()] if isinstance(trajectory, dict) \
         else [["--trajectory", str(trajectory)]]
     command = ["bash", str(ROOT / "scripts/run.sh"), "--scene", str(scene), *[arg for pair in fingers for arg in pair],
-               "--coupling", coupling, "--clock", "lockstep", "--out", str(out_dir), "--quiet"]
+               "--coupling", coupling, "--passivity", "on" if passivity else "off", "--clock", "lockstep",
+               "--out", str(out_dir), "--quiet"]
     for flag, value in (("--rate", rate_hz), ("--phase", phase_ticks), ("--substeps", substeps), ("--engine", engine)):
         if value is not None:
             command += [flag, str(value)]

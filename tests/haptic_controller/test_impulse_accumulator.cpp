@@ -204,3 +204,36 @@ TEST_CASE("a frame of a new world session starts the totals afresh, what the old
                              accumulator.dropped_impulse_Ns();
   CHECK((accounted - accumulator.total_impulse_Ns()).norm() < 1e-15);
 }
+
+TEST_CASE("the hand's input is each tick's push times the finger's velocity over the tick before, where it pushed") {
+  // A finger pressing down into a cube's top by 1 mm per tick, then pulling back out at the same speed: the pushes on
+  // the way in are the hand's input (J·v > 0), the way out gives nothing back to it (the world may not take the
+  // hand's energy twice).
+  ContactPlane cube_top = make_plane({0, 0, 0.05}, {0, 0, 1}, 1, true);
+  cube_top.com_m = Vector3d(0, 0, 0.025);
+  const PlaneSet planes = make_set({cube_top});
+  ImpulseAccumulator accumulator(kSession);
+  constexpr double kStiffness_Npm = 1000.0;
+  constexpr double kTick_s = 1e-3;
+  double expected_J = 0.0;
+  double previous_z = 0.0;
+  for (std::uint64_t tick = 1; tick <= 10; ++tick) {
+    const double depth_m = 1e-3 * static_cast<double>(tick <= 5 ? tick : 10 - tick);
+    const double z = 0.05 - depth_m;
+    accumulator.report().finger_m = {0.0, 0.0, z};
+    const Vector3d force_N(0.0, 0.0, kStiffness_Npm * depth_m);  // up on the finger
+    GodObject god;
+    const GodObjectResult& solved = god.solve(planes, Vector3d(0, 0, z), kTick_s);
+    accumulator.add(planes, solved.contact, solved.contact.active_count > 0 ? force_N : Vector3d::Zero(), kTick_s,
+                    tick);
+    // −f·Δt on the cube, times the finger's velocity (z − previous)/Δt: positive while pressing in.
+    if (tick > 1 && solved.contact.active_count > 0) {
+      expected_J += std::max(0.0, -force_N.z() * kTick_s * (z - previous_z) / kTick_s);
+    }
+    previous_z = z;
+  }
+  REQUIRE(accumulator.report().entry_count == 1);
+  // Pressing in over ticks 2..5: 1000 N/m · (2+3+4+5) mm · 1 mm = 14 mJ; pulling out adds nothing.
+  CHECK(expected_J == Approx(0.014).epsilon(1e-12));
+  CHECK(accumulator.report().entries[0].hand_input_J == Approx(expected_J).epsilon(1e-12));
+}

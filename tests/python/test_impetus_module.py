@@ -88,6 +88,29 @@ class Arguments(unittest.TestCase):
         self.assertEqual(base.logs, {})
         self.assertIsNone(base.out_dir)
 
+    def test_passivity_layer_reaches_the_world(self):
+        # Impulse coupling's tap gives the cube more energy than the hand put in; the world's books say so with the
+        # layer off, and with it on the cube gets no more than the input, the rest counted as withheld. The switch
+        # is the daemon's --passivity: run.sh with it gives the same logs bit for bit.
+        off = impetus.run_trial(self.scene(), "tap", logs=False)
+        on = impetus.run_trial(self.scene(), "tap", passivity=True, out_dir=OUT / "passivity-python")
+        self.assertIs(off.summary["config"]["passivity"], False)
+        self.assertIs(on.summary["config"]["passivity"], True)
+        port_off, port_on = off.summary["world"]["port"], on.summary["world"]["port"]
+        self.assertGreater(port_off["overdraft_J"], 0.01)
+        self.assertEqual(port_off["withheld_J"] + port_off["damped_J"], 0.0)
+        self.assertLessEqual(port_on["port_work_J"], port_on["hand_input_J"] + 1e-12)
+        self.assertGreater(port_on["withheld_J"] + port_on["damped_J"], 0.0)
+        self.assertLess(on.summary["objects"]["cube"]["position"][0], off.summary["objects"]["cube"]["position"][0])
+        processes = OUT / "passivity-processes"
+        subprocess.run(["bash", str(ROOT / "scripts/run.sh"), "--scene", str(self.scene()), "--trajectory", "tap",
+                        "--passivity", "on", "--clock", "lockstep", "--out", str(processes), "--quiet"], check=True)
+        for log in impetus.LOG_FILES.values():
+            with self.subTest(log=log):
+                self.assertEqual((on.out_dir / log).read_text(), (processes / log).read_text())
+        with self.assertRaisesRegex(ValueError, "passivity"):
+            impetus.run_trial(self.scene(), "tap", passivity="on")
+
     def test_link_delay_reaches_the_link(self):
         # 20 ms each way at 1 kHz is 20 ticks; the delay changes the trial (the cube starts later and stops elsewhere),
         # and the summary says what the link held back.

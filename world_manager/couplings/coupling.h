@@ -10,6 +10,7 @@
 //   local     (paper §6.3)  each impulse placed at the time it was rendered; frames carry contacts for the model
 
 #include "common/contract/frames.h"
+#include "world_manager/couplings/passivity_layer.h"
 #include "world_manager/engine/rigid_body_engine.h"
 #include "world_manager/features/feature_extractor.h"
 #include "world_manager/impulse_ledger.h"
@@ -68,6 +69,8 @@ struct CouplingContext {
   RigidBodyEngine& engine;
   std::span<ObjectState> states;  // after the last step; velocities updated by velocity changes
   AppliedImpulses& applied;
+  // Every push goes through it (push_force, push_force_at, change_velocity), so the port's energy is booked.
+  PassivityLayer& port;
 };
 
 // Where the finger is, for position coupling (the sampled finger of the newest report).
@@ -89,6 +92,8 @@ class CouplingStrategy : public SubstepHook {
   // endpoint without a usable finger has valid == false).
   virtual void before_step(std::span<const FingerState>, const FeatureExtractor&) {}
   void before_substep(int) override {}
+  // Books the work of the substep's pushes and, with the layer on, takes out what the hands did not put in.
+  void after_substep(int) final;
   // After the engine's last substep.
   virtual void after_step() {}
   // Whether the engine must record the last substep's contacts for annotate().
@@ -103,6 +108,13 @@ class CouplingStrategy : public SubstepHook {
                              const Eigen::Vector3d& angular_impulse_Nms);
   // The velocity change alone; the caller records the impulse in context_.applied.
   void change_velocity(std::size_t id, const Eigen::Vector3d& impulse_Ns, const Eigen::Vector3d& angular_impulse_Nms);
+  double substep_s() const { return context_.world_period_s / context_.substeps; }
+  // Velocity changes and forces go through the port (passivity_layer.h), which may admit only part of them (the part
+  // withheld is counted there; context_.applied keeps what the coupling took from the reports).
+  // A force (and torque about the centre of mass) held over the coming substep.
+  void push_force(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm);
+  // A force at a world point, held over the coming substep.
+  void push_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m);
 
   CouplingContext context_;
 };

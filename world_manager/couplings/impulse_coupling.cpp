@@ -32,7 +32,7 @@ void ImpulseCoupling::take_impulse(std::size_t id, const ImpulseDelta& delta, co
 
 void ImpulseCoupling::before_substep(int) {
   // The engine clears forces after every substep: hand them in again each time.
-  for (const std::size_t id : held_) context_.engine.add_force(id, force_N_[id], torque_Nm_[id]);
+  for (const std::size_t id : held_) push_force(id, force_N_[id], torque_Nm_[id]);
 }
 
 void ImpulseCoupling::after_step() {

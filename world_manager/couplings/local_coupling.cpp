@@ -119,14 +119,20 @@ void LocalCoupling::apply_slot(int slot) {
     }
     if (impulse_Ns.isZero(0.0) && angular_Nms.isZero(0.0)) continue;
     if (slot < substeps) {
-      context_.engine.add_force(id, impulse_Ns / h, angular_Nms / h);
+      push_force(id, impulse_Ns / h, angular_Nms / h);
     } else {
       Eigen::Vector3d velocity_mps;
       Eigen::Vector3d angular_radps;
       context_.engine.velocity(id, velocity_mps, angular_radps);
       const ObjectState& state = context_.states[id];
-      context_.engine.set_velocity(id, velocity_mps + state.inverse_mass_per_kg * impulse_Ns,
-                                   angular_radps + state.inverse_inertia_world * angular_Nms);
+      const double admitted = context_.port.admit_velocity_change(id, impulse_Ns, angular_Nms, velocity_mps,
+                                                                  angular_radps, state.inverse_mass_per_kg,
+                                                                  state.inverse_inertia_world);
+      const Eigen::Vector3d new_velocity_mps = velocity_mps + state.inverse_mass_per_kg * admitted * impulse_Ns;
+      const Eigen::Vector3d new_angular_radps = angular_radps + state.inverse_inertia_world * admitted * angular_Nms;
+      context_.engine.set_velocity(id, new_velocity_mps, new_angular_radps);
+      context_.port.record_velocity_change(id, admitted * impulse_Ns, admitted * angular_Nms, velocity_mps,
+                                           angular_radps, new_velocity_mps, new_angular_radps);
     }
     impulse_Ns.setZero();
     angular_Nms.setZero();

@@ -43,7 +43,7 @@ void PositionCoupling::before_substep(int) {
   for (const Push& push : pushes_) {
     if (push.force_N.isZero(0.0)) continue;
     context_.engine.wake(push.object_id);
-    context_.engine.add_force_at(push.object_id, push.force_N, push.point_m);
+    push_force_at(push.object_id, push.force_N, push.point_m);
   }
 }
 

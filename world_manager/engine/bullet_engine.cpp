@@ -436,6 +436,7 @@ void BulletEngine::step(int substeps, double substep_s, bool record_contacts, Su
     // One substep of exactly substep_s (no fixed-step interpolation); Bullet clears the forces after it.
     w.world.stepSimulation(substep_s, 0);
     note_awake();
+    hook.after_substep(substep);
   }
   w.escape_guard.check(w.dynamic_ids, w);  // the world reads the state next
   if (record_contacts) w.record_graph(substep_s);

@@ -544,6 +544,7 @@ void OdeEngine::step(int substeps, double substep_s, bool record_contacts, Subst
     }
     if (recording) ode.record_graph();
     dJointGroupEmpty(ode.contacts);
+    hook.after_substep(substep);
   }
   ode.park_escaped();  // the world reads the state next
   if (ode.sleeping) ode.sleeping->put_rested_to_sleep(ode);

@@ -16,11 +16,13 @@
 
 namespace impetus {
 
-// Called by RigidBodyEngine::step before each substep (couplings add their forces there).
+// Called by RigidBodyEngine::step before each substep (couplings add their forces there) and after it (the impulse
+// port books the work those forces did, couplings/passivity_layer.h).
 class SubstepHook {
  public:
   virtual ~SubstepHook() = default;
   virtual void before_substep(int substep) = 0;
+  virtual void after_substep(int /*substep*/) {}
 };
 
 class RigidBodyEngine {
@@ -44,7 +46,8 @@ class RigidBodyEngine {
   virtual void add_force(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm) = 0;
   virtual void add_force_at(std::size_t id, const Eigen::Vector3d& force_N, const Eigen::Vector3d& point_m) = 0;
 
-  // Advances `substeps` substeps of `substep_s` each, calling hook.before_substep(s) first in each. With
+  // Advances `substeps` substeps of `substep_s` each, calling hook.before_substep(s) first in each and
+  // hook.after_substep(s) once the bodies have moved (before the next substep's collisions). With
   // `record_contacts` the contacts of the last substep, each with the normal force the substep found for it, replace
   // contacts() once that substep is done. Reproducible: the same calls from the same state give the same bits,
   // whatever other engines in the process do.

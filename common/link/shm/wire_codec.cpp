@@ -170,7 +170,8 @@ FrameError validate(const wire::HapticReport& report) {
   for (std::uint32_t k = 0; k < report.entry_count; ++k) {
     const wire::ObjectImpulse& entry = report.entries[k];
     if (!all_finite(entry.impulse_Ns) || !all_finite(entry.angular_impulse_Nms) ||
-        !all_finite(entry.impulse_moment_Nss) || !all_finite(entry.angular_impulse_moment_Nmss)) {
+        !all_finite(entry.impulse_moment_Nss) || !all_finite(entry.angular_impulse_moment_Nmss) ||
+        !finite(entry.hand_input_J)) {
       return FrameError::not_finite;
     }
   }

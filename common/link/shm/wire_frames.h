@@ -79,6 +79,7 @@ struct ObjectImpulse {
   Vec3 angular_impulse_Nms{};
   Vec3 impulse_moment_Nss{};
   Vec3 angular_impulse_moment_Nmss{};
+  double hand_input_J = 0.0;
   std::uint64_t last_tick = 0;
 };
 
