@@ -53,6 +53,18 @@ void check_options(const InProcessTrialOptions& options) {
     throw std::invalid_argument(std::string("link_delay_s: the link's one-way delay must be between 0 and ") +
                                 std::to_string(static_cast<int>(kMaxLinkDelay_s)) + " s, not " + text);
   }
+  auto out_of_range = [](const char* option, const char* what, double lowest, double highest, double value) {
+    char text[200];
+    std::snprintf(text, sizeof text, "%s: %s must be between %g and %g, not %.17g", option, what, lowest, highest,
+                  value);
+    return std::invalid_argument(text);
+  };
+  if (!(options.link_loss >= 0.0 && options.link_loss <= kMaxLinkLoss)) {
+    throw out_of_range("link_loss", "the fraction of packets the link loses", 0.0, kMaxLinkLoss, options.link_loss);
+  }
+  if (!(options.link_loss_burst >= 1.0 && options.link_loss_burst <= kMaxLossBurst)) {
+    throw out_of_range("link_loss_burst", "the mean run of lost packets", 1.0, kMaxLossBurst, options.link_loss_burst);
+  }
 }
 
 }  // namespace
@@ -106,7 +118,9 @@ InProcessRig::InProcessRig(const InProcessTrialOptions& options, std::vector<Nam
   link_delay_.delay_ticks = static_cast<std::uint64_t>(std::llround(options.link_delay_s * rate_hz_));
   link_delay_.ticks_per_world_step =
       LockstepSchedule::ticks_per_world_step(world_->link_info().world_period_s, rate_hz_);
-  world_link_ = std::make_unique<InProcessWorldLink>(world_->link_info(), link_delay_);
+  link_loss_.rate = options.link_loss;
+  link_loss_.burst_packets = options.link_loss_burst;
+  world_link_ = std::make_unique<InProcessWorldLink>(world_->link_info(), link_delay_, link_loss_);
   world_->connect(*world_link_);
   world_link_->connect(*world_);
 
@@ -153,6 +167,10 @@ nlohmann::json InProcessRig::summary() const {
       {"delay_s", static_cast<double>(link_delay_.delay_ticks) / rate_hz_},
       {"delay_ticks", link_delay_.delay_ticks},
       {"dropped", world_link_->dropped()},
+      {"loss", link_loss_.rate},
+      {"loss_burst_packets", link_loss_.burst_packets},
+      {"lost_frames", world_link_->lost_frames()},
+      {"lost_reports", world_link_->lost_reports()},
   };
   if (users_.size() > 1) {
     nlohmann::json followers = nlohmann::json::array();

@@ -66,6 +66,7 @@ class InProcessRig {
 
   double rate_hz_;
   InProcessLinkDelay link_delay_;
+  LinkLoss link_loss_;
   std::unique_ptr<WorldNode> world_;
   std::unique_ptr<InProcessWorldLink> world_link_;
   std::vector<std::unique_ptr<Controller>> users_;

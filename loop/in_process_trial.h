@@ -25,6 +25,9 @@ namespace impetus {
 // The longest link delay a trial takes: a second each way is beyond any network a haptic user would put up with, and
 // keeps the delay line's reports (one per tick) to a thousand per finger at 1 kHz.
 inline constexpr double kMaxLinkDelay_s = 1.0;
+// Loss beyond half the packets, or runs of more than a thousand, is a link that is down, not a lossy one.
+inline constexpr double kMaxLinkLoss = 0.5;
+inline constexpr double kMaxLossBurst = 1000.0;
 
 struct InProcessTrialOptions {
   std::string scene_path;  // a scene file (world_manager/scene.h)
@@ -56,6 +59,11 @@ struct InProcessTrialOptions {
   // that many ticks late (common/link/inproc/inproc_world_link.h says exactly when); summary.json's "link" records
   // it. For latency experiments: the daemons' links (shared memory, DDS) have no delay line, so no flag mirrors it.
   double link_delay_s = 0.0;
+  // Loss on the world link, each direction alike (common/link/inproc/link_loss.h): the fraction of frames and of
+  // reports lost, 0 to kMaxLinkLoss, and the mean run of consecutive losses in packets, 1 to kMaxLossBurst (1:
+  // independent losses). Seeded, so a lossy trial is repeatable; summary.json's "link" counts what was lost.
+  double link_loss = 0.0;
+  double link_loss_burst = 1.0;
   // world.csv, haptic.csv and device.csv are written here when it is not empty; nothing is written otherwise.
   std::filesystem::path out_dir;
   // Set by another thread to end the trial between two ticks (Ctrl-C in Python); the summary then covers what ran.

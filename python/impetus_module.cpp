@@ -64,7 +64,8 @@ impetus::InProcessTrialOptions trial_options(const std::string& scene, const std
                                              std::optional<double> world_rate_hz, std::optional<int> substeps,
                                              const std::optional<std::string>& engine,
                                              std::optional<double> stiffness_Npm, std::optional<double> damping_Nspm,
-                                             double link_delay_s, const std::string& out_dir) {
+                                             double link_delay_s, double link_loss, double link_loss_burst,
+                                             const std::string& out_dir) {
   impetus::InProcessTrialOptions options;
   options.scene_path = scene;
   options.scene_text = scene_text;
@@ -77,6 +78,8 @@ impetus::InProcessTrialOptions trial_options(const std::string& scene, const std
   if (stiffness_Npm) options.stiffness_Npm = *stiffness_Npm;
   if (damping_Nspm) options.damping_Nspm = *damping_Nspm;
   options.link_delay_s = link_delay_s;
+  options.link_loss = link_loss;
+  options.link_loss_burst = link_loss_burst;
   options.out_dir = out_dir;
   return options;
 }
@@ -90,11 +93,11 @@ std::string run_trial(const std::string& scene, const std::string& scene_text, c
                       const std::vector<std::vector<std::string>>& followers, const std::string& coupling,
                       bool passivity, std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
                       const std::optional<std::string>& engine, std::optional<double> stiffness_Npm,
-                      std::optional<double> damping_Nspm, double link_delay_s, double duration_s,
-                      const std::string& out_dir) {
-  impetus::InProcessTrialOptions options = trial_options(scene, scene_text, coupling, passivity, phase_ticks, world_rate_hz,
-                                                         substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s,
-                                                         out_dir);
+                      std::optional<double> damping_Nspm, double link_delay_s, double link_loss,
+                      double link_loss_burst, double duration_s, const std::string& out_dir) {
+  impetus::InProcessTrialOptions options =
+      trial_options(scene, scene_text, coupling, passivity, phase_ticks, world_rate_hz, substeps, engine, stiffness_Npm,
+                    damping_Nspm, link_delay_s, link_loss, link_loss_burst, out_dir);
   options.trajectory = trajectory;
   options.fingers = fingers;
   for (const auto& [name, spec, table] : finger_paths) {
@@ -196,10 +199,11 @@ class ClosedLoop {
              const std::vector<std::pair<std::string, std::array<double, 3>>>& fingers, const std::string& coupling,
              bool passivity, std::uint64_t phase_ticks, std::optional<double> world_rate_hz, std::optional<int> substeps,
              const std::optional<std::string>& engine, std::optional<double> stiffness_Npm,
-             std::optional<double> damping_Nspm, double link_delay_s, const std::string& out_dir) {
+             std::optional<double> damping_Nspm, double link_delay_s, double link_loss, double link_loss_burst,
+             const std::string& out_dir) {
     impetus::SimulationOptions options;
     options.trial = trial_options(scene, scene_text, coupling, passivity, phase_ticks, world_rate_hz, substeps, engine,
-                                  stiffness_Npm, damping_Nspm, link_delay_s, out_dir);
+                                  stiffness_Npm, damping_Nspm, link_delay_s, link_loss, link_loss_burst, out_dir);
     for (const auto& [name, start_m] : fingers) options.fingers.push_back({name, start_m});
     options.trial.stop = &stop_;
     py::gil_scoped_release release;
@@ -346,7 +350,8 @@ PYBIND11_MODULE(_impetus, module) {
   module.def("run_trial", &run_trial, py::arg("scene"), py::arg("scene_text"), py::arg("trajectory"),
              py::arg("fingers"), py::arg("finger_paths"), py::arg("followers"), py::arg("coupling"),
              py::arg("passivity"), py::arg("phase_ticks"), py::arg("world_rate_hz"), py::arg("substeps"), py::arg("engine"),
-             py::arg("stiffness_Npm"), py::arg("damping_Nspm"), py::arg("link_delay_s"), py::arg("duration_s"),
+             py::arg("stiffness_Npm"), py::arg("damping_Nspm"), py::arg("link_delay_s"), py::arg("link_loss"),
+             py::arg("link_loss_burst"), py::arg("duration_s"),
              py::arg("out_dir"));
   module.def("read_log", &read_log, py::arg("path"));
   module.def("sample_trajectory", &sample_trajectory, py::arg("spec"), py::arg("times_s"));
@@ -354,12 +359,12 @@ PYBIND11_MODULE(_impetus, module) {
       .def(py::init<const std::string&, const std::string&,
                     const std::vector<std::pair<std::string, std::array<double, 3>>>&, const std::string&, bool,
                     std::uint64_t, std::optional<double>, std::optional<int>, const std::optional<std::string>&,
-                    std::optional<double>, std::optional<double>, double, const std::string&>(),
+                    std::optional<double>, std::optional<double>, double, double, double, const std::string&>(),
            py::arg("scene"), py::arg("scene_text"), py::arg("fingers"), py::arg("coupling"), py::arg("passivity"),
            py::arg("phase_ticks"),
            py::arg("world_rate_hz"), py::arg("substeps"), py::arg("engine"), py::arg("stiffness_Npm"),
            py::arg("damping_Nspm"),
-           py::arg("link_delay_s"), py::arg("out_dir"))
+           py::arg("link_delay_s"), py::arg("link_loss"), py::arg("link_loss_burst"), py::arg("out_dir"))
       .def("step", &ClosedLoop::step, py::arg("ticks"), py::arg("targets"))
       .def("set_target", &ClosedLoop::set_target, py::arg("finger"), py::arg("target_m"))
       .def("set_hand_force", &ClosedLoop::set_hand_force, py::arg("finger"), py::arg("force_N"))

@@ -110,11 +110,11 @@ def coupling_and_layer(label):
     return coupling, variant == "layer"
 
 
-def tap_trial(out_dir, trajectory, label, rate_hz, phase_ticks, delay_ms):
-    """One tap trial; returns its row of measurements."""
+def tap_trial(out_dir, trajectory, label, rate_hz, phase_ticks, delay_ms, loss=(0.0, 1.0)):
+    """One tap trial; returns its row of measurements. loss: (fraction lost, mean burst in packets)."""
     coupling, layer = coupling_and_layer(label)
     summary = run_trial(out_dir, TAP_SCENE, trajectory, coupling, rate_hz, phase_ticks, link_delay_s=delay_ms * 1e-3,
-                        passivity=layer)
+                        passivity=layer, link_loss=loss[0], link_loss_burst=loss[1])
     haptic = logs.read_log(out_dir / logs.HAPTIC)
     device = logs.read_log(out_dir / logs.DEVICE)
     force = force_magnitude_N(haptic)
@@ -123,6 +123,7 @@ def tap_trial(out_dir, trajectory, label, rate_hz, phase_ticks, delay_ms):
             "energy_tolerance_J": tolerance_J, "max_force_N": float(force.max()),
             "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
             "contacts": contact_episodes(force), "ledger_error": ledger_error_Ns(summary, out_dir),
+            "lost_frames": summary.link["lost_frames"], "lost_reports": summary.link["lost_reports"],
             "delay_ticks": summary.link["delay_ticks"],
             "link_dropped": summary.link["dropped"]}
 
@@ -167,6 +168,26 @@ def ms_label(delay_ms):
     return f"{delay_ms:g}"
 
 
+def parse_losses(text):
+    """--losses: comma-separated PCT or PCTbB (PCT % of packets lost in runs of B on average): [(fraction, burst)]."""
+    losses = []
+    for item in (x.strip() for x in text.split(",") if x.strip()):
+        percent, _, burst = item.partition("b")
+        try:
+            loss = (float(percent) / 100.0, float(burst) if burst else 1.0)
+        except ValueError:
+            sys.exit(f"latency_experiment: --losses takes PCT or PCTbBURST items (5, 20b5), not '{item}'")
+        if not (0.0 < loss[0] <= 0.5 and 1.0 <= loss[1] <= 1000.0):
+            sys.exit(f"latency_experiment: a loss must be above 0 and at most 50 %, its burst 1 to 1000 packets, "
+                     f"not '{item}'")
+        losses.append(loss)
+    return losses
+
+
+def loss_label(loss):
+    return f"{100 * loss[0]:g} %" + (f", bursts of {loss[1]:g}" if loss[1] > 1.0 else "")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0],
                                      epilog="\n".join(__doc__.splitlines()[2:]),
@@ -184,6 +205,11 @@ def main():
                              "whole world periods covering two longest delays plus two periods, so the first frames "
                              "(a round trip late) are there before the finger moves at every delay swept; 0: the "
                              "plain tap of scripts/phase_experiment.py, whose finger moves at once")
+    parser.add_argument("--losses", default="5,20,20b5",
+                        help="tap cells with link loss: PCT or PCTbB (B: mean run of lost packets; default "
+                             "%(default)s)")
+    parser.add_argument("--loss-delays-ms", default="0,20,50",
+                        help="delays the loss cells run at (default %(default)s)")
     parser.add_argument("--grasp-delays-ms", default=",".join(map(str, FULL_GRASP_DELAYS_MS)),
                         help="delays of the grasp, ms (default %(default)s; empty: no grasp)")
     parser.add_argument("--grasp-couplings", default="impulse,local",
@@ -201,6 +227,7 @@ def main():
     args = parser.parse_args()
     if args.quick:
         args.delays_ms, args.phases = "0,20", 2
+        args.losses, args.loss_delays_ms = "20b5", "20"
         args.grasp_delays_ms, args.grasp_couplings, args.grasp_phases = "20", "local", 1
     if args.phases < 1 or args.grasp_phases < 1:
         sys.exit(f"latency_experiment: --phases and --grasp-phases must be 1 or more, not {args.phases} and "
@@ -210,6 +237,8 @@ def main():
                  "(scripts/build.sh) and do not set IMPETUS_TRIALS=processes")
     delays = parse_ms(args.delays_ms, "--delays-ms")
     grasp_delays = parse_ms(args.grasp_delays_ms, "--grasp-delays-ms") if args.grasp_delays_ms.strip() else []
+    losses = parse_losses(args.losses)
+    loss_delays = parse_ms(args.loss_delays_ms, "--loss-delays-ms") if losses else []
     couplings = [c for c in args.couplings.split(",") if c]
     grasp_couplings = [c for c in args.grasp_couplings.split(",") if c] if grasp_delays else []
     for label in couplings + grasp_couplings:
@@ -224,7 +253,7 @@ def main():
     # are those of the plain tap, the cube resting meanwhile.
     world_period_s = 1.0 / args.rate
     if args.rest_s is None:
-        args.rest_s = (math.ceil(2e-3 * max(delays) / world_period_s - 1e-9) + 2) * world_period_s
+        args.rest_s = (math.ceil(2e-3 * max(delays + loss_delays) / world_period_s - 1e-9) + 2) * world_period_s
     if args.rest_s < 0:
         sys.exit(f"latency_experiment: --rest-s must be 0 or more, not {args.rest_s}")
     tap = f"tap:rest={args.rest_s:.6g}" if args.rest_s > 0 else "tap"
@@ -235,6 +264,14 @@ def main():
                 out_dir = args.out / "tap" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
                 tasks.append((("tap", coupling, delay, phase), tap_trial,
                               (out_dir, tap, coupling, args.rate, phase, delay)))
+    for coupling in couplings:
+        for loss in losses:
+            for delay in loss_delays:
+                for phase in phases:
+                    out_dir = (args.out / "tap-loss" /
+                               f"{coupling}-loss{100 * loss[0]:g}b{loss[1]:g}-delay{ms_label(delay)}ms-phase{phase:03d}")
+                    tasks.append((("tap-loss", coupling, delay, phase, loss), tap_trial,
+                                  (out_dir, tap, coupling, args.rate, phase, delay, loss)))
     # The reference: impulse coupling with the world at the haptic rate and no delay (one phase: its period is a tick).
     tasks.append((("tap", "reference", 0.0, 0), tap_trial,
                   (args.out / "tap" / "reference", tap, "impulse", float(HAPTIC_RATE_HZ), 0, 0.0)))
@@ -280,6 +317,26 @@ def main():
                           "contacts_mean": sum(r["contacts"] for r in rows) / len(rows),
                           "ledger_error_max": max(ledger) if ledger else math.nan,
                           "link_dropped": sum(r["link_dropped"] for r in rows)})
+    for coupling in couplings:
+        for loss in losses:
+            for delay in loss_delays:
+                rows = [trials[("tap-loss", coupling, delay, p, loss)] for p in phases]
+                stops = [r["stop_x_m"] for r in rows]
+                mean = sum(stops) / len(stops)
+                ledger = [r["ledger_error"] for r in rows if r["ledger_error"] is not None]
+                cells.append({"scene": "tap-loss", "coupling": coupling, "delay_ms": delay, "loss": loss[0],
+                              "loss_burst": loss[1], "delay_ticks": rows[0]["delay_ticks"], "trials": len(rows),
+                              "stop_x_mean_m": mean, "phase_spread_m": max(stops) - min(stops),
+                              "bias_m": mean - reference_x,
+                              "bias_pct_of_travel": 100.0 * (mean - reference_x) / travel,
+                              "energy_gain_max_J": max(r["energy_gain_J"] for r in rows),
+                              "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
+                              "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
+                              "max_force_N": max(r["max_force_N"] for r in rows),
+                              "lost_frames_mean": sum(r["lost_frames"] for r in rows) / len(rows),
+                              "lost_reports_mean": sum(r["lost_reports"] for r in rows) / len(rows),
+                              "ledger_error_max": max(ledger) if ledger else math.nan,
+                              "link_dropped": sum(r["link_dropped"] for r in rows)})
     for coupling in grasp_couplings:
         for delay in grasp_delays:
             rows = [trials[("grasp", coupling, delay, p)] for p in grasp_phases]
@@ -300,7 +357,8 @@ def main():
                           "link_dropped": sum(r["link_dropped"] for r in rows)})
 
     args.out.mkdir(parents=True, exist_ok=True)
-    fields = ["scene", "coupling", "delay_ms", "delay_ticks", "trials", "stop_x_mean_m", "phase_spread_m", "bias_m",
+    fields = ["scene", "coupling", "delay_ms", "loss", "loss_burst", "lost_frames_mean", "lost_reports_mean",
+              "delay_ticks", "trials", "stop_x_mean_m", "phase_spread_m", "bias_m",
               "bias_pct_of_travel", "lift_mm", "lift_end_mm", "held", "slip_mm", "hold_force_p2p_N",
               "energy_gain_max_J",
               "energy_tolerance_J", "energy_over_tolerance", "max_force_N", "layer_withheld_max_J", "contacts_max",
@@ -311,14 +369,17 @@ def main():
         writer.writeheader()
         writer.writerows(cells)
     with open(args.out / "latency_trials.csv", "w", newline="") as f:
-        trial_fields = ["scene", "coupling", "delay_ms", "phase_ticks", "delay_ticks", "stop_x_m", "lift_mm",
+        trial_fields = ["scene", "coupling", "delay_ms", "loss", "loss_burst", "phase_ticks", "delay_ticks", "stop_x_m", "lift_mm",
                         "lift_end_mm", "slip_mm", "hold_force_p2p_N", "energy_gain_J", "energy_tolerance_J",
                         "max_force_N", "layer_withheld_J",
-                        "contacts", "ledger_error", "link_dropped"]
+                        "contacts", "ledger_error", "lost_frames", "lost_reports", "link_dropped"]
         writer = csv.DictWriter(f, fieldnames=trial_fields, restval="")
         writer.writeheader()
-        for (scene, coupling, delay, phase), row in sorted(trials.items(), key=lambda item: item[0]):
-            writer.writerow({"scene": scene, "coupling": coupling, "delay_ms": delay, "phase_ticks": phase, **row})
+        for key, row in sorted(trials.items(), key=lambda item: item[0][:4]):
+            scene, coupling, delay, phase = key[:4]
+            extra = {"loss": key[4][0], "loss_burst": key[4][1]} if len(key) > 4 else {}
+            writer.writerow({"scene": scene, "coupling": coupling, "delay_ms": delay, "phase_ticks": phase, **extra,
+                             **row})
 
     lines = [f"Tap trial (`{tap}`), world {args.rate:g} Hz, {len(phases)} world-clock phases per cell, one-way link "
              f"delay each way; reference: impulse coupling, world at {HAPTIC_RATE_HZ} Hz, no delay (stop x = "
@@ -339,6 +400,21 @@ def main():
                      f"{1e3 * c['energy_gain_max_J']:+.2f} | {c['energy_over_tolerance']}/{c['trials']} | "
                      f"{c['max_force_N']:.2f} | "
                      f"{1e3 * c['layer_withheld_max_J']:.1f} | {c['contacts_mean']:.1f}, {c['contacts_max']} |")
+    if losses:
+        lines += ["", f"Tap with link loss ({len(phases)} phases per cell; each direction loses its own packets, from "
+                  f"a seeded Gilbert–Elliott model)", "",
+                  "| coupling | delay (ms) | loss | lost frames, reports (mean) | stop x mean (m) | phase spread (mm) | "
+                  "bias (% of travel) | energy gain, worst phase (mJ) | phases over tolerance | max force (N) |",
+                  "|---|---|---|---|---|---|---|---|---|---|"]
+        for c in cells:
+            if c["scene"] != "tap-loss":
+                continue
+            lines.append(f"| {c['coupling']} | {ms_label(c['delay_ms'])} | "
+                         f"{loss_label((c['loss'], c['loss_burst']))} | "
+                         f"{c['lost_frames_mean']:.1f}, {c['lost_reports_mean']:.0f} | {c['stop_x_mean_m']:.4f} | "
+                         f"{1e3 * c['phase_spread_m']:.2f} | {c['bias_pct_of_travel']:+.1f} | "
+                         f"{1e3 * c['energy_gain_max_J']:+.2f} | {c['energy_over_tolerance']}/{c['trials']} | "
+                         f"{c['max_force_N']:.2f} |")
     if grasp_couplings:
         lines += ["", f"Grasp and lift (thumb and index), {len(grasp_phases)} world-clock phases per cell, worst phase "
                   f"shown; hold window {GRASP_HOLD_S[0]:g}–{GRASP_HOLD_S[1]:g} s; held: the cube still at least half "
@@ -411,11 +487,13 @@ def main():
             if not all(math.isfinite(v) for v in numbers):
                 failures.append(f"{c['scene']} {c['coupling']} {ms_label(c['delay_ms'])} ms: a number is not finite")
         # Every trial whose coupling applies the rendered impulse (the reference included), one by one.
-        for (scene, coupling, delay, phase), row in trials.items():
+        for key, row in trials.items():
+            scene, coupling, delay, phase = key[:4]
             error = row["ledger_error"]
             if error is not None and not error <= LEDGER_TOLERANCE:
-                failures.append(f"{scene} {coupling} {ms_label(delay)} ms phase {phase}: the impulse applied differs "
-                                f"from the impulse rendered by {error:.3g} (relative)")
+                where = f"{scene} {coupling} {ms_label(delay)} ms" + (f" {loss_label(key[4])}" if len(key) > 4 else "")
+                failures.append(f"{where} phase {phase}: the impulse applied differs from the impulse rendered by "
+                                f"{error:.3g} (relative)")
         if failures:
             print("CHECK FAILED: " + "; ".join(failures))
             sys.exit(1)

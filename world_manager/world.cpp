@@ -159,7 +159,17 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
   // leaves that time alone, so the report after a silence covers the whole of it.
   const double covered_world_s = known_start ? time_s_ - endpoint.last_applied_world_time_s : period_s_;
   const bool new_report = known_start || endpoint.last_report_session != report.haptic_session;
-  if (new_report) endpoint.last_applied_world_time_s = time_s_;
+  // A report that lagged (the world read an older one than its step's: the newer ones lost or late on the link)
+  // covered less haptic time than the world time it was applied over, and the next one covers that much more, which
+  // the device could render: the limit below carries that lag over, up to one world period (a longer run of lost
+  // reports leaves the world a stale finger, which the staleness rules handle; and a carry cannot grow into an
+  // allowance for a stall's backlog). A stall is the opposite, more haptic time than world time, and carries nothing.
+  const double lag_carried_s = known_start ? std::min(endpoint.report_lag_s, period_s_) : 0.0;
+  if (new_report) {
+    endpoint.last_applied_world_time_s = time_s_;
+    endpoint.report_lag_s =
+        known_start ? std::clamp(lag_carried_s + covered_world_s - window.length_s, 0.0, period_s_) : 0.0;
+  }
   endpoint.last_report_session = report.haptic_session;
   endpoint.last_report_time_s = report.haptic_time_s;
   endpoint.last_report_tick = report.tick;
@@ -200,7 +210,8 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
   if (all_finite(report.static_impulse_Ns)) static_delta_Ns = ledger_.take_static(owner, report.static_impulse_Ns);
   reaction_Ns += static_delta_Ns;
   reaction_sum_Ns += static_delta_Ns.norm();
-  // What a device can have put in: its force limit over the world time the report covers, |Σ ΔJ| ≤ F_max·T, the
+  // What a device can have put in: its force limit over the world time the report covers (plus the lag carried
+  // over, above), |Σ ΔJ| ≤ F_max·T, the
   // reaction split among the contacts by at most kMaxReactionSplitRatio (Σ|ΔJ| ≤ √3·|reaction| for ≤ 3 constraints,
   // haptic_controller/impulse_accumulator.cpp). World time, not haptic time: after a stalled world the controller has
   // rendered against a plane that did not move for the whole stall, but the world simulates one step, and applying
@@ -208,7 +219,8 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
   // from every share alike, dropped and counted: the world receives less, never more.
   constexpr double kMaxReactionSplitRatio = 1.7320508075688772;
   constexpr double kRounding = 1.0 + 1e-9;  // sums of a tick's worth of rounding
-  const double limit_Ns = options_.report_force_limit_N * std::max(covered_world_s, period_s_) * kRounding;
+  const double limit_Ns =
+      options_.report_force_limit_N * std::max(covered_world_s + lag_carried_s, period_s_) * kRounding;
   double scale = 1.0;
   if (reaction_Ns.norm() > limit_Ns) scale = limit_Ns / reaction_Ns.norm();
   if (reaction_sum_Ns > kMaxReactionSplitRatio * limit_Ns) {

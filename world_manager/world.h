@@ -152,6 +152,7 @@ class World {
     double last_report_time_s = 0.0;
     std::uint64_t last_report_tick = 0;
     double last_applied_world_time_s = 0.0;  // the world time its previous report was applied at (same session)
+    double report_lag_s = 0.0;  // haptic time its reports so far covered less than the world time (take_report)
   };
 
   void take_finger(Endpoint& endpoint, const HapticReport& report);

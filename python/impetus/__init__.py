@@ -158,7 +158,8 @@ def _scene_argument(scene):
     return str(path), ""
 
 
-def _options(coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s):
+def _options(coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s,
+             link_loss, link_loss_burst):
     """The options every run takes, checked and converted (ValueError naming the argument)."""
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling: must be one of {', '.join(COUPLINGS)}, not {coupling!r}")
@@ -176,7 +177,8 @@ def _options(coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffn
         substeps = int(substeps)
     return (coupling, passivity, int(phase_ticks), _real("rate_hz", rate_hz, optional=True), substeps, engine,
             _real("stiffness_Npm", stiffness_Npm, optional=True), _real("damping_Nspm", damping_Nspm, optional=True),
-            _real("link_delay_s", link_delay_s))
+            _real("link_delay_s", link_delay_s), _real("link_loss", link_loss),
+            _real("link_loss_burst", link_loss_burst))
 
 
 def _waypoints(name, value):
@@ -194,8 +196,8 @@ def _is_path_like(value):
 
 
 def run_trial(scene, trajectory, coupling="impulse", *, passivity=False, users=(), rate_hz=None, phase_ticks=0,
-              substeps=None, engine=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, duration_s=60.0,
-              out_dir=None, logs=True):
+              substeps=None, engine=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0, link_loss=0.0,
+              link_loss_burst=1.0, duration_s=60.0, out_dir=None, logs=True):
     """Runs one trial and returns its Trial.
 
     scene          a scene file (str or path; shipped_scene("tap") for a shipped one), or a dict in the scene file's
@@ -223,6 +225,9 @@ def run_trial(scene, trajectory, coupling="impulse", *, passivity=False, users=(
     link_delay_s   a one-way delay of the world link, the same both ways, 0 to 1 s, rounded to the nearest whole
                    haptic tick: frames reach the haptic side and reports reach the world that much later (latency
                    experiments; the daemons have no delay line). summary["link"] records it.
+    link_loss, link_loss_burst   the fraction of frames and of reports the link loses (0 to 0.5) and the mean run of
+                   consecutive losses in packets (1 to 1000; 1: independent), from a seeded Gilbert-Elliott model, so
+                   a lossy trial is repeatable. summary["link"] counts lost_frames and lost_reports.
     duration_s     the longest trial; it ends earlier when the trajectory does (run.sh --duration, default 60)
     out_dir        a directory for world.csv, haptic.csv, device.csv and summary.json, created if missing; None: a
                    temporary one, removed before returning
@@ -242,8 +247,9 @@ def run_trial(scene, trajectory, coupling="impulse", *, passivity=False, users=(
         raise TypeError(f"out_dir: must be a path or None, not {type(out_dir).__name__}")
     if isinstance(users, (str, dict)) or not all(isinstance(user, (str, dict, pathlib.Path)) for user in users):
         raise ValueError(f"users: must be a list of trajectories or {{name: trajectory}} dicts, not {users!r}")
-    coupling, passivity, phase_ticks, rate_hz, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s = _options(
-        coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s)
+    (coupling, passivity, phase_ticks, rate_hz, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s,
+     link_loss, link_loss_burst) = _options(coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm,
+                                            damping_Nspm, link_delay_s, link_loss, link_loss_burst)
     duration_s = _real("duration_s", duration_s)
     # Specs and files go by name, as spidar_sim --finger NAME=PATH takes them; with an array among them every finger
     # goes as (name, spec, waypoints). One finger given as a spec or file keeps the single-trajectory form, so its
@@ -264,6 +270,7 @@ def run_trial(scene, trajectory, coupling="impulse", *, passivity=False, users=(
                                                 paths, followers, coupling, passivity, phase_ticks, rate_hz,
                                                 substeps,
                                                 engine, stiffness_Npm, damping_Nspm, float(link_delay_s),
+                                                float(link_loss), float(link_loss_burst),
                                                 float(duration_s),
                                                 str(directory) if (out_dir is not None or logs) else ""))
         # What run.sh adds to the daemons' config (impetus_py/summary.py): the trial's own arguments.
@@ -346,7 +353,8 @@ class Simulation:
     scene        a scene file or a dict in its schema (as run_trial takes it)
     start_m      where the one finger starts, at rest (x, y, z in metres); or fingers=
     fingers      several fingers: {name: start point} in endpoint order
-    coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s
+    coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm, damping_Nspm, link_delay_s,
+    link_loss, link_loss_burst
                  as run_trial
                  takes them
     out_dir      a directory for world.csv, haptic.csv, device.csv and (at close) summary.json; None: no logs
@@ -358,7 +366,7 @@ class Simulation:
 
     def __init__(self, scene, start_m=None, coupling="impulse", *, passivity=False, fingers=None, rate_hz=None,
                  phase_ticks=0, substeps=None, engine=None, stiffness_Npm=None, damping_Nspm=None, link_delay_s=0.0,
-                 out_dir=None):
+                 link_loss=0.0, link_loss_burst=1.0, out_dir=None):
         import numpy as np
         self._loop = None
         self.summary = None
@@ -376,7 +384,7 @@ class Simulation:
         if out_dir is not None and not isinstance(out_dir, (str, os.PathLike)):
             raise TypeError(f"out_dir: must be a path or None, not {type(out_dir).__name__}")
         options = _options(coupling, passivity, rate_hz, phase_ticks, substeps, engine, stiffness_Npm,
-                           damping_Nspm, link_delay_s)
+                           damping_Nspm, link_delay_s, link_loss, link_loss_burst)
         self.out_dir = pathlib.Path(out_dir) if out_dir is not None else None
         if self.out_dir is not None:
             self.out_dir.mkdir(parents=True, exist_ok=True)

@@ -36,7 +36,7 @@ def run_trial(scene: _Scene, trajectory: _Trajectory, coupling: str = ..., *, pa
               users: Sequence[_Trajectory] = ...,
               rate_hz: float | None = ..., phase_ticks: int = ..., substeps: int | None = ...,
               engine: str | None = ..., stiffness_Npm: float | None = ..., damping_Nspm: float | None = ...,
-              link_delay_s: float = ...,
+              link_delay_s: float = ..., link_loss: float = ..., link_loss_burst: float = ...,
               duration_s: float = ..., out_dir: _Path | None = ..., logs: bool = ...) -> Trial: ...
 
 class Step:
@@ -60,7 +60,8 @@ class Simulation:
     def __init__(self, scene: _Scene, start_m: _Point | None = ..., coupling: str = ..., *, passivity: bool = ...,
                  fingers: Mapping[str, _Point] | None = ..., rate_hz: float | None = ..., phase_ticks: int = ...,
                  substeps: int | None = ..., engine: str | None = ..., stiffness_Npm: float | None = ...,
-                 damping_Nspm: float | None = ..., link_delay_s: float = ..., out_dir: _Path | None = ...) -> None: ...
+                 damping_Nspm: float | None = ..., link_delay_s: float = ..., link_loss: float = ...,
+                 link_loss_burst: float = ..., out_dir: _Path | None = ...) -> None: ...
     @property
     def ticks(self) -> int: ...
     @property

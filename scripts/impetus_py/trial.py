@@ -68,13 +68,15 @@ def engine_choice():
 
 
 def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=None, substeps=None,
-              stiffness_Npm=None, damping_Nspm=None, link_delay_s=None, passivity=False):
+              stiffness_Npm=None, damping_Nspm=None, link_delay_s=None, passivity=False, link_loss=0.0,
+              link_loss_burst=1.0):
     """Runs one lockstep trial of `scene` (a path) driven by `trajectory` (a spidar_sim --trajectory spec or file, or
     a dict {finger name: spec or file} for a device of several fingers)
     into out_dir and returns its Summary. rate_hz, phase_ticks and substeps are world_manager's --rate, --phase and
     --substeps, stiffness_Npm and damping_Nspm haptic_controller's --stiffness and --damping (None: the scene's
     values, phase 0). link_delay_s is the world link's one-way delay (s, both ways; None or 0: none): only the
-    in-process link has a delay line, so a nonzero delay needs the impetus package. passivity is world_manager's
+    in-process link has a delay line, so a nonzero delay needs the impetus package, and so do link_loss and
+    link_loss_burst (the fraction of frames and reports lost, and the mean run of losses). passivity is world_manager's
     --passivity (False: the paper's couplings as they are). The engine is engine_choice().
     Raises RuntimeError naming the trial if it failed."""
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -85,12 +87,17 @@ def run_trial(out_dir, scene, trajectory, coupling, rate_hz=None, phase_ticks=No
             trial = module.run_trial(scene, trajectory, coupling, passivity=passivity, rate_hz=rate_hz,
                                      phase_ticks=phase_ticks or 0,
                                      substeps=substeps, engine=engine, stiffness_Npm=stiffness_Npm,
-                                     damping_Nspm=damping_Nspm, link_delay_s=link_delay_s or 0.0, out_dir=out_dir,
+                                     damping_Nspm=damping_Nspm, link_delay_s=link_delay_s or 0.0,
+                                     link_loss=link_loss, link_loss_burst=link_loss_burst, out_dir=out_dir,
                                      logs=False)
         except (ValueError, RuntimeError, OSError) as error:
             raise RuntimeError(f"trial failed ({scene}, {trajectory}, {coupling} coupling, rate {rate_hz}, "
-                               f"phase {phase_ticks}, link delay {link_delay_s or 0.0} s): {error}") from None
+                               f"phase {phase_ticks}, link delay {link_delay_s or 0.0} s, loss {link_loss}): "
+                               f"{error}") from None
         return Summary(trial.summary)
+    if link_loss:
+        raise RuntimeError(f"link loss ({link_loss}) needs the in-process link of the impetus package (build it, do "
+                           f"not set IMPETUS_TRIALS=processes)")
     if link_delay_s:
         raise RuntimeError(f"a link delay ({link_delay_s} s) needs the in-process link of the impetus package; the "
                            f"daemons' links have no delay line (build the package, do not set "

@@ -111,12 +111,25 @@ class Arguments(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "passivity"):
             impetus.run_trial(self.scene(), "tap", passivity="on")
 
+    def test_link_loss_reaches_the_link(self):
+        # Half the packets lost in runs of 20: the summary counts what was lost, the same in a second run.
+        lossy = impetus.run_trial(self.scene(), "tap", link_loss=0.5, link_loss_burst=20, logs=False)
+        again = impetus.run_trial(self.scene(), "tap", link_loss=0.5, link_loss_burst=20, logs=False)
+        self.assertGreater(lossy.summary["link"]["lost_frames"], 0)
+        self.assertGreater(lossy.summary["link"]["lost_reports"], 0)
+        self.assertEqual(lossy.summary["link"], again.summary["link"])
+        self.assertEqual(lossy.summary["objects"], again.summary["objects"])
+        for bad in ({"link_loss": 0.6}, {"link_loss": -0.1}, {"link_loss_burst": 0.5}):
+            with self.subTest(bad=bad), self.assertRaisesRegex(ValueError, next(iter(bad))):
+                impetus.run_trial(self.scene(), "tap", **bad)
+
     def test_link_delay_reaches_the_link(self):
         # 20 ms each way at 1 kHz is 20 ticks; the delay changes the trial (the cube starts later and stops elsewhere),
         # and the summary says what the link held back.
         base = impetus.run_trial(self.scene(), "tap", logs=False)
         delayed = impetus.run_trial(self.scene(), "tap", link_delay_s=0.02, logs=False)
-        self.assertEqual(base.summary["link"], {"delay_s": 0.0, "delay_ticks": 0, "dropped": 0})
+        self.assertEqual(base.summary["link"], {"delay_s": 0.0, "delay_ticks": 0, "dropped": 0, "loss": 0.0,
+                                                "loss_burst_packets": 1.0, "lost_frames": 0, "lost_reports": 0})
         self.assertEqual(delayed.summary["link"]["delay_ticks"], 20)
         self.assertEqual(delayed.summary["link"]["dropped"], 0)
         self.assertNotEqual(base.summary["objects"], delayed.summary["objects"])

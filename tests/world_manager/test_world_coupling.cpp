@@ -181,6 +181,31 @@ TEST_CASE("a report bringing more impulse than a device renders in the world tim
   CHECK(world->step_impulse_Ns(0).x() == Approx(0.5 * 1.7320508075688772 * 0.5).epsilon(1e-8));
 }
 
+TEST_CASE("a report that catches up on one that lagged (a lossy link) is applied whole, a stall's backlog is not") {
+  // Steps 50 ms apart. The world reads the report of tick 100, then (its tick-150 report lost) the one of tick 140,
+  // then the one of tick 200: that one covers 60 ms of rendering in a 50 ms step, and the device could have pushed
+  // 10 N all along, so 0.6 N·s goes in whole. The lag is used up: a report covering 80 ms in the next 50 ms step (a
+  // stall's backlog) is cut to the step's 0.5 N·s.
+  auto world = make_world(impetus::parse_scene(impetus::test::free_body_document(tilted_box()), "free.json"));
+  HapticReport report = make_report(7, 100);
+  add_entry(report, 0, 1, {0.1, 0.0, 0.0});
+  const auto step_with_total = [&](std::uint64_t tick, double total_Ns) {
+    report.tick = tick;
+    report.haptic_time_s = static_cast<double>(tick) * 1e-3;
+    report.entries[0].impulse_Ns = {total_Ns, 0.0, 0.0};
+    world->step(&report);
+  };
+  step_with_total(100, 0.1);
+  step_with_total(140, 0.5);  // 40 ms of rendering in a 50 ms step: 10 ms of lag carried
+  CHECK(world->step_impulse_Ns(0).x() == Approx(0.4));
+  step_with_total(200, 1.1);  // 60 ms: within 10 N over 50 ms + the 10 ms carried
+  CHECK(world->step_impulse_Ns(0).x() == Approx(0.6));
+  CHECK(world->clipped_reports() == 0);
+  step_with_total(280, 1.9);  // 80 ms in 50 ms, nothing carried
+  CHECK(world->step_impulse_Ns(0).x() == Approx(0.5).epsilon(1e-8));
+  CHECK(world->clipped_reports() == 1);
+}
+
 TEST_CASE("entries on static geometry or unknown ids move nothing") {
   json document = impetus::test::free_body_document(tilted_box());
   document["objects"].push_back(json{{"name", "wall"}, {"shape", "box"}, {"size_m", {0.1, 0.1, 0.1}},

@@ -21,8 +21,14 @@
 // attaches (frames: d/n + 3 for n ticks per world step; reports: d + 2); publishing and receiving never allocate, lock
 // or throw. A full line drops its oldest entry and counts it (dropped()); that happens only when a node stops taking
 // its frames. Not thread-safe: the lockstep run's one thread uses every end.
+//
+// Loss (link_loss.h): the link can also lose frames and reports, each direction of each slot by its own seeded
+// Gilbert–Elliott stream. A lost frame never reaches its node (it keeps the frame before); a lost report never reaches
+// the world (it reads the newest report that did arrive, whose running totals hold the lost one's impulse). Counted in
+// lost_frames() and lost_reports(). No loss is the link without a loss model, bit for bit.
 
 #include "common/link/inproc/delay_line.h"
+#include "common/link/inproc/link_loss.h"
 #include "common/link/world_link.h"
 
 #include <memory>
@@ -58,8 +64,8 @@ class FollowerStepper {
 class InProcessWorldLink final : public WorldLinkServer {
  public:
   // Throws std::invalid_argument if delay.ticks_per_world_step is 0.
-  explicit InProcessWorldLink(const WorldLinkInfo& info, InProcessLinkDelay delay = {})
-      : info_(info), delay_(delay), slots_(kMaxEndpoints) {
+  explicit InProcessWorldLink(const WorldLinkInfo& info, InProcessLinkDelay delay = {}, LinkLoss loss = {})
+      : info_(info), delay_(delay), loss_(loss), slots_(kMaxEndpoints) {
     if (delay.ticks_per_world_step == 0) {
       throw std::invalid_argument("in-process link: ticks_per_world_step must be 1 or more, not 0");
     }
@@ -91,6 +97,8 @@ class InProcessWorldLink final : public WorldLinkServer {
     for (std::uint32_t k = slots_used_; k < slots_used_ + endpoints; ++k) {
       slots_[k].frames.reset(delay_.delay_ticks, frame_capacity);
       slots_[k].reports.reset(delay_.delay_ticks, report_capacity);
+      slots_[k].frame_loss = LossProcess(loss_, 2 * k);
+      slots_[k].report_loss = LossProcess(loss_, 2 * k + 1);
     }
     clients_.push_back(std::make_unique<Client>(*this, slots_used_, endpoints, clients_.empty()));
     slots_used_ += endpoints;
@@ -109,7 +117,7 @@ class InProcessWorldLink final : public WorldLinkServer {
   }
   // Sent at the world's tick: the newest tick any report carries.
   void publish_frame(std::uint32_t slot, const PlaneFrame& frame) override {
-    if (slot >= slots_used_) return;
+    if (slot >= slots_used_ || slots_[slot].frame_loss.lose()) return;
     slots_[slot].frames.push(now_ticks_, frame);
   }
   void publish_stats(const LoopStats& stats) override { stats_ = stats; }
@@ -126,11 +134,24 @@ class InProcessWorldLink final : public WorldLinkServer {
     for (std::uint32_t k = 0; k < slots_used_; ++k) total += slots_[k].frames.dropped() + slots_[k].reports.dropped();
     return total;
   }
+  // Frames and reports the loss model lost over the run.
+  std::uint64_t lost_frames() const {
+    std::uint64_t total = 0;
+    for (std::uint32_t k = 0; k < slots_used_; ++k) total += slots_[k].frame_loss.lost();
+    return total;
+  }
+  std::uint64_t lost_reports() const {
+    std::uint64_t total = 0;
+    for (std::uint32_t k = 0; k < slots_used_; ++k) total += slots_[k].report_loss.lost();
+    return total;
+  }
 
  private:
   struct Slot {
     DelayLine<PlaneFrame> frames;        // world → haptic
     DelayLine<HapticReport> reports;     // haptic → world
+    LossProcess frame_loss;
+    LossProcess report_loss;
     std::uint64_t frame_taken = 0;       // sequence of the last frame its node took (0: none yet)
   };
 
@@ -154,8 +175,9 @@ class InProcessWorldLink final : public WorldLinkServer {
       if (report.endpoint >= endpoints_) return;
       if (report.tick > now_ticks_) now_ticks_ = report.tick;
       if (report.tick > link_.now_ticks_) link_.now_ticks_ = report.tick;
-      DelayLine<HapticReport>& reports = link_.slots_[first_slot_ + report.endpoint].reports;
-      reports.push(report.tick, report);
+      Slot& slot = link_.slots_[first_slot_ + report.endpoint];
+      DelayLine<HapticReport>& reports = slot.reports;
+      if (!slot.report_loss.lose()) reports.push(report.tick, report);
       // Reports the world can no longer need give way now, so the line holds only those in flight: the world, at a
       // tick ≥ this one, will want a report at least this new.
       reports.take_newest_due(link_.now_ticks_);
@@ -196,6 +218,7 @@ class InProcessWorldLink final : public WorldLinkServer {
 
   WorldLinkInfo info_;
   InProcessLinkDelay delay_;
+  LinkLoss loss_;
   WorldStepper* world_ = nullptr;
   std::vector<Slot> slots_;  // kMaxEndpoints; their lines are sized at attach
   std::uint32_t slots_used_ = 0;
