@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: Apache-2.0
-"""Latency tolerance of the couplings: the tap and the grasp with a one-way delay on the world link.
+"""Latency and loss tolerance of the couplings: the tap, the catch and the grasp over a delayed, lossy world link.
 
 Every trial runs in this process through the impetus package (in-process link with its delay line: frames and reports
 each arrive DELAY later, rounded to whole haptic ticks; common/link/inproc/inproc_world_link.h). The three daemons
@@ -15,6 +15,11 @@ have no delay line, so the package must be built (scripts/build.sh).
          scripts/phase_experiment.py computes it), and stability: the largest energy
          gain beyond the hand's work (impetus_py/energy.py), the largest finger force, and how many separate contacts
          the single stroke made (1 for a clean push; more when the cube is bounced back and forth).
+  loss   the tap again with the link losing packets (--losses, at --loss-delays-ms): frames and reports, each
+         direction its own seeded Gilbert-Elliott stream (common/link/inproc/link_loss.h).
+  catch  hard case 12a (a cube sliding into a still finger), every coupling with and without the layer: caught (never
+         through the finger), settled (under 0.1 mm of motion in the last 0.5 s), arrival and leaving speed, energy
+         gain.
   grasp  scenes/grasp.json, thumb and index (scenes/grasp_*.csv) lifting the cube, impulse and local coupling: lift at
          the start of the hold, slip during the hold, peak-to-peak of each finger's force during the hold, energy
          gain.
@@ -45,6 +50,11 @@ from impetus_py.trial import COUPLINGS, backend, run_trial  # noqa: E402
 
 TAP_SCENE = ROOT / "scenes/tap.json"
 GRASP_SCENE = ROOT / "scenes/grasp.json"
+# The catch: a cube slides down a ramp into a finger held still (hard case 12a).
+CATCH_SCENE = ROOT / "tests/hard_cases/c12a_slide_down_ramp.json"
+CATCH_TRAJECTORY = ROOT / "tests/hard_cases/c12a_slide_down_ramp.csv"
+CATCH_SETTLE_S = 0.5      # the issue's settling window: the cube's motion over the last half second...
+CATCH_SETTLE_M = 1e-4     # ...below 0.1 mm
 GRASP_FINGERS = {"thumb": str(ROOT / "scenes/grasp_thumb.csv"), "index": str(ROOT / "scenes/grasp_index.csv")}
 # The fingers hold the cube up over this window (scripts/grasp_figure.py): lift, slip and force ripple are read here.
 GRASP_HOLD_S = (2.5, 7.0)
@@ -102,6 +112,31 @@ def energy_gain(out_dir, summary, scene, devices, phase_ticks):
     balance = energy_balance(scene, summary.objects, devices, world, summary.device, summary.world_period_s,
                              haptic_period_s)
     return balance["excess_J"], balance["tolerance_J"]
+
+
+def catch_trial(out_dir, label, phase_ticks, delay_ms):
+    """One catch trial; returns its row of measurements: caught (hard_cases.check_arrival: never passed through, ends
+    on its own side), the speed it arrived at and left with along the approach, its motion in the last CATCH_SETTLE_S,
+    and the energy gain."""
+    import hard_cases  # scripts/: the arrival check is the hard case's own
+    coupling, layer = coupling_and_layer(label)
+    summary = run_trial(out_dir, CATCH_SCENE, str(CATCH_TRAJECTORY), coupling, None, phase_ticks,
+                        link_delay_s=delay_ms * 1e-3, passivity=layer)
+    trial = hard_cases.Trial(out_dir)
+    caught, _, _ = hard_cases.check_arrival(trial)
+    centre = trial.world.vectors("cube.", "_m")
+    u = trial.device.vectors("target_", "_m")[0] - np.asarray(trial.objects["cube"]["position_m"])
+    u /= np.linalg.norm(u)
+    speed = trial.world.vectors("cube.v", "_mps") @ u
+    t = trial.world["time_s"]
+    last = centre[t >= t[-1] - CATCH_SETTLE_S]
+    gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(CATCH_SCENE), [trial.device], phase_ticks)
+    return {"caught": bool(caught), "arrival_mps": float(np.max(speed)), "leaving_mps": float(max(0.0, -np.min(speed))),
+            "settle_m": float(np.max(np.linalg.norm(last - last[-1], axis=1))), "energy_gain_J": gain_J,
+            "energy_tolerance_J": tolerance_J, "max_force_N": float(force_magnitude_N(trial.haptic).max()),
+            "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
+            "ledger_error": ledger_error_Ns(summary, out_dir), "delay_ticks": summary.link["delay_ticks"],
+            "link_dropped": summary.link["dropped"]}
 
 
 def coupling_and_layer(label):
@@ -210,6 +245,12 @@ def main():
                              "%(default)s)")
     parser.add_argument("--loss-delays-ms", default="0,20,50",
                         help="delays the loss cells run at (default %(default)s)")
+    parser.add_argument("--catch-delays-ms", default=",".join(map(str, FULL_GRASP_DELAYS_MS)),
+                        help="catch cells (a cube sliding into a still finger, hard case 12a): delays (default "
+                             "%(default)s; empty: none)")
+    parser.add_argument("--catch-couplings", default="position,impulse,local,position+layer,impulse+layer",
+                        help="catch couplings, as --couplings (default %(default)s)")
+    parser.add_argument("--catch-phases", type=int, default=5, help="world-clock phases per catch cell (default 5)")
     parser.add_argument("--grasp-delays-ms", default=",".join(map(str, FULL_GRASP_DELAYS_MS)),
                         help="delays of the grasp, ms (default %(default)s; empty: no grasp)")
     parser.add_argument("--grasp-couplings", default="impulse,local",
@@ -228,6 +269,7 @@ def main():
     if args.quick:
         args.delays_ms, args.phases = "0,20", 2
         args.losses, args.loss_delays_ms = "20b5", "20"
+        args.catch_delays_ms, args.catch_couplings, args.catch_phases = "20", "local,impulse+layer", 1
         args.grasp_delays_ms, args.grasp_couplings, args.grasp_phases = "20", "local", 1
     if args.phases < 1 or args.grasp_phases < 1:
         sys.exit(f"latency_experiment: --phases and --grasp-phases must be 1 or more, not {args.phases} and "
@@ -239,9 +281,11 @@ def main():
     grasp_delays = parse_ms(args.grasp_delays_ms, "--grasp-delays-ms") if args.grasp_delays_ms.strip() else []
     losses = parse_losses(args.losses)
     loss_delays = parse_ms(args.loss_delays_ms, "--loss-delays-ms") if losses else []
+    catch_delays = parse_ms(args.catch_delays_ms, "--catch-delays-ms") if args.catch_delays_ms.strip() else []
+    catch_couplings = [c for c in args.catch_couplings.split(",") if c] if catch_delays else []
     couplings = [c for c in args.couplings.split(",") if c]
     grasp_couplings = [c for c in args.grasp_couplings.split(",") if c] if grasp_delays else []
-    for label in couplings + grasp_couplings:
+    for label in couplings + grasp_couplings + catch_couplings:
         coupling, _ = coupling_and_layer(label)
         if coupling not in COUPLINGS or label not in (coupling, coupling + "+layer"):
             sys.exit(f"latency_experiment: a coupling must be one of {', '.join(COUPLINGS)}, optionally with "
@@ -282,9 +326,16 @@ def main():
                 out_dir = args.out / "grasp" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
                 tasks.append((("grasp", coupling, delay, phase), grasp_trial, (out_dir, coupling, phase, delay)))
 
-    # A grasp runs 10 s of trajectory, a tap about 2 s; the reference steps its world 50 times as often.
+    catch_phases = sorted({round(k * ticks_per_step / args.catch_phases) for k in range(args.catch_phases)})
+    for coupling in catch_couplings:
+        for delay in catch_delays:
+            for phase in catch_phases:
+                out_dir = args.out / "catch" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
+                tasks.append((("catch", coupling, delay, phase), catch_trial, (out_dir, coupling, phase, delay)))
+
+    # A grasp runs 10 s of trajectory, a catch 4 s, a tap about 2 s; the reference steps its world 50 times as often.
     def weight(key):
-        return {"grasp": 5.0}.get(key[0], 1.0) * (3.0 if key[1] == "reference" else 1.0)
+        return {"grasp": 5.0, "catch": 2.0}.get(key[0], 1.0) * (3.0 if key[1] == "reference" else 1.0)
 
     trials = {}
     try:
@@ -337,6 +388,24 @@ def main():
                               "lost_reports_mean": sum(r["lost_reports"] for r in rows) / len(rows),
                               "ledger_error_max": max(ledger) if ledger else math.nan,
                               "link_dropped": sum(r["link_dropped"] for r in rows)})
+    for coupling in catch_couplings:
+        for delay in catch_delays:
+            rows = [trials[("catch", coupling, delay, p)] for p in catch_phases]
+            ledger = [r["ledger_error"] for r in rows if r["ledger_error"] is not None]
+            cells.append({"scene": "catch", "coupling": coupling, "delay_ms": delay,
+                          "delay_ticks": rows[0]["delay_ticks"], "trials": len(rows),
+                          "caught": sum(r["caught"] for r in rows),
+                          "settled": sum(r["settle_m"] < CATCH_SETTLE_M for r in rows),
+                          "arrival_mps": max(r["arrival_mps"] for r in rows),
+                          "leaving_mps": max(r["leaving_mps"] for r in rows),
+                          "settle_m": max(r["settle_m"] for r in rows),
+                          "energy_gain_max_J": max(r["energy_gain_J"] for r in rows),
+                          "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
+                          "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
+                          "max_force_N": max(r["max_force_N"] for r in rows),
+                          "layer_withheld_max_J": max(r["layer_withheld_J"] for r in rows),
+                          "ledger_error_max": max(ledger) if ledger else math.nan,
+                          "link_dropped": sum(r["link_dropped"] for r in rows)})
     for coupling in grasp_couplings:
         for delay in grasp_delays:
             rows = [trials[("grasp", coupling, delay, p)] for p in grasp_phases]
@@ -358,6 +427,7 @@ def main():
 
     args.out.mkdir(parents=True, exist_ok=True)
     fields = ["scene", "coupling", "delay_ms", "loss", "loss_burst", "lost_frames_mean", "lost_reports_mean",
+              "caught", "settled", "arrival_mps", "leaving_mps", "settle_m",
               "delay_ticks", "trials", "stop_x_mean_m", "phase_spread_m", "bias_m",
               "bias_pct_of_travel", "lift_mm", "lift_end_mm", "held", "slip_mm", "hold_force_p2p_N",
               "energy_gain_max_J",
@@ -369,7 +439,8 @@ def main():
         writer.writeheader()
         writer.writerows(cells)
     with open(args.out / "latency_trials.csv", "w", newline="") as f:
-        trial_fields = ["scene", "coupling", "delay_ms", "loss", "loss_burst", "phase_ticks", "delay_ticks", "stop_x_m", "lift_mm",
+        trial_fields = ["scene", "coupling", "delay_ms", "loss", "loss_burst", "phase_ticks", "delay_ticks", "caught",
+                        "arrival_mps", "leaving_mps", "settle_m", "stop_x_m", "lift_mm",
                         "lift_end_mm", "slip_mm", "hold_force_p2p_N", "energy_gain_J", "energy_tolerance_J",
                         "max_force_N", "layer_withheld_J",
                         "contacts", "ledger_error", "lost_frames", "lost_reports", "link_dropped"]
@@ -415,6 +486,23 @@ def main():
                          f"{1e3 * c['phase_spread_m']:.2f} | {c['bias_pct_of_travel']:+.1f} | "
                          f"{1e3 * c['energy_gain_max_J']:+.2f} | {c['energy_over_tolerance']}/{c['trials']} | "
                          f"{c['max_force_N']:.2f} |")
+    if catch_couplings:
+        lines += ["", f"Catch: a cube slides down a ramp into a finger held still (hard case 12a), {len(catch_phases)} "
+                  f"world-clock phases per cell, worst phase shown; caught: never through the finger and on its own "
+                  f"side at the end; settled: it moves less than {1e3 * CATCH_SETTLE_M:g} mm in the last "
+                  f"{CATCH_SETTLE_S:g} s", "",
+                  "| coupling | delay (ms) | caught | settled | arrived at (m/s) | left at (m/s) | motion in the last "
+                  f"{CATCH_SETTLE_S:g} s (mm) | energy gain (mJ) | phases over tolerance | max force (N) | layer "
+                  "withheld (mJ) |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for c in cells:
+            if c["scene"] != "catch":
+                continue
+            lines.append(f"| {c['coupling']} | {ms_label(c['delay_ms'])} | {c['caught']}/{c['trials']} | "
+                         f"{c['settled']}/{c['trials']} | {c['arrival_mps']:.2f} | {c['leaving_mps']:.2f} | "
+                         f"{1e3 * c['settle_m']:.2f} | {1e3 * c['energy_gain_max_J']:+.1f} | "
+                         f"{c['energy_over_tolerance']}/{c['trials']} | {c['max_force_N']:.2f} | "
+                         f"{1e3 * c['layer_withheld_max_J']:.1f} |")
     if grasp_couplings:
         lines += ["", f"Grasp and lift (thumb and index), {len(grasp_phases)} world-clock phases per cell, worst phase "
                   f"shown; hold window {GRASP_HOLD_S[0]:g}–{GRASP_HOLD_S[1]:g} s; held: the cube still at least half "
