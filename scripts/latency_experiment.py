@@ -348,82 +348,59 @@ def main():
     reference_x = trials[("tap", "reference", 0.0, 0)]["stop_x_m"]
     start_x = Scene(TAP_SCENE).start_position_m("cube")[0]
     travel = reference_x - start_x
+    def shared(scene, coupling, delay, rows):
+        """What every cell reports, over its phases' rows: the energy check, the force, the ledger, the link."""
+        ledger = [r["ledger_error"] for r in rows if r["ledger_error"] is not None]
+        return {"scene": scene, "coupling": coupling, "delay_ms": delay, "delay_ticks": rows[0]["delay_ticks"],
+                "trials": len(rows), "energy_gain_max_J": max(r["energy_gain_J"] for r in rows),
+                "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
+                "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
+                "max_force_N": max(r["max_force_N"] for r in rows),
+                "layer_withheld_max_J": max(r["layer_withheld_J"] for r in rows),
+                "ledger_error_max": max(ledger) if ledger else math.nan,
+                "link_dropped": sum(r["link_dropped"] for r in rows)}
+
+    def stops(rows):
+        """The tap's stop position over its phases: mean, spread and bias against the reference."""
+        x = [r["stop_x_m"] for r in rows]
+        mean = sum(x) / len(x)
+        return {"stop_x_mean_m": mean, "phase_spread_m": max(x) - min(x), "bias_m": mean - reference_x,
+                "bias_pct_of_travel": 100.0 * (mean - reference_x) / travel}
+
     cells = []
     for coupling in couplings:
         for delay in delays:
             rows = [trials[("tap", coupling, delay, p)] for p in phases]
-            stops = [r["stop_x_m"] for r in rows]
-            mean = sum(stops) / len(stops)
-            ledger = [r["ledger_error"] for r in rows if r["ledger_error"] is not None]
-            cells.append({"scene": "tap", "coupling": coupling, "delay_ms": delay,
-                          "delay_ticks": rows[0]["delay_ticks"], "trials": len(rows), "stop_x_mean_m": mean,
-                          "phase_spread_m": max(stops) - min(stops),
-                          "bias_m": mean - reference_x, "bias_pct_of_travel": 100.0 * (mean - reference_x) / travel,
-                          "energy_gain_max_J": max(r["energy_gain_J"] for r in rows),
-                          "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
-                          "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
-                          "max_force_N": max(r["max_force_N"] for r in rows),
-                          "layer_withheld_max_J": max(r["layer_withheld_J"] for r in rows),
+            cells.append({**shared("tap", coupling, delay, rows), **stops(rows),
                           "contacts_max": max(r["contacts"] for r in rows),
-                          "contacts_mean": sum(r["contacts"] for r in rows) / len(rows),
-                          "ledger_error_max": max(ledger) if ledger else math.nan,
-                          "link_dropped": sum(r["link_dropped"] for r in rows)})
+                          "contacts_mean": sum(r["contacts"] for r in rows) / len(rows)})
     for coupling in couplings:
         for loss in losses:
             for delay in loss_delays:
                 rows = [trials[("tap-loss", coupling, delay, p, loss)] for p in phases]
-                stops = [r["stop_x_m"] for r in rows]
-                mean = sum(stops) / len(stops)
-                ledger = [r["ledger_error"] for r in rows if r["ledger_error"] is not None]
-                cells.append({"scene": "tap-loss", "coupling": coupling, "delay_ms": delay, "loss": loss[0],
-                              "loss_burst": loss[1], "delay_ticks": rows[0]["delay_ticks"], "trials": len(rows),
-                              "stop_x_mean_m": mean, "phase_spread_m": max(stops) - min(stops),
-                              "bias_m": mean - reference_x,
-                              "bias_pct_of_travel": 100.0 * (mean - reference_x) / travel,
-                              "energy_gain_max_J": max(r["energy_gain_J"] for r in rows),
-                              "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
-                              "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
-                              "max_force_N": max(r["max_force_N"] for r in rows),
+                cells.append({**shared("tap-loss", coupling, delay, rows), **stops(rows), "loss": loss[0],
+                              "loss_burst": loss[1],
                               "lost_frames_mean": sum(r["lost_frames"] for r in rows) / len(rows),
-                              "lost_reports_mean": sum(r["lost_reports"] for r in rows) / len(rows),
-                              "ledger_error_max": max(ledger) if ledger else math.nan,
-                              "link_dropped": sum(r["link_dropped"] for r in rows)})
+                              "lost_reports_mean": sum(r["lost_reports"] for r in rows) / len(rows)})
     for coupling in catch_couplings:
         for delay in catch_delays:
             rows = [trials[("catch", coupling, delay, p)] for p in catch_phases]
-            ledger = [r["ledger_error"] for r in rows if r["ledger_error"] is not None]
-            cells.append({"scene": "catch", "coupling": coupling, "delay_ms": delay,
-                          "delay_ticks": rows[0]["delay_ticks"], "trials": len(rows),
+            cells.append({**shared("catch", coupling, delay, rows),
                           "caught": sum(r["caught"] for r in rows),
                           "settled": sum(r["settle_m"] < CATCH_SETTLE_M for r in rows),
                           "arrival_mps": max(r["arrival_mps"] for r in rows),
                           "leaving_mps": max(r["leaving_mps"] for r in rows),
-                          "settle_m": max(r["settle_m"] for r in rows),
-                          "energy_gain_max_J": max(r["energy_gain_J"] for r in rows),
-                          "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
-                          "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
-                          "max_force_N": max(r["max_force_N"] for r in rows),
-                          "layer_withheld_max_J": max(r["layer_withheld_J"] for r in rows),
-                          "ledger_error_max": max(ledger) if ledger else math.nan,
-                          "link_dropped": sum(r["link_dropped"] for r in rows)})
+                          "settle_m": max(r["settle_m"] for r in rows)})
     for coupling in grasp_couplings:
         for delay in grasp_delays:
             rows = [trials[("grasp", coupling, delay, p)] for p in grasp_phases]
-            ledger = [r["ledger_error"] for r in rows if r["ledger_error"] is not None]
             # Held: the cube is still at least half as high at the hold's end as at its start.
             held = sum(r["lift_end_mm"] >= 0.5 * r["lift_mm"] > 0 for r in rows)
-            cells.append({"scene": "grasp", "coupling": coupling, "delay_ms": delay,
-                          "delay_ticks": rows[0]["delay_ticks"], "trials": len(rows),
+            cells.append({**shared("grasp", coupling, delay, rows),
                           "lift_mm": min(r["lift_mm"] for r in rows),
                           "lift_end_mm": min(r["lift_end_mm"] for r in rows), "held": held,
                           "slip_mm": max(r["slip_mm"] for r in rows),
-                          "hold_force_p2p_N": max(r["hold_force_p2p_N"] for r in rows),
-                          "max_force_N": max(r["max_force_N"] for r in rows),
-                          "energy_gain_max_J": max(r["energy_gain_J"] for r in rows),
-                          "energy_tolerance_J": max(r["energy_tolerance_J"] for r in rows),
-                          "energy_over_tolerance": sum(r["energy_gain_J"] > r["energy_tolerance_J"] for r in rows),
-                          "ledger_error_max": max(ledger) if ledger else math.nan,
-                          "link_dropped": sum(r["link_dropped"] for r in rows)})
+                          "hold_force_p2p_N": max(r["hold_force_p2p_N"] for r in rows)})
 
     args.out.mkdir(parents=True, exist_ok=True)
     fields = ["scene", "coupling", "delay_ms", "loss", "loss_burst", "lost_frames_mean", "lost_reports_mean",
