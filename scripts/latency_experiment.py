@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: Apache-2.0
-"""Latency and loss tolerance of the couplings: the tap, the catch and the grasp over a delayed, lossy world link.
+"""Latency and loss tolerance of the couplings: tap, catch, stack and grasp over a delayed, lossy world link.
 
 Every trial runs in this process through the impetus package (in-process link with its delay line: frames and reports
 each arrive DELAY later, rounded to whole haptic ticks; common/link/inproc/inproc_world_link.h). The three daemons
@@ -17,6 +17,8 @@ have no delay line, so the package must be built (scripts/build.sh).
          the single stroke made (1 for a clean push; more when the cube is bounced back and forth).
   loss   the tap again with the link losing packets (--losses, at --loss-delays-ms): frames and reports, each
          direction its own seeded Gilbert-Elliott stream (common/link/inproc/link_loss.h).
+  stack  hard case 8 (five boxes of 1000:1 mass ratios pressed from above): held (every box within 1 mm of its rest
+         pose), energy gain.
   catch  hard case 12a (a cube sliding into a still finger), every coupling with and without the layer: caught (never
          through the finger), settled (under 0.1 mm of motion in the last 0.5 s), arrival and leaving speed, energy
          gain.
@@ -53,6 +55,11 @@ GRASP_SCENE = ROOT / "scenes/grasp.json"
 # The catch: a cube slides down a ramp into a finger held still (hard case 12a).
 CATCH_SCENE = ROOT / "tests/hard_cases/c12a_slide_down_ramp.json"
 CATCH_TRAJECTORY = ROOT / "tests/hard_cases/c12a_slide_down_ramp.csv"
+# The stack: five boxes of 1000:1 mass ratios pressed from above (hard case 8), the finger starting 4.5 cm above (the
+# device frame's top) so the first frames reach it before the press at every delay swept (a round trip of 0.3 s
+# plus a period at 150 ms; it reaches the top box after about 0.7 s).
+STACK_SCENE = ROOT / "tests/hard_cases/c08_stack_ratio.json"
+STACK_TRAJECTORY = "press:x=0,y=0,surface_z=0.2,depth=0.01,speed=0.1,hold=2,standoff=0.045"
 CATCH_SETTLE_S = 0.5      # the issue's settling window: the cube's motion over the last half second...
 CATCH_SETTLE_M = 1e-4     # ...below 0.1 mm
 GRASP_FINGERS = {"thumb": str(ROOT / "scenes/grasp_thumb.csv"), "index": str(ROOT / "scenes/grasp_index.csv")}
@@ -134,6 +141,26 @@ def catch_trial(out_dir, label, phase_ticks, delay_ms):
     return {"caught": bool(caught), "arrival_mps": float(np.max(speed)), "leaving_mps": float(max(0.0, -np.min(speed))),
             "settle_m": float(np.max(np.linalg.norm(last - last[-1], axis=1))), "energy_gain_J": gain_J,
             "energy_tolerance_J": tolerance_J, "max_force_N": float(force_magnitude_N(trial.haptic).max()),
+            "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
+            "ledger_error": ledger_error_Ns(summary, out_dir), "delay_ticks": summary.link["delay_ticks"],
+            "link_dropped": summary.link["dropped"]}
+
+
+def stack_trial(out_dir, label, phase_ticks, delay_ms):
+    """One stack trial; returns its row of measurements: the largest displacement of any box from its rest pose
+    (hard_cases.check_stack: held within 1 mm) and the energy gain."""
+    import hard_cases  # scripts/: the stack check is the hard case's own
+    coupling, layer = coupling_and_layer(label)
+    summary = run_trial(out_dir, STACK_SCENE, STACK_TRAJECTORY, coupling, None, phase_ticks,
+                        link_delay_s=delay_ms * 1e-3, passivity=layer)
+    trial = hard_cases.Trial(out_dir)
+    held, _, _ = hard_cases.check_stack(trial)
+    worst = max(float(np.max(np.linalg.norm(trial.world.vectors(f"{name}.", "_m") - np.asarray(obj["position_m"]),
+                                            axis=1)))
+                for name, obj in trial.objects.items())
+    gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(STACK_SCENE), [trial.device], phase_ticks)
+    return {"held": bool(held), "displacement_m": worst, "energy_gain_J": gain_J, "energy_tolerance_J": tolerance_J,
+            "max_force_N": float(force_magnitude_N(trial.haptic).max()),
             "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
             "ledger_error": ledger_error_Ns(summary, out_dir), "delay_ticks": summary.link["delay_ticks"],
             "link_dropped": summary.link["dropped"]}
@@ -251,6 +278,12 @@ def main():
     parser.add_argument("--catch-couplings", default="position,impulse,local,position+layer,impulse+layer",
                         help="catch couplings, as --couplings (default %(default)s)")
     parser.add_argument("--catch-phases", type=int, default=5, help="world-clock phases per catch cell (default 5)")
+    parser.add_argument("--stack-delays-ms", default=",".join(map(str, FULL_GRASP_DELAYS_MS)),
+                        help="stack cells (five boxes of 1000:1 mass ratios pressed from above, hard case 8): delays "
+                             "(default %(default)s; empty: none)")
+    parser.add_argument("--stack-couplings", default="position,impulse,local,position+layer,impulse+layer",
+                        help="stack couplings, as --couplings (default %(default)s)")
+    parser.add_argument("--stack-phases", type=int, default=3, help="world-clock phases per stack cell (default 3)")
     parser.add_argument("--grasp-delays-ms", default=",".join(map(str, FULL_GRASP_DELAYS_MS)),
                         help="delays of the grasp, ms (default %(default)s; empty: no grasp)")
     parser.add_argument("--grasp-couplings", default="impulse,local",
@@ -270,6 +303,7 @@ def main():
         args.delays_ms, args.phases = "0,20", 2
         args.losses, args.loss_delays_ms = "20b5", "20"
         args.catch_delays_ms, args.catch_couplings, args.catch_phases = "20", "local,impulse+layer", 1
+        args.stack_delays_ms, args.stack_couplings, args.stack_phases = "20", "local", 1
         args.grasp_delays_ms, args.grasp_couplings, args.grasp_phases = "20", "local", 1
     if args.phases < 1 or args.grasp_phases < 1:
         sys.exit(f"latency_experiment: --phases and --grasp-phases must be 1 or more, not {args.phases} and "
@@ -283,9 +317,11 @@ def main():
     loss_delays = parse_ms(args.loss_delays_ms, "--loss-delays-ms") if losses else []
     catch_delays = parse_ms(args.catch_delays_ms, "--catch-delays-ms") if args.catch_delays_ms.strip() else []
     catch_couplings = [c for c in args.catch_couplings.split(",") if c] if catch_delays else []
+    stack_delays = parse_ms(args.stack_delays_ms, "--stack-delays-ms") if args.stack_delays_ms.strip() else []
+    stack_couplings = [c for c in args.stack_couplings.split(",") if c] if stack_delays else []
     couplings = [c for c in args.couplings.split(",") if c]
     grasp_couplings = [c for c in args.grasp_couplings.split(",") if c] if grasp_delays else []
-    for label in couplings + grasp_couplings + catch_couplings:
+    for label in couplings + grasp_couplings + catch_couplings + stack_couplings:
         coupling, _ = coupling_and_layer(label)
         if coupling not in COUPLINGS or label not in (coupling, coupling + "+layer"):
             sys.exit(f"latency_experiment: a coupling must be one of {', '.join(COUPLINGS)}, optionally with "
@@ -333,9 +369,17 @@ def main():
                 out_dir = args.out / "catch" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
                 tasks.append((("catch", coupling, delay, phase), catch_trial, (out_dir, coupling, phase, delay)))
 
-    # A grasp runs 10 s of trajectory, a catch 4 s, a tap about 2 s; the reference steps its world 50 times as often.
+    stack_phases = sorted({round(k * ticks_per_step / args.stack_phases) for k in range(args.stack_phases)})
+    for coupling in stack_couplings:
+        for delay in stack_delays:
+            for phase in stack_phases:
+                out_dir = args.out / "stack" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
+                tasks.append((("stack", coupling, delay, phase), stack_trial, (out_dir, coupling, phase, delay)))
+
+    # A grasp runs 10 s of trajectory, a catch 4 s, a stack 3 s, a tap about 2 s; the reference steps its world 50
+    # times as often.
     def weight(key):
-        return {"grasp": 5.0, "catch": 2.0}.get(key[0], 1.0) * (3.0 if key[1] == "reference" else 1.0)
+        return {"grasp": 5.0, "catch": 2.0, "stack": 1.5}.get(key[0], 1.0) * (3.0 if key[1] == "reference" else 1.0)
 
     trials = {}
     try:
@@ -391,6 +435,11 @@ def main():
                           "arrival_mps": max(r["arrival_mps"] for r in rows),
                           "leaving_mps": max(r["leaving_mps"] for r in rows),
                           "settle_m": max(r["settle_m"] for r in rows)})
+    for coupling in stack_couplings:
+        for delay in stack_delays:
+            rows = [trials[("stack", coupling, delay, p)] for p in stack_phases]
+            cells.append({**shared("stack", coupling, delay, rows), "held": sum(r["held"] for r in rows),
+                          "displacement_m": max(r["displacement_m"] for r in rows)})
     for coupling in grasp_couplings:
         for delay in grasp_delays:
             rows = [trials[("grasp", coupling, delay, p)] for p in grasp_phases]
@@ -404,7 +453,7 @@ def main():
 
     args.out.mkdir(parents=True, exist_ok=True)
     fields = ["scene", "coupling", "delay_ms", "loss", "loss_burst", "lost_frames_mean", "lost_reports_mean",
-              "caught", "settled", "arrival_mps", "leaving_mps", "settle_m",
+              "caught", "settled", "arrival_mps", "leaving_mps", "settle_m", "displacement_m",
               "delay_ticks", "trials", "stop_x_mean_m", "phase_spread_m", "bias_m",
               "bias_pct_of_travel", "lift_mm", "lift_end_mm", "held", "slip_mm", "hold_force_p2p_N",
               "energy_gain_max_J",
@@ -417,7 +466,7 @@ def main():
         writer.writerows(cells)
     with open(args.out / "latency_trials.csv", "w", newline="") as f:
         trial_fields = ["scene", "coupling", "delay_ms", "loss", "loss_burst", "phase_ticks", "delay_ticks", "caught",
-                        "arrival_mps", "leaving_mps", "settle_m", "stop_x_m", "lift_mm",
+                        "arrival_mps", "leaving_mps", "settle_m", "held", "displacement_m", "stop_x_m", "lift_mm",
                         "lift_end_mm", "slip_mm", "hold_force_p2p_N", "energy_gain_J", "energy_tolerance_J",
                         "max_force_N", "layer_withheld_J",
                         "contacts", "ledger_error", "lost_frames", "lost_reports", "link_dropped"]
@@ -478,6 +527,20 @@ def main():
             lines.append(f"| {c['coupling']} | {ms_label(c['delay_ms'])} | {c['caught']}/{c['trials']} | "
                          f"{c['settled']}/{c['trials']} | {c['arrival_mps']:.2f} | {c['leaving_mps']:.2f} | "
                          f"{1e3 * c['settle_m']:.2f} | {1e3 * c['energy_gain_max_J']:+.1f} | "
+                         f"{c['energy_over_tolerance']}/{c['trials']} | {c['max_force_N']:.2f} | "
+                         f"{1e3 * c['layer_withheld_max_J']:.1f} |")
+    if stack_couplings:
+        lines += ["", f"Stack: five boxes of 1000:1 mass ratios pressed from above (hard case 8, `{STACK_TRAJECTORY}`), "
+                  f"{len(stack_phases)} world-clock phases per cell, worst phase shown; held: every box within 1 mm "
+                  f"of its rest pose", "",
+                  "| coupling | delay (ms) | held | largest box displacement (mm) | energy gain (mJ) | phases over "
+                  "tolerance | max force (N) | layer withheld (mJ) |",
+                  "|---|---|---|---|---|---|---|---|"]
+        for c in cells:
+            if c["scene"] != "stack":
+                continue
+            lines.append(f"| {c['coupling']} | {ms_label(c['delay_ms'])} | {c['held']}/{c['trials']} | "
+                         f"{1e3 * c['displacement_m']:.3f} | {1e3 * c['energy_gain_max_J']:+.1f} | "
                          f"{c['energy_over_tolerance']}/{c['trials']} | {c['max_force_N']:.2f} | "
                          f"{1e3 * c['layer_withheld_max_J']:.1f} |")
     if grasp_couplings:
