@@ -59,7 +59,7 @@ struct InProcessTrialOptions {
   // that many ticks late (common/link/inproc/inproc_world_link.h says exactly when); summary.json's "link" records
   // it. For latency experiments: the daemons' links (shared memory, DDS) have no delay line, so no flag mirrors it.
   double link_delay_s = 0.0;
-  // Loss on the world link, each direction alike (common/link/inproc/link_loss.h): the fraction of frames and of
+  // Loss on the world link, each direction alike (common/link/link_loss.h): the fraction of frames and of
   // reports lost, 0 to kMaxLinkLoss, and the mean run of consecutive losses in packets, 1 to kMaxLossBurst (1:
   // independent losses). Seeded, so a lossy trial is repeatable; summary.json's "link" counts what was lost.
   double link_loss = 0.0;

@@ -16,7 +16,7 @@ have no delay line, so the package must be built (scripts/build.sh).
          gain beyond the hand's work (impetus_py/energy.py), the largest finger force, and how many separate contacts
          the single stroke made (1 for a clean push; more when the cube is bounced back and forth).
   loss   the tap again with the link losing packets (--losses, at --loss-delays-ms): frames and reports, each
-         direction its own seeded Gilbert-Elliott stream (common/link/inproc/link_loss.h).
+         direction its own seeded Gilbert-Elliott stream (common/link/link_loss.h).
   stack  hard case 8 (five boxes of 1000:1 mass ratios pressed from above): held (every box within 1 mm of its rest
          pose), energy gain.
   catch  hard case 12a (a cube sliding into a still finger), every coupling with and without the layer: caught (never

@@ -3,6 +3,8 @@
 // Which transport carries the world link (docs/architecture.md §2), as the daemons' --link flags choose it: shared
 // memory on one host (the default; lockstep and real time), or DDS across hosts (real time; common/link/dds).
 
+#include "common/link/link_loss.h"
+
 #include <cstdint>
 #include <string>
 
@@ -19,7 +21,15 @@ struct DdsLinkOptions {
   // participant's credentials (dds_participant.h lists the files). Empty: an open link, which anyone on the network
   // segment can join.
   std::string security_dir;
+  // A delay and loss stage on what this process receives (common/link/delay_stage.h), for experiments where the
+  // kernel cannot delay the network (no netem): frames for a controller, reports for a world. Give both ends the
+  // same values for a symmetric link. Off by default (0 and no loss).
+  double delay_s = 0.0;
+  LinkLoss loss;
 };
+
+// The longest delay the stage holds: a second, as the in-process link's delay line.
+inline constexpr double kMaxDdsDelay_s = 1.0;
 
 // Highest domain id: the RTPS port mapping (7400 + 250·domain + offsets) stays below 65536 up to 232.
 inline constexpr std::uint32_t kMaxDdsDomainId = 232;

@@ -133,6 +133,17 @@ void add_link_flags(CLI::App& app, LinkOptions& link) {
                  "only its own topics, everything encrypted): this participant's folder made by "
                  "scripts/dds_security.sh")
       ->check(CLI::ExistingDirectory);
+  app.add_option_function<double>(
+         "--dds-delay-ms", [&link](double ms) { link.dds.delay_s = ms * 1e-3; },
+         "--link dds: hold what this process receives back by MS milliseconds (a network delay for experiments; give "
+         "both ends the same; 0)")
+      ->check(number_in(0.0, kMaxDdsDelay_s * 1e3));
+  app.add_option("--dds-loss", link.dds.loss.rate,
+                 "--link dds: lose this fraction of what this process receives, 0 to 0.5 (for experiments; 0)")
+      ->check(number_in(0.0, 0.5));
+  app.add_option("--dds-loss-burst", link.dds.loss.burst_packets,
+                 "--link dds: the mean run of lost packets, 1 to 1000 (1: independent losses)")
+      ->check(number_in(1.0, 1000.0));
 }
 
 void add_output_flag(CLI::App& app, const std::string& flag, std::string& path, const std::string& description) {

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// Loss on the in-process world link (common/link/inproc/link_loss.h): the Gilbert–Elliott streams lose the fraction
+// Loss on the in-process world link (common/link/link_loss.h): the Gilbert–Elliott streams lose the fraction
 // and the runs they are asked for, repeatably, and the impulse ledger stays exact through lost reports.
 
 #include "common/link/inproc/inproc_world_link.h"
-#include "common/link/inproc/link_loss.h"
+#include "common/link/link_loss.h"
 #include "loop/in_process_trial.h"
 #include "tests/integration/trial_support.h"
 

@@ -3,6 +3,7 @@
 
 #include "common/link/dds/dds_codec.h"
 #include "common/link/dds/dds_entities.h"
+#include "common/link/delay_stage.h"
 #include "common/link/shm/seqlock.h"
 #include "common/runtime/message_text.h"
 #include "common/runtime/process.h"
@@ -11,8 +12,10 @@
 
 #include <array>
 #include <atomic>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <set>
@@ -42,6 +45,21 @@ constexpr std::uint32_t kTakeBatch = 16;
 
 using Key = std::pair<std::uint64_t, std::uint32_t>;  // (client id, client endpoint)
 
+std::int64_t steady_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// Room in a delay stage for what arrives in `delay_ns` at `rate_hz` at most, and a few more.
+std::size_t stage_capacity(std::int64_t delay_ns, double rate_hz) {
+  return static_cast<std::size_t>(static_cast<double>(delay_ns) * 1e-9 * rate_hz) + 8;
+}
+// Reports: one per servo tick at most (2 kHz covers the default 1 kHz servo twice over); a faster servo's in-flight
+// reports beyond that are dropped oldest first, which only means the world skips one (running totals).
+constexpr double kStagedReportRate_Hz = 2000.0;
+// Frames: one per world step; 100 Hz worlds and slower keep every frame in flight.
+constexpr double kStagedFrameRate_Hz = 100.0;
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -57,7 +75,12 @@ struct DdsWorldLinkServer::State {
   };
 
   State(const DdsLinkOptions& options, const WorldLinkInfo& link_info)
-      : participant(options), info(link_info), world_id(new_session_id()) {
+      : participant(options),
+        info(link_info),
+        world_id(new_session_id()),
+        delay_ns(static_cast<std::int64_t>(options.delay_s * 1e9)),
+        loss(options.loss),
+        staged(options.delay_s > 0.0 || options.loss.rate > 0.0) {
     const dds_entity_t publisher = make_publisher(participant.handle(), options.partition);
     const dds_entity_t subscriber = make_subscriber(participant.handle(), options.partition);
     frame_writer = make_writer(publisher, make_topic(participant.handle(), &impetus_dds_PlaneFrame_desc, kFrameTopic),
@@ -99,6 +122,7 @@ struct DdsWorldLinkServer::State {
     for (std::uint32_t k = 0; k < kMaxEndpoints; ++k) {
       if (slots[k].key.first == 0) {
         slots[k] = Slot{key, HapticReport{}, false, LoopStats{}, false};
+        if (staged) stages[k].reset(delay_ns, stage_capacity(delay_ns, kStagedReportRate_Hz), loss, 2 * k + 1);
         std::fprintf(stderr, "world_manager: endpoint slot %u serves controller %016llx, its endpoint %u\n", k,
                      static_cast<unsigned long long>(key.first), key.second);
         publish_info();
@@ -113,11 +137,12 @@ struct DdsWorldLinkServer::State {
     return -1;
   }
 
-  // Takes every report that arrived since the last call into the slots.
+  // Takes every report that arrived since the last call into the slots (through the delay stage, if there is one).
   void drain() {
+    const std::int64_t now_ns = steady_now_ns();
     for (;;) {
       const dds_return_t taken = dds_take(report_reader, buffers.data(), infos.data(), kTakeBatch, kTakeBatch);
-      if (taken <= 0) return;
+      if (taken <= 0) break;
       for (dds_return_t n = 0; n < taken; ++n) {
         const impetus_dds_HapticReport& sample = *samples[n];
         const Key key{sample.client_id, sample.client_endpoint};
@@ -144,8 +169,12 @@ struct DdsWorldLinkServer::State {
             if (slot < 0) slot = take_slot(key);
             // A report of session 0 only asks for a slot: the controller's servo has not rendered anything yet.
             if (slot >= 0 && report.haptic_session != 0) {
-              slots[slot].latest = report;
-              slots[slot].have = true;
+              if (staged) {
+                stages[static_cast<std::size_t>(slot)].push(now_ns, report);
+              } else {
+                slots[slot].latest = report;
+                slots[slot].have = true;
+              }
             }
           }
         }
@@ -158,6 +187,14 @@ struct DdsWorldLinkServer::State {
           ++released;
           publish_info();
         }
+      }
+    }
+    if (!staged) return;
+    for (std::uint32_t k = 0; k < kMaxEndpoints; ++k) {
+      if (!stages[k].active()) continue;
+      if (const HapticReport* due = stages[k].take_due(now_ns)) {
+        slots[k].latest = *due;
+        slots[k].have = true;
       }
     }
   }
@@ -181,6 +218,11 @@ struct DdsWorldLinkServer::State {
   DdsParticipant participant;
   WorldLinkInfo info;
   std::uint64_t world_id;
+  // The delay and loss stage on the reports (DdsLinkOptions::delay_s, loss), one per slot, sized when a slot is taken.
+  std::int64_t delay_ns;
+  LinkLoss loss;
+  bool staged;
+  std::array<DelayStage<HapticReport>, kMaxEndpoints> stages;
   dds_entity_t frame_writer = 0;
   dds_entity_t report_reader = 0;
   dds_entity_t info_writer = 0;
@@ -246,7 +288,14 @@ std::string DdsWorldLinkServer::name() const { return describe(state_->participa
 
 struct DdsWorldLinkClient::State {
   State(const DdsLinkOptions& options, std::uint32_t endpoint_count)
-      : participant(options), endpoints(endpoint_count), client_id(new_session_id()) {
+      : participant(options),
+        endpoints(endpoint_count),
+        client_id(new_session_id()),
+        staged(options.delay_s > 0.0 || options.loss.rate > 0.0) {
+    const auto delay_ns = static_cast<std::int64_t>(options.delay_s * 1e9);
+    for (std::uint32_t k = 0; staged && k < endpoints; ++k) {
+      stages[k].reset(delay_ns, stage_capacity(delay_ns, kStagedFrameRate_Hz), options.loss, 2 * k);
+    }
     const dds_entity_t publisher = make_publisher(participant.handle(), options.partition);
     const dds_entity_t subscriber = make_subscriber(participant.handle(), options.partition);
     frame_reader = make_reader(
@@ -285,9 +334,26 @@ struct DdsWorldLinkClient::State {
   // Receiver thread: frames for this client into the endpoints' channels, and the world's info.
   void receive() {
     while (!stop.load()) {
-      dds_waitset_wait(waitset, nullptr, 0, kReceiveWait);
+      dds_duration_t wait = kReceiveWait;
+      if (staged) {  // wake for the next frame the delay stage releases
+        std::int64_t next_ns = std::numeric_limits<std::int64_t>::max();
+        for (std::uint32_t k = 0; k < endpoints; ++k) next_ns = std::min(next_ns, stages[k].next_due_ns());
+        if (next_ns != std::numeric_limits<std::int64_t>::max()) {
+          wait = std::clamp<dds_duration_t>(next_ns - steady_now_ns(), 0, kReceiveWait);
+        }
+      }
+      dds_waitset_wait(waitset, nullptr, 0, wait);
       take_frames();
       take_info();
+      if (staged) release_frames();
+    }
+  }
+
+  // Frames the delay stage holds that are due now go to the endpoints' channels.
+  void release_frames() {
+    const std::int64_t now_ns = steady_now_ns();
+    for (std::uint32_t k = 0; k < endpoints; ++k) {
+      if (const wire::PlaneFrame* due = stages[k].take_due(now_ns)) frames[k].write(*due, used_bytes(*due));
     }
   }
 
@@ -311,7 +377,11 @@ struct DdsWorldLinkClient::State {
           malformed_frames.fetch_add(1);
           continue;
         }
-        frames[sample.client_endpoint].write(received_wire, used_bytes(received_wire));
+        if (staged) {
+          stages[sample.client_endpoint].push(steady_now_ns(), received_wire);
+        } else {
+          frames[sample.client_endpoint].write(received_wire, used_bytes(received_wire));
+        }
       }
     }
   }
@@ -420,6 +490,9 @@ struct DdsWorldLinkClient::State {
   // World → servo and servo → world, one channel per endpoint (~30 KB and ~8 KB each: on the heap with the state).
   std::array<SeqlockChannel<wire::PlaneFrame>, kMaxEndpoints> frames;
   std::array<SeqlockChannel<wire::HapticReport>, kMaxEndpoints> reports;
+  // The delay and loss stage on the frames (DdsLinkOptions::delay_s, loss), one per endpoint; the receiver's alone.
+  bool staged;
+  std::array<DelayStage<wire::PlaneFrame>, kMaxEndpoints> stages;
   SeqlockChannel<LoopStats> stats;  // the controller's loop statistics, now and then
 
   // Servo thread.

@@ -22,13 +22,13 @@
 // or throw. A full line drops its oldest entry and counts it (dropped()); that happens only when a node stops taking
 // its frames. Not thread-safe: the lockstep run's one thread uses every end.
 //
-// Loss (link_loss.h): the link can also lose frames and reports, each direction of each slot by its own seeded
+// Loss (common/link/link_loss.h): the link can also lose frames and reports, each direction of each slot by its own seeded
 // Gilbert–Elliott stream. A lost frame never reaches its node (it keeps the frame before); a lost report never reaches
 // the world (it reads the newest report that did arrive, whose running totals hold the lost one's impulse). Counted in
 // lost_frames() and lost_reports(). No loss is the link without a loss model, bit for bit.
 
 #include "common/link/inproc/delay_line.h"
-#include "common/link/inproc/link_loss.h"
+#include "common/link/link_loss.h"
 #include "common/link/world_link.h"
 
 #include <memory>

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Packet loss for the in-process world link (inproc_world_link.h): which frames and reports never arrive, drawn from a
-// seeded generator so a lossy lockstep trial is bitwise repeatable.
+// Packet loss on a world link (the in-process one, inproc/inproc_world_link.h; the DDS one's delay stage,
+// delay_stage.h): which frames and reports never arrive, drawn from a seeded generator so a lossy lockstep trial is
+// bitwise repeatable.
 //
 // Gilbert–Elliott two-state model, the usual one for bursty network loss: in the good state nothing is lost, in the bad
 // state everything is. The chain leaves the bad state with probability 1/B per packet (B: the mean burst length, in
