@@ -33,7 +33,7 @@ TEST_CASE("a delay stage hands the newest value over once it is due, never befor
   CHECK(stage.lost() == 0);
 }
 
-TEST_CASE("a full delay stage drops its oldest value and counts it; a lossy one loses what its stream says") {
+TEST_CASE("a full delay stage drops its oldest value and counts it, and a lossy one loses what its stream says") {
   DelayStage<int> full;
   full.reset(1'000, 2, LinkLoss{}, 0);
   full.push(0, 1);
