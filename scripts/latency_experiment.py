@@ -10,7 +10,8 @@ have no delay line, so the package must be built (scripts/build.sh).
          a round trip after the start, and a finger that strikes before would meet a cube nobody told it about),
          world 20 Hz, PHASES world-clock phases per (coupling, delay) for position, impulse and local coupling, and
          position and impulse coupling with the world's passivity layer (COUPLING+layer, world_manager --passivity
-         on; the energy it withheld from pushes or damped out of bodies is the "layer withheld" column): the
+         on; the energy it withheld from pushes, as predicted, plus what it damped out of bodies is the "layer
+         withheld + damped" column): the
          cube's stop position (mean, phase spread, bias against the zero-delay single-rate 1 kHz reference as
          scripts/phase_experiment.py computes it), and stability: the largest energy
          gain beyond the hand's work (impetus_py/energy.py), the largest finger force, and how many separate contacts
@@ -483,7 +484,7 @@ def main():
              f"{reference_x:.4f} m, travel {travel:.4f} m)", "",
              "| coupling | delay (ms) | stop x mean (m) | phase spread (mm) | bias vs reference (mm) | "
              "bias (% of travel) | energy gain, worst phase (mJ) | phases over tolerance | max force (N) | "
-             "layer withheld, worst phase (mJ) | contacts per stroke (mean, max) |",
+             "layer withheld + damped, worst phase (mJ) | contacts per stroke (mean, max) |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     ref = trials[("tap", "reference", 0.0, 0)]
     lines.append(f"| reference (1 kHz world) | 0 | {reference_x:.4f} | – | – | – | {1e3 * ref['energy_gain_J']:+.2f} | "
@@ -519,7 +520,7 @@ def main():
                   f"{CATCH_SETTLE_S:g} s", "",
                   "| coupling | delay (ms) | caught | settled | arrived at (m/s) | left at (m/s) | motion in the last "
                   f"{CATCH_SETTLE_S:g} s (mm) | energy gain (mJ) | phases over tolerance | max force (N) | layer "
-                  "withheld (mJ) |",
+                  "withheld + damped (mJ) |",
                   "|---|---|---|---|---|---|---|---|---|---|---|"]
         for c in cells:
             if c["scene"] != "catch":
@@ -534,7 +535,7 @@ def main():
                   f"{len(stack_phases)} world-clock phases per cell, worst phase shown; held: every box within 1 mm "
                   f"of its rest pose", "",
                   "| coupling | delay (ms) | held | largest box displacement (mm) | energy gain (mJ) | phases over "
-                  "tolerance | max force (N) | layer withheld (mJ) |",
+                  "tolerance | max force (N) | layer withheld + damped (mJ) |",
                   "|---|---|---|---|---|---|---|---|"]
         for c in cells:
             if c["scene"] != "stack":
