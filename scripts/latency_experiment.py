@@ -122,15 +122,27 @@ def energy_gain(out_dir, summary, scene, devices, phase_ticks):
     return balance["excess_J"], balance["tolerance_J"]
 
 
+def hard_case_trial(out_dir, scene, trajectory, label, phase_ticks, delay_ms):
+    """One trial of a hard case's scene: (its hard_cases.Trial, the measurements every cell shares)."""
+    import hard_cases  # scripts/: the cases' own checks
+    coupling, layer = coupling_and_layer(label)
+    summary = run_trial(out_dir, scene, trajectory, coupling, None, phase_ticks, link_delay_s=delay_ms * 1e-3,
+                        passivity=layer)
+    trial = hard_cases.Trial(out_dir)
+    gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(scene), [trial.device], phase_ticks)
+    return trial, {"energy_gain_J": gain_J, "energy_tolerance_J": tolerance_J,
+                   "max_force_N": float(force_magnitude_N(trial.haptic).max()),
+                   "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
+                   "ledger_error": ledger_error_Ns(summary, out_dir), "delay_ticks": summary.link["delay_ticks"],
+                   "link_dropped": summary.link["dropped"]}
+
+
 def catch_trial(out_dir, label, phase_ticks, delay_ms):
     """One catch trial; returns its row of measurements: caught (hard_cases.check_arrival: never passed through, ends
     on its own side), the speed it arrived at and left with along the approach, its motion in the last CATCH_SETTLE_S,
     and the energy gain."""
-    import hard_cases  # scripts/: the arrival check is the hard case's own
-    coupling, layer = coupling_and_layer(label)
-    summary = run_trial(out_dir, CATCH_SCENE, str(CATCH_TRAJECTORY), coupling, None, phase_ticks,
-                        link_delay_s=delay_ms * 1e-3, passivity=layer)
-    trial = hard_cases.Trial(out_dir)
+    import hard_cases
+    trial, row = hard_case_trial(out_dir, CATCH_SCENE, str(CATCH_TRAJECTORY), label, phase_ticks, delay_ms)
     caught, _, _ = hard_cases.check_arrival(trial)
     centre = trial.world.vectors("cube.", "_m")
     u = trial.device.vectors("target_", "_m")[0] - np.asarray(trial.objects["cube"]["position_m"])
@@ -138,33 +150,21 @@ def catch_trial(out_dir, label, phase_ticks, delay_ms):
     speed = trial.world.vectors("cube.v", "_mps") @ u
     t = trial.world["time_s"]
     last = centre[t >= t[-1] - CATCH_SETTLE_S]
-    gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(CATCH_SCENE), [trial.device], phase_ticks)
-    return {"caught": bool(caught), "arrival_mps": float(np.max(speed)), "leaving_mps": float(max(0.0, -np.min(speed))),
-            "settle_m": float(np.max(np.linalg.norm(last - last[-1], axis=1))), "energy_gain_J": gain_J,
-            "energy_tolerance_J": tolerance_J, "max_force_N": float(force_magnitude_N(trial.haptic).max()),
-            "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
-            "ledger_error": ledger_error_Ns(summary, out_dir), "delay_ticks": summary.link["delay_ticks"],
-            "link_dropped": summary.link["dropped"]}
+    return {**row, "caught": bool(caught), "arrival_mps": float(np.max(speed)),
+            "leaving_mps": float(max(0.0, -np.min(speed))),
+            "settle_m": float(np.max(np.linalg.norm(last - last[-1], axis=1)))}
 
 
 def stack_trial(out_dir, label, phase_ticks, delay_ms):
     """One stack trial; returns its row of measurements: the largest displacement of any box from its rest pose
     (hard_cases.check_stack: held within 1 mm) and the energy gain."""
-    import hard_cases  # scripts/: the stack check is the hard case's own
-    coupling, layer = coupling_and_layer(label)
-    summary = run_trial(out_dir, STACK_SCENE, STACK_TRAJECTORY, coupling, None, phase_ticks,
-                        link_delay_s=delay_ms * 1e-3, passivity=layer)
-    trial = hard_cases.Trial(out_dir)
+    import hard_cases
+    trial, row = hard_case_trial(out_dir, STACK_SCENE, STACK_TRAJECTORY, label, phase_ticks, delay_ms)
     held, _, _ = hard_cases.check_stack(trial)
     worst = max(float(np.max(np.linalg.norm(trial.world.vectors(f"{name}.", "_m") - np.asarray(obj["position_m"]),
                                             axis=1)))
                 for name, obj in trial.objects.items())
-    gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(STACK_SCENE), [trial.device], phase_ticks)
-    return {"held": bool(held), "displacement_m": worst, "energy_gain_J": gain_J, "energy_tolerance_J": tolerance_J,
-            "max_force_N": float(force_magnitude_N(trial.haptic).max()),
-            "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
-            "ledger_error": ledger_error_Ns(summary, out_dir), "delay_ticks": summary.link["delay_ticks"],
-            "link_dropped": summary.link["dropped"]}
+    return {**row, "held": bool(held), "displacement_m": worst}
 
 
 def coupling_and_layer(label):
@@ -306,9 +306,10 @@ def main():
         args.catch_delays_ms, args.catch_couplings, args.catch_phases = "20", "local,impulse+layer", 1
         args.stack_delays_ms, args.stack_couplings, args.stack_phases = "20", "local", 1
         args.grasp_delays_ms, args.grasp_couplings, args.grasp_phases = "20", "local", 1
-    if args.phases < 1 or args.grasp_phases < 1:
-        sys.exit(f"latency_experiment: --phases and --grasp-phases must be 1 or more, not {args.phases} and "
-                 f"{args.grasp_phases}")
+    for flag, count in (("--phases", args.phases), ("--grasp-phases", args.grasp_phases),
+                        ("--catch-phases", args.catch_phases), ("--stack-phases", args.stack_phases)):
+        if count < 1:
+            sys.exit(f"latency_experiment: {flag} must be 1 or more, not {count}")
     if backend() != "module":
         sys.exit("latency_experiment: the delay line lives in the in-process link; build the impetus package "
                  "(scripts/build.sh) and do not set IMPETUS_TRIALS=processes")
@@ -356,26 +357,19 @@ def main():
     # The reference: impulse coupling with the world at the haptic rate and no delay (one phase: its period is a tick).
     tasks.append((("tap", "reference", 0.0, 0), tap_trial,
                   (args.out / "tap" / "reference", tap, "impulse", float(HAPTIC_RATE_HZ), 0, 0.0)))
-    grasp_phases = sorted({round(k * ticks_per_step / args.grasp_phases) for k in range(args.grasp_phases)})
-    for coupling in grasp_couplings:
-        for delay in grasp_delays:
-            for phase in grasp_phases:
-                out_dir = args.out / "grasp" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
-                tasks.append((("grasp", coupling, delay, phase), grasp_trial, (out_dir, coupling, phase, delay)))
+    def scene_tasks(scene, trial, scene_couplings, scene_delays, phase_count):
+        """Tasks for every (coupling, delay, phase) of a scene; returns its phases."""
+        scene_phases = sorted({round(k * ticks_per_step / phase_count) for k in range(phase_count)})
+        for coupling in scene_couplings:
+            for delay in scene_delays:
+                for phase in scene_phases:
+                    out_dir = args.out / scene / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
+                    tasks.append(((scene, coupling, delay, phase), trial, (out_dir, coupling, phase, delay)))
+        return scene_phases
 
-    catch_phases = sorted({round(k * ticks_per_step / args.catch_phases) for k in range(args.catch_phases)})
-    for coupling in catch_couplings:
-        for delay in catch_delays:
-            for phase in catch_phases:
-                out_dir = args.out / "catch" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
-                tasks.append((("catch", coupling, delay, phase), catch_trial, (out_dir, coupling, phase, delay)))
-
-    stack_phases = sorted({round(k * ticks_per_step / args.stack_phases) for k in range(args.stack_phases)})
-    for coupling in stack_couplings:
-        for delay in stack_delays:
-            for phase in stack_phases:
-                out_dir = args.out / "stack" / f"{coupling}-delay{ms_label(delay)}ms-phase{phase:03d}"
-                tasks.append((("stack", coupling, delay, phase), stack_trial, (out_dir, coupling, phase, delay)))
+    grasp_phases = scene_tasks("grasp", grasp_trial, grasp_couplings, grasp_delays, args.grasp_phases)
+    catch_phases = scene_tasks("catch", catch_trial, catch_couplings, catch_delays, args.catch_phases)
+    stack_phases = scene_tasks("stack", stack_trial, stack_couplings, stack_delays, args.stack_phases)
 
     # A grasp runs 10 s of trajectory, a catch 4 s, a stack 3 s, a tap about 2 s; the reference steps its world 50
     # times as often.
