@@ -356,6 +356,7 @@ nlohmann::json HapticNode::summary() const {
       {"cpu_per_tick_mean_ns", tick_cpu_ns_.mean_ns()},
       {"cpu_per_tick_samples", tick_cpu_ns_.count()},  // every 64th tick
       {"endpoints", all}});
+  if (nlohmann::json details = device_.details(); !details.is_null()) haptic["device"] = std::move(details);
   return {{"haptic", haptic}};
 }
 

@@ -39,4 +39,6 @@ cp out/figures/latency/latency.md docs/latency_table.md
 # takes the picture).
 bash scripts/deps.sh --browser
 node tests/viewer/viewer_test.mjs --build build --case replay --picture docs/viewer_tap.png
+# The page as an input device: a pointer pushing the cube through the web hand (the touch test's drag case).
+node tests/viewer/touch_test.mjs --build build --case drag --picture docs/touch_page.png
 echo "figures written to docs/ (speed vs error: scripts/speed_vs_error.py --docs; hard cases: scripts/hard_cases.py)"

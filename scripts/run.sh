@@ -3,8 +3,8 @@
 # Runs one trial: world_manager + haptic_controller + spidar_sim (docs/architecture.md §4), collects their logs under
 # DIR, prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
 #
-#   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ...) [--user SPEC ...]
-#                  [--coupling impulse|position|local] [--passivity on|off]
+#   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ... | --device web[:FILE.json])
+#                  [--user SPEC ...] [--coupling impulse|position|local] [--passivity on|off]
 #                  [--rate HZ] [--phase TICKS] [--substeps N] [--engine ode|bullet]
 #                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet] [--no-logs]
 #                  [--view [--view-listen HOST:PORT] [--view-wait S]]
@@ -18,6 +18,10 @@
 # --view-wait S the finger starts S seconds after the world, time to open the page. Afterwards
 # `build/viewer/viewer --replay DIR` plays the trial back.
 #
+# --device web: a person steers the finger from the viewer's page instead of a trajectory (a simulated hand in the
+# haptic controller, no spidar_sim): real time, the viewer on, and the trial runs until Ctrl-C (or --duration). It
+# prints the address to open; FILE.json sets the hand (docs/touch.md).
+#
 # --no-logs writes only the summaries (no CSV logs: for throughput, or sweeps that read summary.json alone).
 #
 # Binaries come from $IMPETUS_BUILD_DIR (default build/); build them with scripts/build.sh.
@@ -25,11 +29,12 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${IMPETUS_BUILD_DIR:-$root/build}"
 
-usage() { sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "run.sh: $*" >&2; exit 2; }
 
 view=0 view_listen="127.0.0.1:8080" view_wait=0 logs=1
-substeps="" engine="" passivity="" scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="lockstep" duration="60" out="" quiet=0
+substeps="" engine="" passivity="" scene="" trajectory="" coupling="impulse" rate="" phase="0" clock="" duration="" out="" quiet=0
+device="spidar"
 haptic_extra=()
 fingers=()
 users=()
@@ -44,6 +49,7 @@ while (($#)); do
     --substeps) substeps="${2:?}"; shift 2 ;;
     --engine) engine="${2:?}"; shift 2 ;;
     --passivity) passivity="${2:?}"; shift 2 ;;
+    --device) device="${2:?}"; shift 2 ;;
     --phase) phase="${2:?}"; shift 2 ;;
     --clock) clock="${2:?}"; shift 2 ;;
     --duration) duration="${2:?}"; shift 2 ;;
@@ -60,19 +66,36 @@ while (($#)); do
 done
 [ -n "$scene" ] || die "--scene is required"
 [ -f "$scene" ] || die "--scene: no such file '$scene'"
-if ((${#fingers[@]})); then
+web=0
+case "$device" in
+  web|web:*) web=1 ;;
+  spidar) ;;
+  *) die "--device must be web or web:FILE.json (a trajectory plays the simulated SPIDAR without it), not '$device'" ;;
+esac
+if ((web)); then
+  [ -z "$trajectory" ] && ((${#fingers[@]} == 0 && ${#users[@]} == 0)) || \
+    die "--device web: the page steers the finger; give no --trajectory, --finger or --user"
+  [ -z "$clock" ] || [ "$clock" = realtime ] || die "--device web runs in real time (a person does not wait for \
+lockstep turns), not --clock $clock"
+  clock=realtime
+  view=1
+  trajectory="web"
+elif ((${#fingers[@]})); then
   [ -z "$trajectory" ] || die "give --trajectory or --finger, not both"
   ((${#fingers[@]} <= 8)) || die "--finger: at most 8 fingers, not ${#fingers[@]}"
 else
   [ -n "$trajectory" ] || die "--trajectory (or --finger NAME=SPEC for each finger) is required"
 fi
+[ -n "$clock" ] || clock=lockstep
+[ -n "$duration" ] || { ((web)) || duration=60; }
 case "$clock" in realtime|lockstep) ;; *) die "--clock must be realtime or lockstep, not '$clock'" ;; esac
 first_fingers=$(( ${#fingers[@]} > 0 ? ${#fingers[@]} : 1 ))
 endpoints=$(( first_fingers + ${#users[@]} ))
 ((endpoints <= 8)) || die "a world serves at most 8 endpoints: the first controller's $first_fingers finger(s) and \
 ${#users[@]} other user(s) make $endpoints"
 [[ "$view_wait" =~ ^[0-9]+([.][0-9]+)?$ ]] || die "--view-wait must be a number of seconds, not '$view_wait'"
-bins=(world_manager haptic_controller spidar_sim)
+bins=(world_manager haptic_controller)
+((web)) || bins+=(spidar_sim)
 ((view)) && bins+=(viewer)
 for bin in "${bins[@]}"; do
   [ -x "$build/$bin/$bin" ] || die "$build/$bin/$bin is missing: run scripts/build.sh first"
@@ -91,7 +114,9 @@ add_log world_args world
 [ -n "$substeps" ] && world_args+=(--substeps "$substeps")
 [ -n "$engine" ] && world_args+=(--engine "$engine")
 [ -n "$passivity" ] && world_args+=(--passivity "$passivity")
-haptic_args=(--clock "$clock" --duration "$duration" --shm "$shm" --summary "$out/haptic.json" "${haptic_extra[@]}")
+haptic_args=(--clock "$clock" --shm "$shm" --summary "$out/haptic.json" "${haptic_extra[@]}")
+[ -n "$duration" ] && haptic_args+=(--duration "$duration")
+((web)) && haptic_args+=(--device "$device")
 add_log haptic_args haptic
 device_args=(--clock "$clock" --shm "$shm" --summary "$out/device.json")
 add_log device_args device
@@ -103,7 +128,7 @@ else
   device_args+=(--trajectory "$trajectory")
 fi
 # Every segment the trial may create: the world's, the viewer's and one device port per finger.
-segments=("/dev/shm/$shm.world" "/dev/shm/$shm.view" "/dev/shm/$shm.device")
+segments=("/dev/shm/$shm.world" "/dev/shm/$shm.view" "/dev/shm/$shm.device" "/dev/shm/$shm.touch")
 for ((k = 1; k < ${#fingers[@]}; ++k)); do segments+=("/dev/shm/$shm.device$k"); done
 # Another user's controller has a device port of its own: NAME_uU.device.
 for ((u = 1; u <= ${#users[@]}; ++u)); do segments+=("/dev/shm/${shm}_u$u.device"); done
@@ -123,7 +148,7 @@ check_flags() {
 }
 check_flags world_manager "${world_args[@]}"
 check_flags haptic_controller "${haptic_args[@]}"
-check_flags spidar_sim "${device_args[@]}"
+((web)) || check_flags spidar_sim "${device_args[@]}"
 
 pids=()
 viewer_pid=""
@@ -143,14 +168,26 @@ start=$(date +%s.%N)
 "$build/world_manager/world_manager" "${world_args[@]}" 2>"$out/world.err" & world=$!; pids+=("$world")
 if ((view)); then
   # The viewer is a bystander: if it cannot start (the port is taken), the trial runs without it.
-  "$build/viewer/viewer" --shm "$shm" --listen "$view_listen" >"$out/viewer.out" 2>"$out/viewer.err" & viewer_pid=$!
+  viewer_args=(--shm "$shm" --listen "$view_listen")
+  ((web)) && viewer_args+=(--touch)
+  "$build/viewer/viewer" "${viewer_args[@]}" >"$out/viewer.out" 2>"$out/viewer.err" & viewer_pid=$!
   for _ in $(seq 100); do
     grep -q serving "$out/viewer.out" 2>/dev/null && break
     kill -0 "$viewer_pid" 2>/dev/null || break
     sleep 0.05
   done
-  if grep -q serving "$out/viewer.out" 2>/dev/null; then
+  if ((web)) && grep -q "touch the world" "$out/viewer.out" 2>/dev/null; then
+    echo "run.sh: touch it: open $(sed -n 's/.*touch the world: \(http[^ ]*\).*/\1/p' "$out/viewer.out") in a browser;" \
+         "drag to move the finger, wheel for depth; Ctrl-C ends the trial" >&2
+  elif grep -q serving "$out/viewer.out" 2>/dev/null; then
     echo "run.sh: watch it live: open $(sed -n 's/.*serving \(http[^ ]*\).*/\1/p' "$out/viewer.out") in a browser" >&2
+  elif ((web)); then
+    echo "run.sh: the viewer did not start, and --device web needs it:" >&2
+    cat "$out/viewer.err" >&2
+    stop_all
+    wait || true
+    rm -f "${segments[@]}"
+    exit 1
   else
     echo "run.sh: the viewer did not start (the trial runs without it):" >&2
     cat "$out/viewer.err" >&2
@@ -159,7 +196,9 @@ if ((view)); then
   sleep "$view_wait"
 fi
 "$build/haptic_controller/haptic_controller" "${haptic_args[@]}" 2>"$out/haptic.err" & haptic=$!; pids+=("$haptic")
-"$build/spidar_sim/spidar_sim" "${device_args[@]}" 2>"$out/device.err" & device=$!; pids+=("$device")
+if ((!web)); then
+  "$build/spidar_sim/spidar_sim" "${device_args[@]}" 2>"$out/device.err" & device=$!; pids+=("$device")
+fi
 user_haptics=() user_devices=()
 if ((${#users[@]})); then
   if [ "$clock" = lockstep ]; then
@@ -187,18 +226,29 @@ fi
 # The trial lasts as long as the trajectory (its final hold lets the objects come to rest), capped by --duration.
 # Then the haptic controller and the world are stopped like a user would, and must exit cleanly.
 device_status=0 haptic_status=0 world_status=0
-wait "$device" || device_status=$?
-# Other users: their devices end with their trajectories; then their controllers leave before the first one.
 user_status=()
-for ((u = 1; u <= ${#users[@]}; ++u)); do
-  status_u=0
-  wait "${user_devices[u - 1]}" || status_u=$?
-  kill -TERM "${user_haptics[u - 1]}" 2>/dev/null || true
-  wait "${user_haptics[u - 1]}" || status_u=$((status_u ? status_u : $?))
-  user_status+=("$status_u")
-done
-kill -TERM "$haptic" 2>/dev/null || true
-wait "$haptic" || haptic_status=$?
+if ((web)); then
+  # The person ends a web trial: Ctrl-C stops the haptic controller as --duration would, and the trial is summarised.
+  trap 'echo "run.sh: ending the trial" >&2; kill -TERM "$haptic" 2>/dev/null || true' INT TERM
+  while :; do
+    haptic_status=0
+    wait "$haptic" || haptic_status=$?
+    kill -0 "$haptic" 2>/dev/null || break
+  done
+  trap on_interrupt INT TERM
+else
+  wait "$device" || device_status=$?
+  # Other users: their devices end with their trajectories; then their controllers leave before the first one.
+  for ((u = 1; u <= ${#users[@]}; ++u)); do
+    status_u=0
+    wait "${user_devices[u - 1]}" || status_u=$?
+    kill -TERM "${user_haptics[u - 1]}" 2>/dev/null || true
+    wait "${user_haptics[u - 1]}" || status_u=$((status_u ? status_u : $?))
+    user_status+=("$status_u")
+  done
+  kill -TERM "$haptic" 2>/dev/null || true
+  wait "$haptic" || haptic_status=$?
+fi
 kill -TERM "$world" 2>/dev/null || true
 wait "$world" || world_status=$?
 if [ -n "$viewer_pid" ]; then

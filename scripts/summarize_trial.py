@@ -29,8 +29,12 @@ def main():
     args = parser.parse_args()
 
     entries = {key: value for key, _, value in (item.partition("=") for item in args.set)}
-    merged = summary.merge(load(args.dir / summary.WORLD_FILE_NAME), load(args.dir / summary.HAPTIC_FILE_NAME),
-                           load(args.dir / summary.DEVICE_FILE_NAME), entries)
+    haptic = load(args.dir / summary.HAPTIC_FILE_NAME)
+    # A device simulated inside the haptic controller (the web hand) has no process and no file of its own: its
+    # figures are the haptic controller's "device".
+    device_file = args.dir / summary.DEVICE_FILE_NAME
+    device = load(device_file) if device_file.exists() else {"device": haptic["haptic"].get("device", {})}
+    merged = summary.merge(load(args.dir / summary.WORLD_FILE_NAME), haptic, device, entries)
     # Other users on the same world (run.sh --user): userU.haptic.json and userU.device.json, U = 1, 2, ...
     followers = []
     while (args.dir / f"user{len(followers) + 1}.haptic.json").exists():
@@ -55,6 +59,10 @@ def main():
           f"force clamps {h['force_clamps']}, saturations {h['saturations']}, skipped periods {h['skipped_periods']}, "
           f"lateness p50/p99/max {h['lateness_p50_ns'] / 1e3:.0f}/{h['lateness_p99_ns'] / 1e3:.0f}/"
           f"{h['lateness_max_ns'] / 1e3:.0f} µs")
+    if merged["device"].get("kind") == "web":
+        d = merged["device"]
+        print(f"  web hand: taken {d['holds']} time(s), let go {d['releases']} time(s) when told and "
+              f"{d['timeouts']} on silence; force off within {d['max_release_delay_s'] * 1e3:.1f} ms of a page's end")
     print(f"  world:  {w['steps']} steps, {w['time_s']:.3f} s simulated, skipped periods {w['skipped_periods']}, "
           f"rejected reports {w['rejected_reports']}")
     written = "logs and summary.json" if any(pathlib.Path(args.dir).glob("*.csv")) else "summary.json (no logs)"

@@ -13,7 +13,7 @@
 #include "common/contract/frames.h"
 #include "spidar_sim/trajectory.h"
 #include "common/contract/vec3.h"
-#include "spidar_sim/finger.h"
+#include "common/hand/finger.h"
 #include "spidar_sim/spidar_hardware.h"
 
 #include <array>

@@ -23,6 +23,12 @@ int main(int argc, char** argv) {
                  "with --allow-remote: a DNS name the page may be opened by, besides IP addresses and this machine's "
                  "name (any other Host is refused: DNS rebinding)")
       ->needs("--allow-remote");
+  app.add_flag("--touch", options.touch,
+               "let a page steer the web hand (haptic_controller --device web on the same --shm): the page opened "
+               "from the address printed with the run's token takes it, one page at a time");
+  app.add_flag("--allow-remote-touch", options.allow_remote_touch,
+               "with --touch and --allow-remote: accept input from pages on other machines")
+      ->needs("--touch");
   app.add_option("--web", web_dir, "folder with the page (default: the installed or source viewer/web)")
       ->check(CLI::ExistingDirectory);
   app.add_option("--duration", options.duration_s, "seconds to serve (default: until stopped)")

@@ -30,6 +30,17 @@
 // 3. Page → viewer (replay only; ignored live), text messages of one JSON object:
 //      {"play": true | false}   {"speed": 0.1 .. 10}   {"seek": seconds of trial time}
 //    Anything else, or a message over kMaxClientMessageBytes, closes that connection; the viewer carries on.
+//
+// 4. Touch (viewer --touch; viewer/touch_control.h, viewer/web/touch.js). On the page's touch socket at /ws/touch
+//    (no scene, no frames; the page's worker, viewer/web/touch_worker.js, holds it) or on /ws. Page → viewer:
+//      {"touch": "take", "token": "<the run's token, from the page's address ?touch=TOKEN>"}
+//      {"touch": "target", "target_m": [x, y, z]}     the holder's target, at least every 10 ms (its heartbeat)
+//      {"touch": "release"}
+//    Viewer → page, a text message answering a take or a release, or a target from a page that does not hold:
+//      {"type": "touch", "state": "holding" | "watching" | "released" | "refused" | "unavailable",
+//       "reason": "...",                                     (why, when not holding)
+//       "hand": {"finger_m": [x, y, z], "workspace_min_m": [..], "workspace_max_m": [..], "max_force_N": f}}
+//    A malformed touch message closes the connection as in §3.
 
 #include <cstddef>
 

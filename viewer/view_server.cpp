@@ -55,8 +55,13 @@ class ConnectionToken {
 // One page over a WebSocket: sends the scene, then frames as the feed has them; reads the page's control messages.
 class WsSession : public std::enable_shared_from_this<WsSession> {
  public:
-  WsSession(tcp::socket socket, ViewFeed& feed, ConnectionToken token)
-      : ws_(std::move(socket)), feed_(feed), token_(std::move(token)) {}
+  // `from_page`: the upgrade carried an Origin header, which the server checked is this viewer's own page.
+  // `touch_only`: a page's touch socket (/ws/touch): no scene and no frames, only touch messages.
+  WsSession(tcp::socket socket, ViewFeed& feed, ConnectionToken token, TouchControl* touch, bool from_page,
+            bool touch_only)
+      : ws_(std::move(socket)), feed_(feed), token_(std::move(token)), touch_(touch), from_page_(from_page),
+        touch_only_(touch_only), page_(++token_.counters().page_serial) {}
+  ~WsSession() { leave(); }
 
   void accept(http::request<http::string_body> request) {
     ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
@@ -73,6 +78,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   // Called by the server every feed period.
   void pump(double elapsed_s) {
     if (!open_) return;
+    if (touch_only_) return write_next();
     if (feed_.scene_serial() != playback_.scene_serial && feed_.scene() != nullptr) {
       playback_ = Playback{};
       playback_.scene_serial = feed_.scene_serial();
@@ -92,15 +98,20 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void close() {
     if (!open_) return;
     open_ = false;
+    leave();
     ws_.async_close(websocket::close_code::going_away, [self = shared_from_this()](beast::error_code) {});
   }
 
  private:
   void write_next() {
     if (writing_ || !open_) return;
-    const bool text = pending_scene_ != nullptr;
-    std::shared_ptr<const std::string> message = text ? std::move(pending_scene_) : std::move(pending_frame_);
+    const bool reply = pending_scene_ == nullptr && pending_reply_ != nullptr;
+    const bool text = pending_scene_ != nullptr || reply;
+    std::shared_ptr<const std::string> message = pending_scene_ != nullptr ? std::move(pending_scene_)
+                                                 : reply                    ? std::move(pending_reply_)
+                                                                            : std::move(pending_frame_);
     pending_scene_.reset();
+    if (reply) pending_reply_.reset();
     if (!text) pending_frame_.reset();
     if (message == nullptr) return;
     writing_ = true;
@@ -110,6 +121,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
                       self->writing_ = false;
                       if (error) {
                         self->open_ = false;  // the page went away; the session ends with its last handler
+                        self->leave();
                         return;
                       }
                       if (!text) ++self->token_.counters().frames_sent;
@@ -122,12 +134,24 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code error, std::size_t) {
       if (error) {  // closed, timed out, or a message over read_message_max: this page ends
         self->open_ = false;
+        self->leave();
         return;
       }
       const std::string text = beast::buffers_to_string(self->buffer_.data());
       self->buffer_.consume(self->buffer_.size());
       const nlohmann::json message = nlohmann::json::parse(text, nullptr, false);
-      if (message.is_discarded() || !self->feed_.control(self->playback_, message)) {
+      bool ok = false;
+      if (!message.is_discarded() && message.is_object() && message.contains("touch")) {
+        // Touch messages go to the touch control (view_protocol.h §4); a server without one answers every take
+        // "unavailable".
+        nlohmann::json reply = self->touch_ != nullptr
+                                   ? self->touch_->on_message(self->page_, self->from_page_, message, ok)
+                                   : TouchControl::without_touch(message, ok);
+        if (ok && !reply.is_null()) self->send_text(reply.dump());
+      } else {
+        ok = !self->touch_only_ && !message.is_discarded() && self->feed_.control(self->playback_, message);
+      }
+      if (!ok) {
         self->close_with(websocket::close_code::policy_error);
         return;
       }
@@ -136,8 +160,21 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     });
   }
 
+  // The page lets go of the web hand if it held it; once.
+  void leave() {
+    if (touch_ != nullptr && !left_) touch_->page_closed(page_);
+    left_ = true;
+  }
+
+  // A reply to this page alone, sent before the next frame (at most one waits: a newer reply replaces it).
+  void send_text(std::string text) {
+    pending_reply_ = std::make_shared<const std::string>(std::move(text));
+    write_next();
+  }
+
   void close_with(websocket::close_code code) {
     open_ = false;
+    leave();
     ws_.async_close(code, [self = shared_from_this()](beast::error_code) {});
   }
 
@@ -148,6 +185,12 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   Playback playback_;
   std::shared_ptr<const std::string> pending_scene_;
   std::shared_ptr<const std::string> pending_frame_;
+  std::shared_ptr<const std::string> pending_reply_;
+  TouchControl* touch_;
+  bool from_page_;
+  bool touch_only_;
+  std::uint64_t page_;
+  bool left_ = false;
   bool open_ = false;
   bool writing_ = false;
 };
@@ -158,9 +201,9 @@ namespace {
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
   HttpSession(tcp::socket socket, const WebRoot& web, ViewFeed& feed, ConnectionToken token,
-              std::vector<std::weak_ptr<WsSession>>& pages, const HostRule& host_rule)
+              std::vector<std::weak_ptr<WsSession>>& pages, const HostRule& host_rule, TouchControl* touch)
       : stream_(std::move(socket)), web_(web), feed_(feed), token_(std::move(token)), pages_(pages),
-        host_rule_(host_rule) {}
+        host_rule_(host_rule), touch_(touch) {}
 
   void read() {
     parser_.emplace();
@@ -198,9 +241,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       return answer(http::status::forbidden, problem + "\n", false);
     }
     if (websocket::is_upgrade(request)) {
-      if (target != "/ws") return answer(http::status::not_found, "no WebSocket at " + target + " (use /ws)\n", false);
+      if (target != "/ws" && target != "/ws/touch") {
+        return answer(http::status::not_found, "no WebSocket at " + target + " (use /ws, or /ws/touch)\n", false);
+      }
       stream_.expires_never();  // the WebSocket keeps its own timeouts
-      auto page = std::make_shared<WsSession>(stream_.release_socket(), feed_, std::move(token_));
+      const bool from_page = !header(http::field::origin).empty();  // and it passed origin_problem above
+      auto page = std::make_shared<WsSession>(stream_.release_socket(), feed_, std::move(token_), touch_, from_page,
+                                              target == "/ws/touch");
       pages_.push_back(page);
       page->accept(std::move(request));
       return;
@@ -260,6 +307,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   ConnectionToken token_;
   std::vector<std::weak_ptr<WsSession>>& pages_;
   HostRule host_rule_;  // a copy: a session may outlive the server
+  TouchControl* touch_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
 };
@@ -267,8 +315,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 }  // namespace
 
 ViewServer::ViewServer(asio::io_context& io, const tcp::endpoint& endpoint, const WebRoot& web, ViewFeed& feed,
-                       std::vector<std::string> host_names)
-    : io_(io), acceptor_(io), timer_(io), web_(web), feed_(feed), counters_(std::make_shared<ServerCounters>()) {
+                       std::vector<std::string> host_names, TouchControl* touch)
+    : io_(io), acceptor_(io), timer_(io), web_(web), feed_(feed), touch_(touch),
+      counters_(std::make_shared<ServerCounters>()) {
   acceptor_.open(endpoint.protocol());
   acceptor_.set_option(asio::socket_base::reuse_address(true));
   acceptor_.bind(endpoint);
@@ -310,7 +359,8 @@ void ViewServer::accept() {
         beast::error_code ignored;
         socket.close(ignored);
       } else {
-        std::make_shared<HttpSession>(std::move(socket), web_, feed_, ConnectionToken(counters_), pages_, host_rule_)
+        std::make_shared<HttpSession>(std::move(socket), web_, feed_, ConnectionToken(counters_), pages_, host_rule_,
+                                      touch_)
             ->read();
       }
     }

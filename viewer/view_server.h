@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The viewer's HTTP and WebSocket server (Boost.Beast), on one thread: the page's files from a WebRoot, and at /ws a
-// WebSocket per page fed from a ViewFeed (view_protocol.h).
+// The viewer's HTTP and WebSocket server (Boost.Beast), on one thread: the page's files from a WebRoot, at /ws a
+// WebSocket per page fed from a ViewFeed (view_protocol.h), and at /ws/touch a page's touch socket, which carries only
+// touch messages (view_protocol.h §4).
 //
 // A page that reads slowly is sent only the newest frame when it is ready for one (never a queue that grows); a
 // request that is too large, too slow, or for anything but the page's files gets an HTTP error or is closed; beyond
@@ -9,6 +10,7 @@
 // through a read-only mapping.
 
 #include "viewer/request_check.h"
+#include "viewer/touch_control.h"
 #include "viewer/view_feed.h"
 #include "viewer/web_root.h"
 
@@ -34,6 +36,7 @@ struct ServerCounters {
   std::uint64_t frames_dropped = 0;    // replaced by a newer one before a slow page was ready for it
   std::uint64_t bytes_sent = 0;
   std::size_t open_connections = 0;
+  std::uint64_t page_serial = 0;       // the last page's serial (pages are numbered from 1)
 };
 
 class ViewServer {
@@ -44,8 +47,9 @@ class ViewServer {
   // Requests are answered only with a Host header naming this server and, if they carry one, the Origin of its own
   // page (request_check.h); `host_names` are DNS names accepted beside the loopback names, the IP literals of a
   // non-loopback listen address and this machine's host name (lower case).
+  // `touch` (may be null: no page steers anything) decides which page steers the web hand; it must outlive the server.
   ViewServer(boost::asio::io_context& io, const boost::asio::ip::tcp::endpoint& endpoint, const WebRoot& web,
-             ViewFeed& feed, std::vector<std::string> host_names = {});
+             ViewFeed& feed, std::vector<std::string> host_names = {}, TouchControl* touch = nullptr);
   ~ViewServer();
 
   boost::asio::ip::tcp::endpoint local_endpoint() const { return acceptor_.local_endpoint(); }
@@ -65,6 +69,7 @@ class ViewServer {
   boost::asio::steady_timer timer_;
   const WebRoot& web_;
   ViewFeed& feed_;
+  TouchControl* touch_;
   HostRule host_rule_;
   // Shared with the sessions: a session may outlive the server by the handlers io_context still holds.
   std::shared_ptr<ServerCounters> counters_;

@@ -4,8 +4,11 @@
 #include "common/runtime/ascii.h"
 #include "common/link/dds/dds_world_view.h"
 
+#include "common/link/shm/names.h"
+#include "common/link/shm/shm_touch_port.h"
 #include "common/runtime/process.h"
 #include "viewer/view_feed.h"
+#include "viewer/touch_control.h"
 #include "viewer/view_server.h"
 #include "viewer/web_root.h"
 
@@ -18,6 +21,7 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 namespace impetus::view {
@@ -88,12 +92,37 @@ int ViewerNode::run() {
     feed = std::move(live_feed);
   }
 
+  // Declared before the server and its io_context: pages hold it until their last handler has run.
+  std::optional<TouchControl> touch;
+  if (options_.touch) {
+    if (!options_.replay_dir.empty()) {
+      throw std::invalid_argument("--touch steers a live world's web hand; a replay has none");
+    }
+    if (options_.allow_remote && !options_.allow_remote_touch) {
+      throw std::invalid_argument("--touch with --allow-remote would let pages on other machines steer the hand (and "
+                                  "push the world); add --allow-remote-touch if that is what you want");
+    }
+    const std::string shm = options_.shm;
+    touch.emplace(
+        [shm]() -> std::unique_ptr<TouchPortClient> {
+          try {
+            return std::make_unique<ShmTouchPortClient>(shm);
+          } catch (const SegmentError& error) {
+            if (!error.transient()) throw;
+            throw std::runtime_error("no web hand device is running on '" + shm + "' (haptic_controller --shm " + shm +
+                                     " --device web --clock realtime)");
+          }
+        },
+        new_touch_token());
+  }
+
   asio::io_context io(1);
   std::unique_ptr<ViewServer> server_owner;
   try {
     server_owner = std::make_unique<ViewServer>(io, asio::ip::tcp::endpoint{asio::ip::make_address(address.host),
                                                                             address.port},
-                                                web, *feed, lower_case(options_.allow_hosts));
+                                                web, *feed, lower_case(options_.allow_hosts),
+                                                touch ? &*touch : nullptr);
   } catch (const boost::system::system_error& error) {
     throw std::runtime_error("--listen " + options_.listen + ": cannot serve there: " + error.code().message() +
                              (error.code() == boost::asio::error::address_in_use
@@ -109,6 +138,11 @@ int ViewerNode::run() {
                                                          : "live, world '" + options_.shm + "'")
                         .c_str()
                                           : ("replay of " + options_.replay_dir).c_str());
+  if (touch) {
+    std::printf("viewer: touch the world: http://%s:%u/?touch=%s (the web hand on '%s'; one page at a time holds it)\n",
+                host.c_str(), static_cast<unsigned>(bound.port()), touch->token().c_str(),
+                touch_port_name(options_.shm).c_str());
+  }
   std::fflush(stdout);
   server.start();
 
@@ -142,6 +176,11 @@ int ViewerNode::run() {
   if (live != nullptr) {
     std::fprintf(stderr, ", %llu snapshots read, %llu rejected", static_cast<unsigned long long>(live->snapshots_read()),
                  static_cast<unsigned long long>(live->rejected()));
+  }
+  if (touch) {
+    std::fprintf(stderr, ", touch: %llu targets (longest gap %.1f ms), %llu takes refused",
+                 static_cast<unsigned long long>(touch->targets()), static_cast<double>(touch->longest_gap_ns()) * 1e-6,
+                 static_cast<unsigned long long>(touch->refusals()));
   }
   std::fprintf(stderr, "\n");
   return 0;

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The viewer node (docs/architecture.md §1.3, paper §6.1 "graphics"): attaches read-only to a running world's view, or
-// reads a finished trial, and serves the page that shows it. It never writes anything the world, the haptic loop or the
-// device reads.
+// reads a finished trial, and serves the page that shows it. It never writes anything the world or the haptic loop
+// reads; with --touch it writes one thing, the controlling page's target, into the web hand's touch port
+// (viewer/touch_control.h).
 
 #include "common/link/link_options.h"
 
@@ -20,6 +21,9 @@ struct ViewerOptions {
   std::string listen = "127.0.0.1:8080";
   bool allow_remote = false;     // serve on an address other than loopback
   std::vector<std::string> allow_hosts;  // with allow_remote: DNS names the page may be reached by (Host header)
+  // Live: a page holding the run's token steers the web hand (haptic_controller --device web) on "<shm>.touch".
+  bool touch = false;
+  bool allow_remote_touch = false;  // touch with allow_remote: input from pages on other machines
   std::filesystem::path web_dir; // the page's files; empty: WebRoot::find_default
   double duration_s = 0.0;       // 0: until stopped
 };

@@ -52,6 +52,8 @@ std::optional<fs::path> WebRoot::file_for(std::string_view target) const {
   if (query != std::string_view::npos) target = target.substr(0, query);
   if (target == "/" || target == "/index.html") return dir_ / "index.html";
   if (target == "/viewer.js") return dir_ / "viewer.js";
+  if (target == "/touch.js") return dir_ / "touch.js";
+  if (target == "/touch_worker.js") return dir_ / "touch_worker.js";
   for (const std::string_view prefix : {std::string_view("/three/build/"), std::string_view("/three/examples/jsm/")}) {
     if (target.substr(0, prefix.size()) != prefix) continue;
     const std::string_view rest = target.substr(prefix.size());

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The page's files (viewer/web) and which request targets name them. Only these are served: "/" and "/index.html",
-// "/viewer.js", and three.js's own files under "/three/build/" and "/three/examples/jsm/" (from the pinned npm
+// "/viewer.js", "/touch.js" and "/touch_worker.js", and three.js's own files under "/three/build/" and "/three/examples/jsm/" (from the pinned npm
 // package in web/node_modules/three). A target with "..", a hidden component, or characters outside
 // [A-Za-z0-9._-/] names nothing.
 

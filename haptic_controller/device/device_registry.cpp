@@ -3,7 +3,9 @@
 
 #include "common/runtime/message_text.h"
 #include "common/spidar/geometry.h"
+#include "common/link/shm/shm_touch_port.h"
 #include "haptic_controller/device/spidar_driver.h"
+#include "haptic_controller/device/web_hand.h"
 
 #include <stdexcept>
 
@@ -31,11 +33,44 @@ std::unique_ptr<DeviceType> parse_spidar(const std::string& argument) {
   return std::make_unique<SpidarType>(parse_device_spec(argument.empty() ? "spidar" : "spidar:" + argument));
 }
 
+// The web hand: a simulated hand steered from the viewer's page (web_hand.h); its argument is a hand file
+// (web_hand_params.h), the built-in hand without one. Its touch port is "<shm>.touch", which `viewer --touch` opens.
+class WebHandType final : public DeviceType {
+ public:
+  explicit WebHandType(WebHandParams params)
+      : params_(std::move(params)), description_{0, "web hand (" + params_.source + ")"} {}
+  const DeviceDescription& description() const override { return description_; }
+  std::unique_ptr<HapticDevice> make_finger(DevicePortHost&, ClockMode, std::uint64_t) const override {
+    throw std::logic_error("the web hand has no device port");
+  }
+  bool uses_device_ports() const override { return false; }
+  std::unique_ptr<HapticDevice> make_local(const std::string& shm, ClockMode clock) const override {
+    if (clock != ClockMode::realtime) {
+      throw std::invalid_argument("--device web needs --clock realtime: a person's pointer does not wait for "
+                                  "lockstep turns");
+    }
+    return std::make_unique<WebHand>(params_, std::make_unique<ShmTouchPortHost>(shm));
+  }
+
+ private:
+  WebHandParams params_;
+  DeviceDescription description_;
+};
+
+std::unique_ptr<DeviceType> parse_web(const std::string& argument) {
+  return std::make_unique<WebHandType>(argument.empty() ? WebHandParams{} : load_web_hand(argument));
+}
+
 constexpr DeviceEntry kDevices[] = {
     {"spidar", "FILE.json", parse_spidar},
+    {"web", "FILE.json", parse_web},
 };
 
 }  // namespace
+
+std::unique_ptr<HapticDevice> DeviceType::make_local(const std::string&, ClockMode) const {
+  throw std::logic_error("this device is reached through device ports");
+}
 
 std::string device_forms() {
   std::vector<std::string> forms;
@@ -67,6 +102,10 @@ AssembledDevice::AssembledDevice(const DeviceType& type, std::span<DevicePortHos
     fingers.push_back(fingers_.back().get());
   }
   if (fingers_.size() > 1) set_.emplace(fingers);
+}
+
+AssembledDevice::AssembledDevice(const DeviceType& type, const std::string& shm, ClockMode clock) {
+  fingers_.push_back(type.make_local(shm, clock));
 }
 
 }  // namespace impetus

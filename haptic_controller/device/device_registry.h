@@ -30,6 +30,12 @@ class DeviceType {
   // One finger's driver on `port`, which must outlive it; `haptic_session` stamps the commands.
   virtual std::unique_ptr<HapticDevice> make_finger(DevicePortHost& port, ClockMode clock,
                                                     std::uint64_t haptic_session) const = 0;
+  // Whether its fingers are reached through device ports, a device process at the other end (spidar_sim, a real
+  // SPIDAR's bridge). One that is not (the web hand, simulated in the haptic controller) is built by make_local.
+  virtual bool uses_device_ports() const { return true; }
+  // The whole device, in this process, with whatever it opens under `shm` (names.h); for a type without device
+  // ports. Throws std::invalid_argument for a clock it cannot run on.
+  virtual std::unique_ptr<HapticDevice> make_local(const std::string& shm, ClockMode clock) const;
 };
 
 struct DeviceEntry {
@@ -51,6 +57,8 @@ class AssembledDevice {
  public:
   AssembledDevice(const DeviceType& type, std::span<DevicePortHost* const> ports, ClockMode clock,
                   std::uint64_t haptic_session);
+  // A type without device ports (DeviceType::make_local).
+  AssembledDevice(const DeviceType& type, const std::string& shm, ClockMode clock);
   HapticDevice& device() { return set_ ? static_cast<HapticDevice&>(*set_) : *fingers_.front(); }
 
  private:

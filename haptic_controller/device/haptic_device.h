@@ -10,6 +10,7 @@
 #include "common/contract/frames.h"
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
 #include <cstdint>
 
@@ -69,6 +70,8 @@ class HapticDevice {
   virtual void end_session() = 0;
 
   virtual DeviceCounters counters() const = 0;
+  // What this kind of device counts beyond DeviceCounters, for summary.json's haptic.device (null: nothing).
+  virtual nlohmann::json details() const { return nullptr; }
 };
 
 }  // namespace impetus

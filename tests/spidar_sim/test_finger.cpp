@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Finger model: static deflection under a constant force, the hand's step response (exact at any step), a target
 // moving at constant speed, and sub-step selection.
-#include "spidar_sim/finger.h"
+#include "common/hand/finger.h"
 
 #include <catch2/catch.hpp>
 

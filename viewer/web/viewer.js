@@ -4,7 +4,8 @@
 //   - a text message, the scene, names the bodies and their shapes; every scene rebuilds the 3-D view;
 //   - each binary message is one world frame (little-endian float64): header, body poses, endpoints with their
 //     active planes; body k of a frame is bodies[k] of the scene;
-//   - in replay, the page sends {"play": b}, {"speed": x}, {"seek": t} back.
+//   - in replay, the page sends {"play": b}, {"speed": x}, {"seek": t} back;
+//   - with ?touch=TOKEN in its address, touch.js steers the web hand over a socket of its own (/ws/touch).
 // Poses are drawn one world period behind the newest frame, interpolated between the last two frames, so motion is
 // smooth at the display's rate whatever the world's rate. The socket reconnects every second when it closes, since
 // the viewer or the world behind it may restart.
@@ -19,6 +20,7 @@
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { createTouch } from './touch.js';
 
 // ---- Protocol (viewer/view_protocol.h) ------------------------------------------------------------------------------
 
@@ -88,9 +90,11 @@ const view = {
   fps: 0,
   renderedFrames: 0,
   get latest() { return latest ? describeFrame(latest) : null; },
+  get touch() { return touch.state; },   // the web hand as this page sees it (touch.js)
   get shown() { return { bodies: describePoses(shownPoses, shownCount) }; },
   send(message) { return sendControl(message); },
   project(name) { return projectBody(name); },   // where body `name` was drawn: {x, y} page pixels, or null
+  projectPoint(point) { return projectPoint(point); },   // where world point [x, y, z] is drawn: {x, y} page pixels
   // Points the camera at a sphere (centre [x, y, z] m, radius m) and stops it following the bodies, as a user's
   // own camera move does.
   lookAt(center, radius) {
@@ -748,7 +752,13 @@ function projectBody(name) {
   const k = scene ? scene.bodies.findIndex((body) => body.name === name) : -1;
   if (k < 0 || k >= shownCount) return null;
   const s = k * BODY_VALUES;
-  const p = new THREE.Vector3(shownPoses[s], shownPoses[s + 1], shownPoses[s + 2]).project(camera);
+  return projectPoint([shownPoses[s], shownPoses[s + 1], shownPoses[s + 2]]);
+}
+
+// Page pixels of world point [x, y, z] (m) with the camera as drawn now.
+function projectPoint(point) {
+  camera.updateMatrixWorld();
+  const p = new THREE.Vector3(point[0], point[1], point[2]).project(camera);
   const rect = renderer.domElement.getBoundingClientRect();
   return { x: rect.left + (p.x + 1) / 2 * rect.width, y: rect.top + (1 - p.y) / 2 * rect.height };
 }
@@ -1298,6 +1308,7 @@ function animate() {
   renderer.render(world, camera);
   forceChart.draw();
   positionChart.draw();
+  touch.update(now);
 
   view.renderedFrames++;
   fpsWindowFrames++;
@@ -1320,6 +1331,22 @@ document.getElementById('reframe').addEventListener('click', () => {
 controls.addEventListener('start', () => { cameraTouched = true; });
 planesToggle.addEventListener('change', () => {
   for (const visual of endpointVisuals) visual.planes.visible = planesToggle.checked;
+});
+
+// Endpoint 0's finger and force in the latest frame, for the touch panel (null without one).
+function firstEndpointVector(offset) {
+  if (!latest || latest.endpoints.length === 0) return null;
+  const o = latest.endpoints[0] + offset;
+  const d = latest.data;
+  return [d[o], d[o + 1], d[o + 2]];
+}
+const touch = createTouch({
+  camera,
+  controls,
+  canvas: renderer.domElement,
+  finger: () => (latest && latest.endpoints.length && latest.data[latest.endpoints[0] + E_FINGER_VALID] === 1
+    ? firstEndpointVector(E_FINGER) : null),
+  force: () => firstEndpointVector(E_FORCE),
 });
 
 resize();

@@ -28,5 +28,7 @@ inline std::string device_port_name(const std::string& shm, unsigned finger = 0)
   return finger == 0 ? shm + ".device" : shm + ".device" + std::to_string(finger);
 }
 inline std::string world_view_name(const std::string& shm) { return shm + ".view"; }
+// The web hand device's touch port: the viewer's page steers it.
+inline std::string touch_port_name(const std::string& shm) { return shm + ".touch"; }
 
 }  // namespace impetus

@@ -42,6 +42,7 @@ const char* to_string(SegmentKind kind) {
     case SegmentKind::world_link: return "world link";
     case SegmentKind::device_port: return "device port";
     case SegmentKind::world_view: return "world view";
+    case SegmentKind::touch_port: return "touch port";
   }
   return "unknown segment kind";
 }

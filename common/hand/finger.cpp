@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "spidar_sim/finger.h"
+#include "common/hand/finger.h"
 
 #include <algorithm>
 #include <cmath>

@@ -46,6 +46,9 @@ class Finger {
   void step(const Eigen::Vector3d& target_m, const Eigen::Vector3d& target_velocity_mps,
             const Eigen::Vector3d& device_force_N, double h_s);
 
+  // Holds the fingertip at rest where it is (a device whose hand let go stops it there).
+  void stop() { velocity_mps_.setZero(); }
+
   const Eigen::Vector3d& position_m() const { return position_m_; }
   const Eigen::Vector3d& velocity_mps() const { return velocity_mps_; }
   const FingerParams& params() const { return params_; }
