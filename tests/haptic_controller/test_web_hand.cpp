@@ -194,7 +194,7 @@ TEST_CASE("the web hand's read() and command() allocate nothing") {
 }
 #endif
 
-TEST_CASE("--device web and web:FILE.json: the hand file's errors name the file and the key") {
+TEST_CASE("the web device (web, web:FILE.json) runs in real time only, and its hand file's errors name the file and key") {
   const std::unique_ptr<DeviceType> type = parse_device("web");
   CHECK_FALSE(type->uses_device_ports());
   CHECK_THROWS_WITH(type->make_local("impetus_test_web_lockstep", ClockMode::lockstep),
