@@ -70,6 +70,13 @@ ViewerNode::ViewerNode(ViewerOptions options, std::filesystem::path executable)
 
 int ViewerNode::run() {
   const ListenAddress address = parse_listen(options_.listen, options_.allow_remote);
+  if (options_.touch && !options_.replay_dir.empty()) {
+    throw std::invalid_argument("--touch steers a live world's web hand; a replay has none");
+  }
+  if (options_.touch && options_.allow_remote && !options_.allow_remote_touch) {
+    throw std::invalid_argument("--touch with --allow-remote would let pages on other machines steer the hand (and "
+                                "push the world); add --allow-remote-touch if that is what you want");
+  }
   const WebRoot web(options_.web_dir.empty() ? WebRoot::find_default(executable_) : options_.web_dir);
   std::unique_ptr<ViewFeed> feed;
   LiveFeed* live = nullptr;
@@ -95,13 +102,6 @@ int ViewerNode::run() {
   // Declared before the server and its io_context: pages hold it until their last handler has run.
   std::optional<TouchControl> touch;
   if (options_.touch) {
-    if (!options_.replay_dir.empty()) {
-      throw std::invalid_argument("--touch steers a live world's web hand; a replay has none");
-    }
-    if (options_.allow_remote && !options_.allow_remote_touch) {
-      throw std::invalid_argument("--touch with --allow-remote would let pages on other machines steer the hand (and "
-                                  "push the world); add --allow-remote-touch if that is what you want");
-    }
     const std::string shm = options_.shm;
     touch.emplace(
         [shm]() -> std::unique_ptr<TouchPortClient> {

@@ -4,6 +4,7 @@
 
 #include "common/link/shm/shm_touch_port.h"
 #include "viewer/touch_control.h"
+#include "viewer/viewer_node.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -188,6 +189,23 @@ TEST_CASE("touch port in shared memory: input one way, the hand the other, unusa
   CHECK(client.host_alive());
   host.reset();  // the device exits: its name goes
   CHECK_THROWS_AS(ShmTouchPortClient(shm), SegmentError);
+}
+
+}  // namespace impetus::view
+
+namespace impetus::view {
+
+TEST_CASE("touch: viewer --touch is refused with --allow-remote alone, and with a replay") {
+  ViewerOptions options;
+  options.touch = true;
+  options.allow_remote = true;
+  options.listen = "0.0.0.0:0";
+  options.web_dir = std::string(IMPETUS_SOURCE_DIR) + "/viewer/web";
+  CHECK_THROWS_WITH(ViewerNode(options, "viewer").run(), Catch::Contains("--allow-remote-touch"));
+  options.allow_remote = false;
+  options.listen = "127.0.0.1:0";
+  options.replay_dir = std::string(IMPETUS_BINARY_DIR);
+  CHECK_THROWS_WITH(ViewerNode(options, "viewer").run(), Catch::Contains("a replay has none"));
 }
 
 }  // namespace impetus::view
