@@ -18,6 +18,8 @@
 #   9. ghost force, release, lost walls and pop-through in clutter and streams   build/tests/bench_ghost_force
 #  10. the closed loop from Python: ticks/s at 1 to 1000 ticks a call, free and in contact (goal: >= 200 k at 50)
 #      tests/bench/bench_closed_loop.py
+#  11. nearest point on a user's mesh of 10^3 to 10^6 triangles: tree build, memory, query percentiles
+#      build/tests/bench_mesh_query
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -27,7 +29,7 @@ world_args=()
 while (($#)); do
   case "$1" in
     --short) rt_seconds=5; world_args=(--quick); shift ;;
-    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -216,3 +218,6 @@ if [ -f "$build/python/impetus/__init__.py" ]; then
 else
   echo "(skipped: the Python package was not built)"
 fi
+
+section "11. Nearest point on a user's mesh (docs/meshes.md): a sphere of 10^3 to 10^6 triangles, 3 mm inside and on the surface"
+bench bench_mesh_query

@@ -17,6 +17,7 @@ esac
 IMPETUS_PACKAGES=(cmake g++ make pkg-config libeigen3-dev libode-dev libbullet-dev libboost-dev catch2 nlohmann-json3-dev
                   libcli11-dev python3-matplotlib python3-numpy python3-tqdm
                   pybind11-dev python3-dev  # the impetus Python module (python/)
+                  libassimp-dev  # users' mesh files: OBJ, STL and more (common/mesh)
                   cyclonedds-dev cyclonedds-tools  # the world link over DDS (common/link/dds; idlc)
                   iproute2  # network namespaces: the DDS tests' and benchmark's two hosts
                   openssl  # the secured DDS link's certificates and signed documents (scripts/dds_security.sh)

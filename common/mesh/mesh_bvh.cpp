@@ -1,0 +1,224 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "common/mesh/mesh_bvh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace impetus {
+
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                          const Eigen::Vector3d& c, std::uint8_t& feature) {
+  // Voronoi regions of the triangle, tested in turn with barycentric coordinates from dot products (Ericson,
+  // "Real-Time Collision Detection", 5.1.5): a vertex, an edge, or the face's interior.
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) {
+    feature = 4;
+    return a;
+  }
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) {
+    feature = 5;
+    return b;
+  }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    feature = 1;
+    return a + (d1 / (d1 - d3)) * ab;
+  }
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) {
+    feature = 6;
+    return c;
+  }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    feature = 3;
+    return a + (d2 / (d2 - d6)) * ac;
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    feature = 2;
+    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  }
+  feature = 0;
+  const double denominator = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denominator) + ac * (vc * denominator);
+}
+
+MeshBvh::MeshBvh(TriangleMesh mesh) : mesh_(std::move(mesh)) {
+  const std::size_t n = mesh_.triangles.size();
+  order_.resize(n);
+  std::iota(order_.begin(), order_.end(), 0u);
+  std::vector<Eigen::Vector3d> centroids(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    const auto& tri = mesh_.triangles[t];
+    centroids[t] = (mesh_.vertices_m[tri[0]] + mesh_.vertices_m[tri[1]] + mesh_.vertices_m[tri[2]]) / 3.0;
+  }
+  nodes_.reserve(n > 0 ? 2 * (n / kLeafTriangles + 1) : 1);
+  if (n == 0) {
+    nodes_.push_back(Node{});
+  } else {
+    build(0, static_cast<std::uint32_t>(n), centroids, 0);
+  }
+  pseudo_normals();
+}
+
+std::uint32_t MeshBvh::build(std::uint32_t begin, std::uint32_t end, std::vector<Eigen::Vector3d>& centroids,
+                             int depth) {
+  const auto index = static_cast<std::uint32_t>(nodes_.size());
+  nodes_.push_back(Node{});
+  Eigen::AlignedBox3d bounds, centre_bounds;
+  for (std::uint32_t i = begin; i < end; ++i) {
+    const auto& tri = mesh_.triangles[order_[i]];
+    for (std::uint32_t v : tri) bounds.extend(mesh_.vertices_m[v]);
+    centre_bounds.extend(centroids[order_[i]]);
+  }
+  nodes_[index].bounds = bounds;
+  // A leaf when few triangles are left, or all their centres coincide, or the tree is as deep as a query's stack.
+  const Eigen::Vector3d spread = centre_bounds.sizes();
+  int axis = 0;
+  spread.maxCoeff(&axis);
+  if (end - begin <= kLeafTriangles || !(spread[axis] > 0.0) || depth + 1 >= static_cast<int>(kMaxDepth)) {
+    nodes_[index].first = begin;
+    nodes_[index].count = end - begin;
+    return index;
+  }
+  // Median split along the widest spread of centres: a balanced tree, depth log2(n / 4).
+  const std::uint32_t middle = begin + (end - begin) / 2;
+  std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
+                   [&](std::uint32_t x, std::uint32_t y) { return centroids[x][axis] < centroids[y][axis]; });
+  build(begin, middle, centroids, depth + 1);
+  const std::uint32_t right = build(middle, end, centroids, depth + 1);
+  nodes_[index].first = right;
+  nodes_[index].count = 0;
+  return index;
+}
+
+void MeshBvh::pseudo_normals() {
+  const std::size_t n = mesh_.triangles.size();
+  face_normals_.resize(n);
+  edge_normals_.assign(n, {});
+  vertex_normals_.assign(mesh_.vertices_m.size(), Eigen::Vector3d::Zero());
+  for (std::size_t t = 0; t < n; ++t) {
+    const auto& tri = mesh_.triangles[t];
+    const Eigen::Vector3d& a = mesh_.vertices_m[tri[0]];
+    const Eigen::Vector3d& b = mesh_.vertices_m[tri[1]];
+    const Eigen::Vector3d& c = mesh_.vertices_m[tri[2]];
+    const Eigen::Vector3d normal = (b - a).cross(c - a);
+    face_normals_[t] = normal.norm() > 0.0 ? Eigen::Vector3d(normal.normalized()) : Eigen::Vector3d::UnitZ();
+    // The angle-weighted vertex normal: each face adds its normal times its angle at the vertex.
+    const Eigen::Vector3d* corner[3] = {&a, &b, &c};
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d u = *corner[(k + 1) % 3] - *corner[k];
+      const Eigen::Vector3d w = *corner[(k + 2) % 3] - *corner[k];
+      const double angle = std::atan2(u.cross(w).norm(), u.dot(w));
+      vertex_normals_[tri[k]] += angle * face_normals_[t];
+    }
+  }
+  for (Eigen::Vector3d& normal : vertex_normals_) {
+    if (normal.norm() > 0.0) normal.normalize();
+  }
+  // An edge's pseudo-normal is the sum of its two faces' normals (one face's at an open edge): the edges are matched
+  // by their sorted vertex pair.
+  struct Use {
+    std::uint64_t key;
+    std::uint32_t triangle;
+    std::uint8_t edge;
+  };
+  std::vector<Use> uses;
+  uses.reserve(3 * n);
+  for (std::size_t t = 0; t < n; ++t) {
+    const auto& tri = mesh_.triangles[t];
+    for (std::uint8_t e = 0; e < 3; ++e) {
+      const std::uint64_t lo = std::min(tri[e], tri[(e + 1) % 3]), hi = std::max(tri[e], tri[(e + 1) % 3]);
+      uses.push_back({(lo << 32) | hi, static_cast<std::uint32_t>(t), e});
+    }
+  }
+  std::sort(uses.begin(), uses.end(), [](const Use& x, const Use& y) { return x.key < y.key; });
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    while (j < uses.size() && uses[j].key == uses[i].key) sum += face_normals_[uses[j++].triangle];
+    if (sum.norm() > 0.0) sum.normalize();
+    for (std::size_t k = i; k < j; ++k) {
+      edge_normals_[uses[k].triangle][uses[k].edge] = sum.norm() > 0.0 ? sum : face_normals_[uses[k].triangle];
+    }
+    i = j;
+  }
+}
+
+bool MeshBvh::nearest(const Eigen::Vector3d& query_m, MeshPoint& out) const {
+  return nearest_within(query_m, std::numeric_limits<double>::infinity(), out);
+}
+
+bool MeshBvh::nearest_within(const Eigen::Vector3d& query_m, double max_distance_m, MeshPoint& out) const {
+  if (mesh_.triangles.empty()) return false;
+  double best_squared = max_distance_m * max_distance_m;
+  std::uint32_t best_triangle = 0;
+  std::uint8_t best_feature = 0;
+  Eigen::Vector3d best_point = Eigen::Vector3d::Zero();
+  bool found = false;
+  // Depth-first, nearer child first; a box no nearer than the best point so far is skipped with all it holds.
+  std::array<std::uint32_t, kMaxDepth + 1> stack{};
+  std::size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const std::uint32_t self = stack[--top];
+    const Node& node = nodes_[self];
+    if (node.bounds.squaredExteriorDistance(query_m) > best_squared) continue;
+    if (node.count > 0) {
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        const std::uint32_t t = order_[i];
+        const auto& tri = mesh_.triangles[t];
+        std::uint8_t feature = 0;
+        const Eigen::Vector3d p = closest_point_on_triangle(query_m, mesh_.vertices_m[tri[0]],
+                                                           mesh_.vertices_m[tri[1]], mesh_.vertices_m[tri[2]], feature);
+        const double squared = (query_m - p).squaredNorm();
+        if (squared <= best_squared) {
+          best_squared = squared;
+          best_point = p;
+          best_triangle = t;
+          best_feature = feature;
+          found = true;
+        }
+      }
+      continue;
+    }
+    const std::uint32_t left = self + 1, right = node.first;
+    const double to_left = nodes_[left].bounds.squaredExteriorDistance(query_m);
+    const double to_right = nodes_[right].bounds.squaredExteriorDistance(query_m);
+    // Pushed farther first, so the nearer is taken next. The depth is below kMaxDepth by construction.
+    if (to_left <= to_right) {
+      stack[top++] = right;
+      stack[top++] = left;
+    } else {
+      stack[top++] = left;
+      stack[top++] = right;
+    }
+  }
+  if (!found) return false;
+  const Eigen::Vector3d& normal = best_feature == 0   ? face_normals_[best_triangle]
+                                  : best_feature <= 3 ? edge_normals_[best_triangle][best_feature - 1]
+                                                      : vertex_normals_[mesh_.triangles[best_triangle][best_feature - 4]];
+  const double distance_m = std::sqrt(best_squared);
+  out.point_m = best_point;
+  out.normal = normal;
+  out.signed_distance_m = (query_m - best_point).dot(normal) < 0.0 ? -distance_m : distance_m;
+  out.triangle = best_triangle;
+  out.feature = best_feature;
+  return true;
+}
+
+std::size_t MeshBvh::memory_bytes() const {
+  return mesh_.vertices_m.capacity() * sizeof(Eigen::Vector3d) +
+         mesh_.triangles.capacity() * sizeof(mesh_.triangles[0]) + nodes_.capacity() * sizeof(Node) +
+         order_.capacity() * sizeof(std::uint32_t) + face_normals_.capacity() * sizeof(Eigen::Vector3d) +
+         edge_normals_.capacity() * sizeof(edge_normals_[0]) + vertex_normals_.capacity() * sizeof(Eigen::Vector3d);
+}
+
+}  // namespace impetus

@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// Nearest points on a triangle mesh, fast enough for the 1 kHz servo (docs/meshes.md): a bounding-volume hierarchy of
+// axis-aligned boxes over the triangles, built once, and a query that walks it nearest box first and skips every box
+// farther than the best point so far.
+//
+// Inside or outside: the sign of a query's distance comes from the angle-weighted pseudo-normal of the feature its
+// nearest point lies on (the triangle's normal in a face's interior, the sum of the two faces' normals on an edge,
+// the angle-weighted sum of the faces around a vertex; Bærentzen and Aanæs 2005), which is exact for a closed mesh,
+// also at edges and corners where a face normal would give the wrong side.
+//
+// The query allocates nothing and never throws; the tree holds the mesh's copy and is immutable after construction,
+// so any number of threads may query it.
+
+#include "common/mesh/triangle_mesh.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace impetus {
+
+struct MeshPoint {
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  // on the mesh
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, outward: the feature's pseudo-normal
+  double signed_distance_m = 0.0;                     // positive outside (along the normal), negative inside
+  std::uint32_t triangle = 0;
+  // Where on the triangle: 0 its interior, 1–3 the edges ab, bc, ca, 4–6 the vertices a, b, c.
+  std::uint8_t feature = 0;
+};
+
+class MeshBvh {
+ public:
+  // Builds the tree: O(n log n); the mesh should have passed check_mesh (degenerate triangles have no normal).
+  explicit MeshBvh(TriangleMesh mesh);
+
+  // The point of the mesh nearest `query_m` (mesh frame). False only for an empty mesh.
+  bool nearest(const Eigen::Vector3d& query_m, MeshPoint& out) const;
+  // The same, but only if it lies within `max_distance_m`: a finger out of reach costs a few box tests.
+  bool nearest_within(const Eigen::Vector3d& query_m, double max_distance_m, MeshPoint& out) const;
+
+  const TriangleMesh& mesh() const { return mesh_; }
+  const Eigen::AlignedBox3d& bounds() const { return nodes_.front().bounds; }
+  std::size_t node_count() const { return nodes_.size(); }
+  // Bytes the tree and its mesh hold (for docs/meshes.md's memory per triangle).
+  std::size_t memory_bytes() const;
+
+ private:
+  struct Node {
+    Eigen::AlignedBox3d bounds;
+    std::uint32_t first = 0;  // leaf: first index into order_; inner: the right child (the left is the next node)
+    std::uint32_t count = 0;  // leaf: triangles; inner: 0
+  };
+  static constexpr std::uint32_t kLeafTriangles = 4;
+  static constexpr std::size_t kMaxDepth = 64;
+
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end, std::vector<Eigen::Vector3d>& centroids, int depth);
+  void pseudo_normals();
+
+  TriangleMesh mesh_;
+  std::vector<Node> nodes_;
+  std::vector<std::uint32_t> order_;                      // triangle indices, leaf by leaf
+  std::vector<Eigen::Vector3d> face_normals_;             // unit
+  std::vector<std::array<Eigen::Vector3d, 3>> edge_normals_;  // per triangle, edges ab, bc, ca (unit)
+  std::vector<Eigen::Vector3d> vertex_normals_;           // unit, angle-weighted
+};
+
+// The point of triangle abc nearest p, and which feature it lies on (MeshPoint::feature's numbering).
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                          const Eigen::Vector3d& c, std::uint8_t& feature);
+
+}  // namespace impetus

@@ -1,0 +1,226 @@
+// SPDX-License-Identifier: Apache-2.0
+// Users' meshes (common/mesh): reading OBJ and STL, the checks a mesh must pass, mass properties against closed
+// forms, and the nearest-point tree against brute force.
+
+#include "common/mesh/mass_properties.h"
+#include "common/mesh/mesh_bvh.h"
+#include "common/mesh/mesh_check.h"
+#include "common/mesh/mesh_file.h"
+#include "common/runtime/input_error.h"
+
+#include "tests/support/allocation_counter.h"
+#include "tests/support/mesh_shapes.h"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+using namespace impetus;
+using impetus::test::box_mesh;
+using impetus::test::icosphere;
+
+namespace {
+
+std::filesystem::path scratch() {
+  const std::filesystem::path dir = std::filesystem::path(IMPETUS_BINARY_DIR) / "test-output" / "mesh";
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST_CASE("mesh: a box's mass, centre and inertia are the closed forms, wherever it sits") {
+  const Eigen::Vector3d size(0.1, 0.2, 0.3), centre(1.0, -2.0, 3.0);
+  const MassProperties p = mass_properties(box_mesh(size, centre), 500.0);
+  const double mass = 500.0 * size.prod();
+  CHECK(p.volume_m3 == Approx(size.prod()).epsilon(1e-12));
+  CHECK(p.mass_kg == Approx(mass).epsilon(1e-12));
+  CHECK((p.centre_of_mass_m - centre).norm() < 1e-12);
+  // I = m/12·(b² + c²), … about the centre; no products.
+  CHECK(p.inertia_about_com_kgm2(0, 0) == Approx(mass / 12 * (0.04 + 0.09)).epsilon(1e-10));
+  CHECK(p.inertia_about_com_kgm2(1, 1) == Approx(mass / 12 * (0.01 + 0.09)).epsilon(1e-10));
+  CHECK(p.inertia_about_com_kgm2(2, 2) == Approx(mass / 12 * (0.01 + 0.04)).epsilon(1e-10));
+  CHECK(std::abs(p.inertia_about_com_kgm2(0, 1)) < 1e-12);
+  CHECK(std::abs(p.inertia_about_com_kgm2(1, 2)) < 1e-12);
+}
+
+TEST_CASE("mesh: a turned box's inertia is R·I·Rᵀ, and a sphere's tends to 2/5·m·r²") {
+  TriangleMesh box = box_mesh({0.1, 0.2, 0.3});
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (Eigen::Vector3d& v : box.vertices_m) v = r * v;
+  const MassProperties turned = mass_properties(box, 1000.0);
+  const MassProperties straight = mass_properties(box_mesh({0.1, 0.2, 0.3}), 1000.0);
+  CHECK((turned.inertia_about_com_kgm2 - r * straight.inertia_about_com_kgm2 * r.transpose()).norm() <
+        1e-12 * straight.inertia_about_com_kgm2.norm());
+
+  const double radius = 0.05;
+  const MassProperties ball = mass_properties(icosphere(radius, 5), 1000.0);  // 20 480 triangles
+  const double volume = 4.0 / 3.0 * M_PI * radius * radius * radius;
+  // An inscribed polyhedron: a little less than the sphere, by the square of the edge over the radius.
+  CHECK(ball.volume_m3 < volume);
+  CHECK(ball.volume_m3 == Approx(volume).epsilon(2e-3));
+  CHECK(ball.centre_of_mass_m.norm() < 1e-15);
+  const double expected = 0.4 * ball.mass_kg * radius * radius;
+  for (int a = 0; a < 3; ++a) CHECK(ball.inertia_about_com_kgm2(a, a) == Approx(expected).epsilon(3e-3));
+}
+
+TEST_CASE("mesh: the checks find open, shared and wound-against edges, and degenerate triangles, by triangle") {
+  CHECK(check_mesh(box_mesh({1, 1, 1})).closed());
+  CHECK(check_mesh(icosphere(1.0, 2)).closed());
+  CHECK(check_mesh(icosphere(1.0, 2)).signed_volume_m3 > 0.0);
+
+  TriangleMesh open = box_mesh({1, 1, 1});
+  open.triangles.erase(open.triangles.begin() + 4);
+  MeshReport report = check_mesh(open);
+  CHECK(report.open_edges == 3);
+  CHECK(report.first_open >= 0);
+  CHECK_FALSE(report.closed());
+
+  TriangleMesh wound = box_mesh({1, 1, 1});
+  std::swap(wound.triangles[7][1], wound.triangles[7][2]);
+  report = check_mesh(wound);
+  CHECK(report.misoriented_edges == 3);
+  CHECK(report.first_misoriented >= 0);
+
+  TriangleMesh doubled = box_mesh({1, 1, 1});
+  doubled.triangles.push_back(doubled.triangles[2]);
+  CHECK(check_mesh(doubled).nonmanifold_edges == 3);
+
+  TriangleMesh flat = box_mesh({1, 1, 1});
+  flat.vertices_m.push_back(Eigen::Vector3d(5, 5, 5));
+  flat.triangles.push_back({8, 8, 1});
+  report = check_mesh(flat);
+  CHECK(report.degenerate_triangles == 1);
+  CHECK(report.first_degenerate == 12);
+}
+
+TEST_CASE("mesh: a moving body needs a closed mesh with a volume, one wound inside out is turned around") {
+  bool flipped = false;
+  TriangleMesh inside_out = box_mesh({0.1, 0.1, 0.1});
+  flip_winding(inside_out);
+  const MeshReport report = require_usable(inside_out, true, "cube.obj", flipped);
+  CHECK(flipped);
+  CHECK(report.signed_volume_m3 == Approx(1e-3));
+  CHECK(mass_properties(inside_out, 1000.0).mass_kg == Approx(1.0));
+
+  TriangleMesh open = box_mesh({0.1, 0.1, 0.1});
+  open.triangles.pop_back();
+  CHECK_THROWS_WITH(require_usable(open, true, "cup.obj", flipped),
+                    Catch::Contains("cup.obj: triangle") && Catch::Contains("open edge"));
+  CHECK_NOTHROW(require_usable(open, false, "terrain.obj", flipped));  // a static mesh may be open
+
+  TriangleMesh flat;
+  flat.vertices_m = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  flat.triangles = {{0, 1, 2}, {0, 2, 1}};
+  CHECK_THROWS_WITH(require_usable(flat, true, "sheet.stl", flipped),
+                    Catch::Contains("sheet.stl") && Catch::Contains("no volume"));
+}
+
+TEST_CASE("mesh: OBJ, ASCII STL and binary STL read to the same welded mesh, scaled") {
+  const TriangleMesh sphere = icosphere(0.04, 2);
+  const std::filesystem::path dir = scratch();
+  test::write_obj(sphere, (dir / "sphere.obj").string());
+  test::write_stl_ascii(sphere, (dir / "sphere_ascii.stl").string());
+  test::write_stl_binary(sphere, (dir / "sphere_binary.stl").string());
+  for (const char* name : {"sphere.obj", "sphere_ascii.stl", "sphere_binary.stl"}) {
+    INFO(name);
+    const TriangleMesh read = load_mesh((dir / name).string());
+    CHECK(read.triangles.size() == sphere.triangles.size());
+    CHECK(read.vertices_m.size() == sphere.vertices_m.size());  // STL's 3 vertices a triangle welded back
+    const MeshReport report = check_mesh(read);
+    CHECK(report.closed());
+    CHECK(report.signed_volume_m3 == Approx(check_mesh(sphere).signed_volume_m3).epsilon(1e-5));
+  }
+  // Millimetres to metres.
+  const TriangleMesh scaled = load_mesh((dir / "sphere.obj").string(), Eigen::Vector3d::Constant(0.001));
+  CHECK(check_mesh(scaled).signed_volume_m3 == Approx(check_mesh(sphere).signed_volume_m3 * 1e-9).epsilon(1e-5));
+  // A mirror (one negative scale) keeps the winding outward.
+  const TriangleMesh mirrored = load_mesh((dir / "sphere.obj").string(), Eigen::Vector3d(-1, 1, 1));
+  CHECK(check_mesh(mirrored).signed_volume_m3 > 0.0);
+}
+
+TEST_CASE("mesh: a missing, foreign, empty or out-of-range file is an error naming it") {
+  const std::filesystem::path dir = scratch();
+  CHECK_THROWS_WITH(load_mesh((dir / "nothing.obj").string()),
+                    Catch::Contains("nothing.obj") && Catch::Contains("cannot open"));
+  std::ofstream(dir / "words.stl") << "this is not a mesh at all\n";
+  CHECK_THROWS_WITH(load_mesh((dir / "words.stl").string()), Catch::Contains("words.stl"));
+  std::ofstream(dir / "points.obj") << "v 0 0 0\nv 1 0 0\n";
+  CHECK_THROWS_WITH(load_mesh((dir / "points.obj").string()), Catch::Contains("points.obj"));
+  std::ofstream(dir / "far.obj") << "v 0 0 0\nv 1 0 0\nv 0 5000 0\nf 1 2 3\n";
+  CHECK_THROWS_WITH(load_mesh((dir / "far.obj").string()),
+                    Catch::Contains("far.obj: vertex 3") && Catch::Contains("scale"));
+}
+
+TEST_CASE("mesh: the tree's nearest point, distance and side agree with brute force, at faces, edges and corners") {
+  const TriangleMesh sphere = icosphere(0.05, 3);  // 1 280 triangles
+  const MeshBvh tree(sphere);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(-0.08, 0.08);
+  int inside = 0;
+  for (int q = 0; q < 2000; ++q) {
+    const Eigen::Vector3d p(coordinate(random), coordinate(random), coordinate(random));
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& t : sphere.triangles) {
+      std::uint8_t feature = 0;
+      const Eigen::Vector3d c = closest_point_on_triangle(p, sphere.vertices_m[t[0]], sphere.vertices_m[t[1]],
+                                                          sphere.vertices_m[t[2]], feature);
+      best = std::min(best, (p - c).norm());
+    }
+    MeshPoint found;
+    REQUIRE(tree.nearest(p, found));
+    CHECK(std::abs(found.signed_distance_m) == Approx(best).margin(1e-15));
+    // Convex: inside exactly when behind every face's plane.
+    bool behind_all = true;
+    for (const auto& t : sphere.triangles) {
+      const Eigen::Vector3d& a = sphere.vertices_m[t[0]];
+      const Eigen::Vector3d n = (sphere.vertices_m[t[1]] - a).cross(sphere.vertices_m[t[2]] - a);
+      behind_all = behind_all && (p - a).dot(n) <= 0.0;
+    }
+    inside += behind_all;
+    CHECK((found.signed_distance_m < 0.0) == behind_all);
+    CHECK(found.normal.norm() == Approx(1.0));
+  }
+  CHECK(inside > 100);  // the queries covered the inside too
+  // Just outside and inside a vertex and an edge: the side from the pseudo-normal, not a face's.
+  const Eigen::Vector3d vertex = sphere.vertices_m[0];
+  const Eigen::Vector3d edge_middle = 0.5 * (sphere.vertices_m[sphere.triangles[0][0]] +
+                                             sphere.vertices_m[sphere.triangles[0][1]]);
+  for (const Eigen::Vector3d& point : {vertex, edge_middle}) {
+    MeshPoint out, in;
+    REQUIRE(tree.nearest(point * 1.001, out));
+    REQUIRE(tree.nearest(point * 0.999, in));
+    CHECK(out.signed_distance_m > 0.0);
+    CHECK(in.signed_distance_m < 0.0);
+  }
+  MeshPoint none;
+  CHECK_FALSE(tree.nearest_within(Eigen::Vector3d(0.2, 0, 0), 0.1, none));
+  CHECK(tree.nearest_within(Eigen::Vector3d(0.1, 0, 0), 0.06, none));
+}
+
+#if IMPETUS_COUNT_ALLOCATIONS
+TEST_CASE("mesh: a nearest-point query allocates nothing") {
+  const MeshBvh tree(icosphere(0.05, 4));
+  MeshPoint out;
+  double sum = 0.0;
+  impetus::test::start_counting_allocations();
+  for (int q = 0; q < 10000; ++q) {
+    tree.nearest(Eigen::Vector3d(0.06 * std::sin(q * 0.01), 0.06 * std::cos(q * 0.013), 0.01), out);
+    sum += out.signed_distance_m;
+  }
+  CHECK(impetus::test::stop_counting_allocations() == 0);
+  CHECK(std::isfinite(sum));
+}
+#endif
+
+TEST_CASE("mesh: the hash is the same for the same mesh and differs when a vertex moves") {
+  const TriangleMesh a = icosphere(0.05, 2);
+  TriangleMesh b = a;
+  CHECK(mesh_hash(a) == mesh_hash(b));
+  b.vertices_m[5].x() += 1e-12;
+  CHECK(mesh_hash(a) != mesh_hash(b));
+}
