@@ -29,7 +29,8 @@ endforeach()
 foreach(dir common world_manager haptic_controller spidar_sim loop)
   # dds_codec.h and dds_entities.h need Cyclone's headers and the idlc-generated types, which the package does not ship.
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/impetus/${dir} COMPONENT dev
-          FILES_MATCHING PATTERN "*.h" PATTERN "dds_codec.h" EXCLUDE PATTERN "dds_entities.h" EXCLUDE)
+          FILES_MATCHING PATTERN "*.h" PATTERN "dds_codec.h" EXCLUDE PATTERN "dds_entities.h" EXCLUDE
+          PATTERN "mesh" EXCLUDE)  # users' meshes: not yet a part of the installed library (docs/meshes.md)
 endforeach()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${IMPETUS_INSTALL_DATADIR}/scenes
         FILES_MATCHING PATTERN "*.json")

@@ -203,3 +203,36 @@ export async function view(page) { return page.evaluate(() => window.impetusView
   framesReceived: window.impetusView.framesReceived, latest: window.impetusView.latest,
   fps: window.impetusView.fps, renderedFrames: window.impetusView.renderedFrames,
   rejectedFrames: window.impetusView.rejectedFrames })) : null); }
+
+// Runs case `which` of `cases` (each an async function of the processes and the browser) as a test program: prints
+// what it checks, and on a failure the reason and each process's last stderr; kills what it started and removes the
+// shared-memory segments named `shm`*; exits 0 if every check held, 1 if not, 2 for an unknown case.
+export async function runCase(program, cases, which, build, outDir, shm) {
+  if (!cases[which]) {
+    console.error(`${program}: --case must be one of ${Object.keys(cases).join(", ")}`);
+    process.exit(2);
+  }
+  const procs = new Processes(build, outDir);
+  let browser;
+  let status = 0;
+  try {
+    browser = await launchBrowser();
+    console.log(`${program.replace("_", " ")} '${which}':`);
+    await cases[which](procs, browser);
+    console.log("passed");
+  } catch (error) {
+    console.log(`FAILED: ${error instanceof Failure ? error.message : error.stack}`);
+    for (const child of procs.children) {
+      const file = path.join(outDir, `${child.name}.log`);
+      if (fs.existsSync(file)) console.log(`--- ${child.name} stderr:\n${fs.readFileSync(file, "utf8").slice(-2000)}`);
+    }
+    status = 1;
+  } finally {
+    procs.killAll();
+    if (browser) await browser.close();
+    for (const name of fs.readdirSync("/dev/shm").filter((n) => n.startsWith(shm))) {
+      fs.rmSync(path.join("/dev/shm", name), { force: true });
+    }
+  }
+  process.exit(status);
+}

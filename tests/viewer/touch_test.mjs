@@ -12,7 +12,7 @@ import net from "node:net";
 import path from "node:path";
 import crypto from "node:crypto";
 import { fileURLToPath } from "node:url";
-import { Failure, Processes, check, launchBrowser, readCsv, sleep, waitFor } from "./browser.mjs";
+import { Failure, check, readCsv, runCase, sleep, waitFor } from "./browser.mjs";
 
 const source = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../..");
 const args = process.argv.slice(2);
@@ -304,30 +304,4 @@ function rawTouchTake(port, token) {
 }
 
 const cases = { drag, letgo, control };
-if (!cases[which]) {
-  console.error(`touch_test: --case must be one of ${Object.keys(cases).join(", ")}`);
-  process.exit(2);
-}
-const procs = new Processes(build, outDir);
-let browser;
-let status = 0;
-try {
-  browser = await launchBrowser();
-  console.log(`touch test '${which}':`);
-  await cases[which](procs, browser);
-  console.log("passed");
-} catch (error) {
-  console.log(`FAILED: ${error instanceof Failure ? error.message : error.stack}`);
-  for (const child of procs.children) {
-    const file = path.join(outDir, `${child.name}.log`);
-    if (fs.existsSync(file)) console.log(`--- ${child.name} stderr:\n${fs.readFileSync(file, "utf8").slice(-2000)}`);
-  }
-  status = 1;
-} finally {
-  procs.killAll();
-  if (browser) await browser.close();
-  for (const name of fs.readdirSync("/dev/shm").filter((n) => n.startsWith(shm))) {
-    fs.rmSync(path.join("/dev/shm", name), { force: true });
-  }
-}
-process.exit(status);
+await runCase("touch_test", cases, which, build, outDir, shm);

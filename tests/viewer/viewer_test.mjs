@@ -11,8 +11,8 @@ import net from "node:net";
 import path from "node:path";
 import { fileURLToPath } from "node:url";
 import {
-  Failure, Processes, angleDeg, changedPixels, check, colourCount, csvPose, decodePng, distance, launchBrowser,
-  cpuSeconds, readCsv, sleep, view, waitFor,
+  Failure, angleDeg, changedPixels, check, colourCount, csvPose, decodePng, distance, cpuSeconds, readCsv, runCase,
+  sleep, view, waitFor,
 } from "./browser.mjs";
 
 const source = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../..");
@@ -353,32 +353,4 @@ async function badInput(procs, browser) {
 }
 
 const cases = { live, replay, bodies, kill, "bad-input": badInput };
-if (!cases[which]) {
-  console.error(`viewer_test: --case must be one of ${Object.keys(cases).join(", ")}`);
-  process.exit(2);
-}
-const procs = new Processes(build, outDir);
-let browser;
-let status = 0;
-try {
-  browser = await launchBrowser();
-  console.log(`viewer test '${which}':`);
-  await cases[which](procs, browser);
-  console.log("passed");
-} catch (error) {
-  console.log(`FAILED: ${error instanceof Failure ? error.message : error.stack}`);
-  for (const child of procs.children) {
-    const file = path.join(outDir, `${child.name}.log`);
-    if (fs.existsSync(file)) console.log(`--- ${child.name} stderr:\n${fs.readFileSync(file, "utf8").slice(-2000)}`);
-  }
-  status = 1;
-} finally {
-  procs.killAll();
-  if (browser) await browser.close();
-  for (const suffix of [".world", ".device", ".view"]) {
-    for (const name of fs.readdirSync("/dev/shm").filter((n) => n.startsWith(shm) && n.endsWith(suffix))) {
-      fs.rmSync(path.join("/dev/shm", name), { force: true });
-    }
-  }
-}
-process.exit(status);
+await runCase("viewer_test", cases, which, build, outDir, shm);
