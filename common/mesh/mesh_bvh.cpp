@@ -158,11 +158,22 @@ bool MeshBvh::nearest(const Eigen::Vector3d& query_m, MeshPoint& out) const {
 
 bool MeshBvh::nearest_within(const Eigen::Vector3d& query_m, double max_distance_m, MeshPoint& out) const {
   if (mesh_.triangles.empty()) return false;
-  double best_squared = max_distance_m * max_distance_m;
-  std::uint32_t best_triangle = 0;
-  std::uint8_t best_feature = 0;
-  Eigen::Vector3d best_point = Eigen::Vector3d::Zero();
-  bool found = false;
+  return search(query_m, max_distance_m * max_distance_m, false, Eigen::Vector3d::Zero(), 0, 0, out);
+}
+
+bool MeshBvh::nearest_from(const Eigen::Vector3d& query_m, const MeshPoint& hint, MeshPoint& out) const {
+  if (mesh_.triangles.empty()) return false;
+  if (hint.triangle >= mesh_.triangles.size()) return nearest(query_m, out);
+  const auto& tri = mesh_.triangles[hint.triangle];
+  std::uint8_t feature = 0;
+  const Eigen::Vector3d p = closest_point_on_triangle(query_m, mesh_.vertices_m[tri[0]], mesh_.vertices_m[tri[1]],
+                                                     mesh_.vertices_m[tri[2]], feature);
+  return search(query_m, (query_m - p).squaredNorm(), true, p, hint.triangle, feature, out);
+}
+
+bool MeshBvh::search(const Eigen::Vector3d& query_m, double best_squared, bool seeded, Eigen::Vector3d best_point,
+                     std::uint32_t best_triangle, std::uint8_t best_feature, MeshPoint& out) const {
+  bool found = seeded;
   // Depth-first, nearer child first; a box no nearer than the best point so far is skipped with all it holds.
   std::array<std::uint32_t, kMaxDepth + 1> stack{};
   std::size_t top = 0;

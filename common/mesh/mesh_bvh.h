@@ -41,6 +41,9 @@ class MeshBvh {
   bool nearest(const Eigen::Vector3d& query_m, MeshPoint& out) const;
   // The same, but only if it lies within `max_distance_m`: a finger out of reach costs a few box tests.
   bool nearest_within(const Eigen::Vector3d& query_m, double max_distance_m, MeshPoint& out) const;
+  // The same answer as nearest(), started from the triangle of `hint` (the last tick's answer): a point that moved
+  // little since has its nearest point on or beside that triangle, so the walk skips nearly every box at once.
+  bool nearest_from(const Eigen::Vector3d& query_m, const MeshPoint& hint, MeshPoint& out) const;
 
   const TriangleMesh& mesh() const { return mesh_; }
   const Eigen::AlignedBox3d& bounds() const { return nodes_.front().bounds; }
@@ -57,6 +60,9 @@ class MeshBvh {
   static constexpr std::uint32_t kLeafTriangles = 4;
   static constexpr std::size_t kMaxDepth = 64;
 
+  // The walk: from a best squared distance (and, if `seeded`, the point, triangle and feature that give it).
+  bool search(const Eigen::Vector3d& query_m, double best_squared, bool seeded, Eigen::Vector3d best_point,
+              std::uint32_t best_triangle, std::uint8_t best_feature, MeshPoint& out) const;
   std::uint32_t build(std::uint32_t begin, std::uint32_t end, std::vector<Eigen::Vector3d>& centroids, int depth);
   void pseudo_normals();
 

@@ -197,6 +197,20 @@ TEST_CASE("mesh: the tree's nearest point, distance and side agree with brute fo
     CHECK(out.signed_distance_m > 0.0);
     CHECK(in.signed_distance_m < 0.0);
   }
+  // Started from the last answer along a sliding path, the same distance and side as from scratch.
+  MeshPoint last;
+  REQUIRE(tree.nearest(Eigen::Vector3d(0.05, 0, 0), last));
+  for (int q = 1; q < 3000; ++q) {
+    const double s = q * 2e-3;
+    const Eigen::Vector3d p = (0.047 + 0.006 * std::sin(7 * s)) *
+                              Eigen::Vector3d(std::cos(s) * std::cos(0.3 * s), std::sin(s) * std::cos(0.3 * s),
+                                              std::sin(0.3 * s));
+    MeshPoint scratch_answer, hinted;
+    REQUIRE(tree.nearest(p, scratch_answer));
+    REQUIRE(tree.nearest_from(p, last, hinted));
+    CHECK(hinted.signed_distance_m == Approx(scratch_answer.signed_distance_m).margin(1e-15));
+    last = hinted;
+  }
   MeshPoint none;
   CHECK_FALSE(tree.nearest_within(Eigen::Vector3d(0.2, 0, 0), 0.1, none));
   CHECK(tree.nearest_within(Eigen::Vector3d(0.1, 0, 0), 0.06, none));
