@@ -261,9 +261,13 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
     }
   }
   for (std::uint32_t c = 0; c < body.contact_count; ++c) {
+    body.friction_limit[c] = 0.0;
+    body.friction_used[c].setZero();
+    body.corner_friction[c] = {};
     if (!(normal_impulse[c] > 0.0)) continue;
     const Eigen::Vector3d& n = body.contact_normal[c];
     const double limit = body.contact_friction[c] * normal_impulse[c];
+    body.friction_limit[c] = limit;
     if (body.sphere_radius_m > 0.0 && body.inverse_mass_per_kg > 0.0) {
       // At the contact point (header): an impulse |j| against the slip lowers it by k·|j|,
       // k = 1 + m·t·((I⁻¹(c × t)) × c), the sphere's effective inverse mass along t at c (7/2 for a solid ball).
@@ -282,12 +286,16 @@ void LocalDynamics::apply_drift(LocalBody& body, double h_s) const {
       continue;
     }
     if (body.rests_on_corners && body.inverse_mass_per_kg > 0.0) {
-      apply_box_friction(body, n, limit);
+      apply_box_friction(body, n, limit, body.corner_friction[c]);
       continue;
     }
     const Eigen::Vector3d slip = v - v.dot(n) * n;
     const double slip_mps = slip.norm();
-    if (slip_mps > 0.0) v -= std::min(slip_mps, limit) / slip_mps * slip;
+    if (slip_mps > 0.0) {
+      const Eigen::Vector3d j = -std::min(slip_mps, limit) / slip_mps * slip;
+      v += j;
+      body.friction_used[c] = j;
+    }
   }
   share_with_neighbours(body);
   // Rotation is otherwise left free: supports do not stop a ball rolling, and where they would stop a box tipping the model
@@ -326,7 +334,8 @@ double LocalDynamics::hold_box_corners(LocalBody& body, const Eigen::Vector3d& n
   return accumulated[0] + accumulated[1] + accumulated[2] + accumulated[3];
 }
 
-void LocalDynamics::apply_box_friction(LocalBody& body, const Eigen::Vector3d& n, double limit) {
+void LocalDynamics::apply_box_friction(LocalBody& body, const Eigen::Vector3d& n, double limit,
+                                       std::array<std::array<double, 2>, 4>& accumulated) {
   const std::array<Eigen::Vector3d, 4> corners = support_corners(body, n);
   // Spin about n per unit of angular impulse about n, per unit mass: m·(n·I⁻¹·n).
   const double spin_per_impulse = n.dot(body.inverse_inertia_world * n) / body.inverse_mass_per_kg;
@@ -339,7 +348,6 @@ void LocalDynamics::apply_box_friction(LocalBody& body, const Eigen::Vector3d& n
   // corners in diagonal pairs and the order reversed on alternate passes, so a box that only slides gets no spin from
   // the order.
   constexpr std::array<int, 4> kOrder{0, 3, 1, 2};
-  std::array<std::array<double, 2>, 4> accumulated{};
   const double corner_limit = 0.25 * limit;
   for (int pass = 0; pass < kContactPasses; ++pass) {
     for (int i = 0; i < 4; ++i) {
@@ -357,6 +365,27 @@ void LocalDynamics::apply_box_friction(LocalBody& body, const Eigen::Vector3d& n
         w += spin_per_impulse * lever * j * n;
       }
     }
+  }
+}
+
+void LocalDynamics::hold_after_push(LocalBody& body) {
+  if (!(body.inverse_mass_per_kg > 0.0) || body.sphere_radius_m > 0.0) return;
+  Eigen::Vector3d& v = body.velocity_mps;
+  for (std::uint32_t c = 0; c < body.contact_count; ++c) {
+    const double limit = body.friction_limit[c];
+    if (!(limit > 0.0)) continue;
+    const Eigen::Vector3d& n = body.contact_normal[c];
+    if (body.rests_on_corners) {
+      apply_box_friction(body, n, limit, body.corner_friction[c]);
+      continue;
+    }
+    const Eigen::Vector3d slip = v - v.dot(n) * n;
+    const double slip_mps = slip.norm();
+    const double left = limit - body.friction_used[c].norm();
+    if (!(slip_mps > 0.0) || !(left > 0.0)) continue;
+    const Eigen::Vector3d j = -std::min(slip_mps, left) / slip_mps * slip;
+    v += j;
+    body.friction_used[c] += j;
   }
 }
 
@@ -419,6 +448,7 @@ void LocalDynamics::apply_impulse(std::int32_t object_id, const Eigen::Vector3d&
   // Paper §3.5 at the haptic rate: Δv = J/m, Δω = I⁻¹·L.
   body->velocity_mps += body->inverse_mass_per_kg * impulse_Ns;
   body->angular_velocity_radps += body->inverse_inertia_world * angular_impulse_Nms;
+  hold_after_push(*body);
   share_with_neighbours(*body);
   body->pushed_Ns += impulse_Ns;
   body->touched = true;

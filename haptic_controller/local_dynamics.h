@@ -42,10 +42,17 @@
 //       finger was let go 3 ms after the world's edge instead of at once.
 //     ω otherwise free (a rolling ball keeps its spin): a turning body keeps its angular momentum L = I·ω while
 //     its inertia turns with it, I ← R·I·Rᵀ each tick, and ω = I⁻¹·L (torque-free precession, as the engines have it)
+//     a push later in the substep (below) meets what is left of each support's friction this substep: the tangential
+//     impulse a support has given since the substep began stays within μ·P, as in the world, where a substep's
+//     contact forces and the finger's push are solved together. Without it a body held against the finger on a
+//     slope crept between the substeps' friction (0.05 mm a 5 ms substep at 1.9 N on 0.5 kg), and under delay the
+//     replayed pushes carried it 0.5 mm away from where the world held it, so the finger pressed too little and the
+//     cube slid through it in the world (docs/latency.md, "Catch")
 //   each tick, before the planes are rendered:
 //     u ← u + v·Δt                                              CoM displacement since the frame
 //   after the force of the tick (§3.4 share J, angular share L about the CoM):
 //     v ← v + J/m;  ω ← ω + I⁻¹·L                               (ω: the surface velocity friction sees, §6.2)
+//     then each support's friction, from what is left of its substep's μ·P (above)
 //
 // A frame's state is the world's state *now* (the world integrates the impulses of the period just rendered, placed
 // at the times they were rendered, world.h), so the planes are rendered at the frame's plane moved with the model:
@@ -141,6 +148,11 @@ struct LocalBody {
   Shape shape;
   Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
   bool rests_on_corners = false;
+  // The friction of the current substep, per support: its Coulomb limit μ·P and what it has used, so a push later in
+  // the substep meets the rest of it (header, "the supports ... after each tick's push").
+  std::array<double, kMaxLocalContacts> friction_limit{};
+  std::array<Eigen::Vector3d, kMaxLocalContacts> friction_used{};                       // a body without corners
+  std::array<std::array<std::array<double, 2>, 4>, kMaxLocalContacts> corner_friction{};  // a box: per corner, per tangent
   bool touched = false;       // the finger pushed it in the last tick
   Eigen::Vector3d pushed_Ns = Eigen::Vector3d::Zero();  // Σ J since the frame (diagnostics, tests)
 
@@ -248,7 +260,10 @@ class LocalDynamics final : public PlaneMotion {
   void apply_drift(LocalBody& body, double h_s) const;
   // Coulomb friction of a box's support with normal n at the corners of the face it rests on (header), `limit` the
   // support's friction impulse per unit mass, μ·P.
-  static void apply_box_friction(LocalBody& body, const Eigen::Vector3d& n, double limit);
+  static void apply_box_friction(LocalBody& body, const Eigen::Vector3d& n, double limit,
+                                 std::array<std::array<double, 2>, 4>& accumulated);
+  // After a push within a substep: each support's friction takes what is left of its substep's limit.
+  static void hold_after_push(LocalBody& body);
   // The four corners of the face a box rests on against a support of normal n, from the centre of mass (world frame).
   static std::array<Eigen::Vector3d, 4> support_corners(const LocalBody& body, const Eigen::Vector3d& n);
   // A holding support keeps each of those corners from moving into it (header); returns the normal impulse it took,
