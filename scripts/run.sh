@@ -4,6 +4,7 @@
 # DIR, prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
 #
 #   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ... | --device web[:FILE.json])
+#                  [--device spidar:FILE.json]
 #                  [--user SPEC ...] [--coupling impulse|position|local] [--passivity on|off]
 #                  [--rate HZ] [--phase TICKS] [--substeps N] [--engine ode|bullet]
 #                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet] [--no-logs]
@@ -18,6 +19,7 @@
 # --view-wait S the finger starts S seconds after the world, time to open the page. Afterwards
 # `build/viewer/viewer --replay DIR` plays the trial back.
 #
+# --device spidar:FILE.json: the SPIDAR's geometry from a device file, for the haptic controller and spidar_sim alike.
 # --device web: a person steers the finger from the viewer's page instead of a trajectory (a simulated hand in the
 # haptic controller, no spidar_sim): real time, the viewer on, and the trial runs until Ctrl-C (or --duration). It
 # prints the address to open; FILE.json sets the hand (docs/touch.md).
@@ -29,7 +31,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${IMPETUS_BUILD_DIR:-$root/build}"
 
-usage() { sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '3,30p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "run.sh: $*" >&2; exit 2; }
 
 view=0 view_listen="127.0.0.1:8080" view_wait=0 logs=1
@@ -69,8 +71,8 @@ done
 web=0
 case "$device" in
   web|web:*) web=1 ;;
-  spidar) ;;
-  *) die "--device must be web or web:FILE.json (a trajectory plays the simulated SPIDAR without it), not '$device'" ;;
+  spidar|spidar:?*) ;;
+  *) die "--device must be spidar, spidar:FILE.json, web or web:FILE.json, not '$device'" ;;
 esac
 if ((web)); then
   [ -z "$trajectory" ] && ((${#fingers[@]} == 0 && ${#users[@]} == 0)) || \
@@ -116,9 +118,9 @@ add_log world_args world
 [ -n "$passivity" ] && world_args+=(--passivity "$passivity")
 haptic_args=(--clock "$clock" --shm "$shm" --summary "$out/haptic.json" "${haptic_extra[@]}")
 [ -n "$duration" ] && haptic_args+=(--duration "$duration")
-((web)) && haptic_args+=(--device "$device")
+haptic_args+=(--device "$device")
 add_log haptic_args haptic
-device_args=(--clock "$clock" --shm "$shm" --summary "$out/device.json")
+device_args=(--clock "$clock" --shm "$shm" --summary "$out/device.json" --device "$device")
 add_log device_args device
 if ((${#fingers[@]})); then
   haptic_args+=(--fingers "${#fingers[@]}")
