@@ -3,17 +3,15 @@
 // opens the world link and runs a HapticNode on them; writes the haptic half of summary.json at exit.
 
 #include "common/link/dds/open_world_link.h"
-#include "common/link/shm/names.h"
-#include "common/link/shm/shm_device_port.h"
 #include "common/runtime/cli.h"
 #include "haptic_controller/device/device_registry.h"
+#include "haptic_controller/device/hosted_device.h"
 #include "haptic_controller/haptic_node.h"
 
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 int main(int argc, char** argv) {
   using namespace impetus;
@@ -68,38 +66,22 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("--world-shm names a shared-memory world link; with --link dds the world is found "
                                   "by --dds-domain and --dds-partition");
     }
-    std::vector<std::unique_ptr<ShmDevicePortHost>> ports;
-    std::vector<DevicePortHost*> port_list;
-    std::optional<AssembledDevice> device;
-    std::string where;
-    if (!device_type->uses_device_ports()) {
-      // A device in this process (the web hand) first: it refuses a clock it cannot run on before anything waits.
-      if (fingers != 1) {
-        throw std::invalid_argument("--device " + device_spec + " has one finger, not --fingers " +
-                                    std::to_string(fingers));
-      }
-      device.emplace(*device_type, shm, options.clock);
-      where = device_type->description().source + ", touch port '" + touch_port_name(shm) + "' (viewer --shm " + shm +
-              " --touch)";
-    }
+    std::optional<HostedDevice> device;
+    const auto host_device = [&] {
+      device.emplace(*device_type, device_spec, shm, options.clock, 1.0 / options.rate_hz, options.haptic_session,
+                     fingers);
+    };
+    // A device in this process (the web hand) first: it refuses a clock it cannot run on before anything waits.
+    if (!device_type->uses_device_ports()) host_device();
     // The world link before the device ports: a device starts its motion when its port appears, and the servo can
     // render only once the world serves it (over DDS that takes a discovery). The device ports stay in shared memory
     // on this host either way, one per finger.
     const std::unique_ptr<WorldLinkClient> world = open_world_link_client(
         link_options, world_shm.empty() ? shm : world_shm, options.clock, world_wait_s, fingers);
-    if (device_type->uses_device_ports()) {
-      for (unsigned k = 0; k < fingers; ++k) {
-        ports.push_back(std::make_unique<ShmDevicePortHost>(shm, options.clock, 1.0 / options.rate_hz,
-                                                            device_type->description(), k));
-        port_list.push_back(ports.back().get());
-      }
-      device.emplace(*device_type, port_list, options.clock, options.haptic_session);
-      where = "device port '" + ports[0]->name() + "'" +
-              (fingers > 1 ? " and " + std::to_string(fingers - 1) + " more, one per finger" : "");
-    }
+    if (!device) host_device();
     HapticNode node(options, *world, device->device());
     std::fprintf(stderr, "haptic_controller: %.0f Hz, %s clock, world at %.1f Hz, %s\n", options.rate_hz,
-                 to_string(options.clock), world->info().world_rate_hz, where.c_str());
+                 to_string(options.clock), world->info().world_rate_hz, device->where().c_str());
     const int status = node.run();
     nlohmann::json summary = node.summary();
     if (nlohmann::json link = link_summary(*world, link_options); !link.is_null()) summary["haptic"]["dds"] = link;
