@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/god_object.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 namespace impetus {
 namespace {
 
@@ -18,39 +22,54 @@ double clearance_m(const ContactPlane& plane, const Eigen::Vector3d& finger_m) {
 const PlaneSet& GodObject::armed_planes(const PlaneSet& planes, const Eigen::Vector3d& finger_m) {
   if (session_starting_ && planes.count > 0) {
     session_starting_ = false;
-    for (std::uint32_t k = 0; k < planes.count && disarmed_count_ < static_cast<int>(kMaxPlanes); ++k) {
-      // Only a resting object is disarmed: one that moves onto the finger pushes it out like any moving plane.
+    for (std::uint32_t k = 0; k < planes.count && sunk_count_ < static_cast<int>(kMaxPlanes); ++k) {
+      // Only a resting object is set back: one that moves onto the finger pushes it out like any moving plane.
       const ContactPlane& plane = planes.planes[k];
       const double approach_mps = plane.surface_velocity_mps(plane.point_m).dot(plane.normal);
-      if (clearance_m(plane, finger_m) < 0.0 && clearance_m(plane, session_start_finger_m_) < 0.0 &&
-          approach_mps <= kRestingSpeed_mps) {
-        disarmed_ids_[disarmed_count_++] = plane.object_id;
+      const double depth_m = -clearance_m(plane, finger_m);
+      if (depth_m <= 0.0 || clearance_m(plane, session_start_finger_m_) >= 0.0 || approach_mps > kRestingSpeed_mps) {
+        continue;
       }
+      bool listed = false;
+      for (int d = 0; d < sunk_count_; ++d) listed = listed || sunk_[d].object_id == plane.object_id;
+      if (listed) continue;
+      const double held_m = held_depth_m(plane.object_id);
+      // Set back by what the finger sank meanwhile; an object it was not in (held depth −∞) is disarmed.
+      const double setback_m = depth_m - held_m;
+      if (setback_m > 0.0) sunk_[sunk_count_++] = Sunk{plane.object_id, setback_m, depth_m};
     }
+    held_count_ = 0;
   }
-  if (disarmed_count_ == 0) return planes;
+  if (sunk_count_ == 0) return planes;
 
-  // Re-arm what the finger has left (or what left the frame); keep the rest disarmed.
+  // Restore what the finger has left (or what left the frame); keep the rest, and how deep the finger is in it.
   int kept = 0;
-  for (int d = 0; d < disarmed_count_; ++d) {
-    bool still_inside = false;
+  for (int d = 0; d < sunk_count_; ++d) {
+    double depth_m = 0.0;
     for (std::uint32_t k = 0; k < planes.count; ++k) {
       const ContactPlane& plane = planes.planes[k];
-      if (plane.object_id == disarmed_ids_[d] && clearance_m(plane, finger_m) < 0.0) still_inside = true;
+      if (plane.object_id == sunk_[d].object_id) depth_m = std::max(depth_m, -clearance_m(plane, finger_m));
     }
-    if (still_inside) disarmed_ids_[kept++] = disarmed_ids_[d];
+    if (depth_m > 0.0) {
+      sunk_[kept] = sunk_[d];
+      sunk_[kept++].depth_m = depth_m;
+    }
   }
-  disarmed_count_ = kept;
-  if (disarmed_count_ == 0) return planes;
+  sunk_count_ = kept;
+  if (sunk_count_ == 0) return planes;
 
   armed_.count = 0;
   armed_.valid_within_m = planes.valid_within_m;
   for (std::uint32_t k = 0; k < planes.count; ++k) {
-    bool disarmed = false;
-    for (int d = 0; d < disarmed_count_; ++d) disarmed = disarmed || planes.planes[k].object_id == disarmed_ids_[d];
-    if (disarmed) continue;
+    double setback_m = 0.0;
+    for (int d = 0; d < sunk_count_; ++d) {
+      if (planes.planes[k].object_id == sunk_[d].object_id) setback_m = sunk_[d].setback_m;
+    }
+    if (std::isinf(setback_m)) continue;  // disarmed
     armed_index_[armed_.count] = static_cast<int>(k);
-    armed_.planes[armed_.count++] = planes.planes[k];
+    ContactPlane& armed = armed_.planes[armed_.count++];
+    armed = planes.planes[k];
+    armed.point_m -= armed.normal * setback_m;
   }
   return armed_;
 }
@@ -61,6 +80,14 @@ const GodObjectResult& GodObject::solve(const PlaneSet& planes, const Eigen::Vec
   const FrictionResult friction = apply_friction(armed, result_.contact, finger_m, dt_s, anchor_);
   result_.contact.proxy_m = friction.proxy_m;
   result_.sticking = friction.sticking;
+  // What the finger presses and how deep, for a session that ends now to be resumed (resumes()).
+  pressed_count_ = 0;
+  for (int j = 0; j < listed_constraints(result_.contact); ++j) {
+    const int index = result_.contact.active[j].plane;
+    if (index < 0) continue;
+    const ContactPlane& plane = armed.planes[index];
+    pressed_[pressed_count_++] = Pressed{plane.object_id, std::max(0.0, -clearance_m(plane, finger_m))};
+  }
   if (&armed != &planes) {
     // The caller shares the reaction by indices into its own PlaneSet.
     for (int j = 0; j < result_.contact.active_count; ++j) {  // a pinch's conflicting plane is counted
@@ -71,17 +98,42 @@ const GodObjectResult& GodObject::solve(const PlaneSet& planes, const Eigen::Vec
   return result_;
 }
 
+double GodObject::held_depth_m(std::int32_t object_id) const {
+  double depth_m = -std::numeric_limits<double>::infinity();
+  for (int h = 0; h < held_count_; ++h) {
+    if (held_[h].object_id == object_id) depth_m = std::max(depth_m, held_[h].depth_m);
+  }
+  return depth_m;
+}
+
 void GodObject::reset() {
-  anchor_ = FrictionAnchor{};
-  result_ = GodObjectResult{};
-  disarmed_count_ = 0;
-  session_starting_ = false;
+  forget_contact();
+  held_count_ = 0;
+}
+
+void GodObject::end_finger_session() {
+  // What the finger pressed, and the objects it is set back from: how deep it is behind their set-back planes (less
+  // than zero when it has room before pressing, −∞ when disarmed), so a session to come carries the setback on.
+  held_count_ = 0;
+  for (int p = 0; p < pressed_count_; ++p) held_[held_count_++] = pressed_[p];
+  for (int d = 0; d < sunk_count_; ++d) {
+    held_[held_count_++] = Pressed{sunk_[d].object_id, sunk_[d].depth_m - sunk_[d].setback_m};
+  }
+  forget_contact();
 }
 
 void GodObject::begin_finger_session(const Eigen::Vector3d& finger_m) {
-  reset();
+  forget_contact();  // what the last session held, if it ended, is kept for resumes()
   session_starting_ = true;
   session_start_finger_m_ = finger_m;
+}
+
+void GodObject::forget_contact() {
+  anchor_ = FrictionAnchor{};
+  result_ = GodObjectResult{};
+  pressed_count_ = 0;
+  sunk_count_ = 0;
+  session_starting_ = false;
 }
 
 }  // namespace impetus

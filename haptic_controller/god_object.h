@@ -15,6 +15,13 @@
 // (or the object has left the frame), after which they act normally. Planes the finger is in front of at the start,
 // planes of objects moving onto the finger, and every plane that appears later act at once — so an object that
 // arrives onto the finger still pushes it out (hard case 5, the pinch).
+//
+// A finger that vanishes while pressing (the device absent or invalid for a while, a web page silent, the servo
+// stalled) and comes back into an object it was pressing resumes that contact as it left it: the object's planes are
+// set back by however much deeper the finger is now than when it vanished (not at all if no deeper), until the finger
+// has left the object. The force it meets again is at most the one it was pressing against, k·depth then, and on the
+// way out it gets back ½k·depth² at most: energy the hand had put in. Disarming the object instead would let the
+// finger sink through what it was pressing on.
 
 #include "haptic_controller/contact_plane.h"
 #include "haptic_controller/friction.h"
@@ -42,19 +49,45 @@ class GodObject {
   // the finger was inside from the start, not driven in while the first world frame was on its way.
   void begin_finger_session(const Eigen::Vector3d& finger_m);
 
+  // The finger vanished: forget the contact memory, but keep the objects the last solve pressed and how deep, for
+  // the next session to resume (above). reset() forgets those too.
+  void end_finger_session();
+
   const GodObjectResult& result() const { return result_; }
 
  private:
-  // The planes that constrain the proxy this tick: `planes` minus the disarmed ones. Returns `planes` itself when
-  // nothing is disarmed (the usual case, no copy); otherwise fills armed_ and armed_index_.
+  // The planes that constrain the proxy this tick: `planes` minus the disarmed ones, the set-back ones moved. Returns
+  // `planes` itself when nothing is set back (the usual case, no copy); otherwise fills armed_ and armed_index_.
   const PlaneSet& armed_planes(const PlaneSet& planes, const Eigen::Vector3d& finger_m);
+
+  // An object the finger pressed, and how deep behind its (set-back) plane, m.
+  struct Pressed {
+    std::int32_t object_id = 0;
+    double depth_m = 0.0;
+  };
+  // An object whose planes the finger is set back from: disarmed (setback infinite) or moved inward along their
+  // normals by setback_m (m, > 0), until the finger has left the object; depth_m is how deep behind its true planes
+  // the finger was at the last solve.
+  struct Sunk {
+    std::int32_t object_id = 0;
+    double setback_m = 0.0;
+    double depth_m = 0.0;
+  };
+  // How deep the finger was behind the object's (set-back) planes when it vanished (m), −∞ if it was not in it.
+  double held_depth_m(std::int32_t object_id) const;
+  // Forgets the anchor, the last result, what is pressed and set back; keeps held_.
+  void forget_contact();
 
   FrictionAnchor anchor_;
   GodObjectResult result_;
   bool session_starting_ = false;
   Eigen::Vector3d session_start_finger_m_ = Eigen::Vector3d::Zero();
-  std::array<std::int32_t, kMaxPlanes> disarmed_ids_{};
-  int disarmed_count_ = 0;
+  std::array<Sunk, kMaxPlanes> sunk_{};
+  int sunk_count_ = 0;
+  std::array<Pressed, kMaxActiveConstraints + 1> pressed_{};  // by the last solve
+  int pressed_count_ = 0;
+  std::array<Pressed, kMaxActiveConstraints + 1 + kMaxPlanes> held_{};  // when the finger vanished
+  int held_count_ = 0;
   PlaneSet armed_;
   std::array<int, kMaxPlanes> armed_index_{};  // armed_ index → index in the caller's PlaneSet
 };

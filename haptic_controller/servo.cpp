@@ -92,7 +92,6 @@ void HapticServo::measure_frame_boundary(const ProxySolution& contact) {
 
 void HapticServo::idle_tick(bool fault) {
   watched_count_ = 0;
-  god_object_.reset();
   renderer_.reset();
   result_.force_N = {};
   accumulator_.report().force_N = {};
@@ -118,6 +117,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
     else ++counters_.no_device_ticks;
     report.finger_valid = 0;
     report.finger_velocity_mps = {};
+    if (finger_known_) god_object_.end_finger_session();  // what it pressed, to resume if it comes back no deeper
     finger_known_ = false;
     idle_tick(finger != nullptr);
     return result_;
@@ -127,6 +127,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   // so the finger is not kicked out (god_object.h), and the hold of this tick's command is the watchdog's at most.
   if (finger_known_ && command_stale(dt_s)) {
     ++counters_.servo_stalls;
+    god_object_.end_finger_session();
     finger_known_ = false;
   }
   const double hold_s = std::min(dt_s, kCommandStale_s);
@@ -165,6 +166,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   const GodObjectResult& contact = god_object_.solve(planes_, finger_m, dt_s);
   if (!contact.contact.proxy_m.allFinite()) {  // only a non-finite plane could do this; frames are validated upstream
     ++counters_.faults;
+    god_object_.reset();
     idle_tick(true);
     return result_;
   }

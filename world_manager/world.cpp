@@ -81,6 +81,7 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
       endpoint.haptic_session = report->haptic_session;
       endpoint.endpoint = report->endpoint;
       endpoint.finger = FingerState{};
+      endpoint.plane_query_known = false;
       endpoint.plane_faces = FeatureMemory{};
     }
     take_finger(endpoint, *report);
@@ -137,6 +138,7 @@ void World::take_finger(Endpoint& endpoint, const HapticReport& report) {
   // Planes come from around the proxy (feature_extractor.h, ReachQuery); a report without a finite proxy falls back
   // to the finger.
   endpoint.plane_query = finger.finger;
+  endpoint.plane_query_known = true;
   if (all_finite(report.proxy_m)) {
     endpoint.plane_query.position_m = to_eigen(report.proxy_m);
     endpoint.plane_query.reach_extra_m = (finger.finger.position_m - endpoint.plane_query.position_m).norm();
@@ -293,15 +295,18 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
   frame.world_time_s = time_s_;
   frame.stiffness_Npm = scene_.haptic.stiffness_Npm;
   frame.damping_Nspm = scene_.haptic.damping_Nspm;
-  // Without a finger there is nothing to be near: no planes until a device reports one. The faces the proxy met are
-  // remembered across such steps (the step count advances only when planes are taken): a device that stalls while
-  // the finger goes on moving comes back with its proxy deep in the object, and must meet the face it went in by,
-  // not the far face of a memory that lapsed.
-  const bool valid = endpoint.finger.valid;
-  if (valid) endpoint.plane_faces.begin_step(states_.size());
+  // Planes are taken around the finger's proxy, and, while the finger is absent (a device gone for a moment, a web
+  // page silent, a report gone stale), around where it was last: a finger that comes back finds the surfaces it left
+  // at once, and the haptic side resumes a press instead of letting the finger sink until the world has heard of it
+  // again (haptic_controller/god_object.h); and the faces the proxy met stay remembered, so a finger that went on
+  // moving while its device stalled meets the face it went in by, not the far face of a memory that lapsed. Before
+  // any finger was reported there is nothing to be near: no planes.
+  const bool near_finger = endpoint.plane_query_known;
+  if (near_finger) endpoint.plane_faces.begin_step(states_.size());
   const std::uint32_t used_before = std::min(frame.plane_count, kMaxPlanes);
   frame.plane_count =
-      valid ? features_.extract(endpoint.plane_query, states_, period_s_, frame.planes, &endpoint.plane_faces) : 0;
+      near_finger ? features_.extract(endpoint.plane_query, states_, period_s_, frame.planes, &endpoint.plane_faces)
+                  : 0;
   // Planes past the count stay value-initialised (frames.h copy_used): only those the last frame used need it.
   for (std::uint32_t k = frame.plane_count; k < used_before; ++k) frame.planes[k] = Plane{};
   coupling_->annotate(frame);

@@ -146,6 +146,7 @@ class World {
     EndpointId endpoint = 0;
     FingerState finger;        // the sampled finger: position coupling's penetration
     ReachQuery plane_query;    // where planes are extracted: the proxy, reach widened to cover the finger
+    bool plane_query_known = false;  // a finger was reported in this session: plane_query is where it was last
     FeatureMemory plane_faces; // the face of each object the plane query (the proxy) met, step to step
     // The haptic time of the previous report applied: the impulses of the next one were rendered after it.
     std::uint64_t last_report_session = 0;

@@ -84,22 +84,15 @@ async function dragTarget(page, from, path, msPerStep = 8) {
 
 function summary() { return JSON.parse(fs.readFileSync(path.join(outDir, "haptic.json"), "utf8")).haptic; }
 
-// Presses the finger on the floor beside the cube, from above, until the page's gauge shows more than 1 N. The press
-// starts from above: a fingertip the hand let go mid-press rests just inside the floor, and a finger that appears
-// inside a surface is not thrown out of it (the proxy starts at the finger). On this machine a starved page can lose
-// the hand mid-press that way (a silence of 40 ms), so the press is tried again, up to four times.
+// Presses the finger on the floor beside the cube, from above, until the page's gauge shows more than 1 N. A page the
+// machine starves for 40 ms mid-press loses the hand and takes it again with its next message; the finger, resting
+// where it was, resumes the press (haptic_controller/god_object.h), so one press is enough.
 async function pressFloor(page) {
-  for (let attempt = 1; attempt <= 4; ++attempt) {
-    if (attempt > 1) await page.mouse.up();
-    const state = await touchState(page);
-    const from = state.target_m ?? state.hand.finger_m;  // the target the page sends now: the drag moves it
-    await dragTarget(page, from, [[-0.04, 0, 0.02], [-0.04, 0, -0.01]]);
-    const pressed = await waitFor("a force on the finger", async () =>
-      Number.parseFloat(await page.textContent("#touch-gauge-label")) > 1.0, 5000).catch(() => false);
-    if (pressed) return;
-    console.log(`  (press ${attempt} lost the floor: the page was silent mid-press; pressing again)`);
-  }
-  throw new Failure("the finger never pressed on the floor in four tries");
+  const state = await touchState(page);
+  const from = state.target_m ?? state.hand.finger_m;  // the target the page sends now: the drag moves it
+  await dragTarget(page, from, [[-0.04, 0, 0.02], [-0.04, 0, -0.01]]);
+  await waitFor("a force on the finger", async () =>
+    Number.parseFloat(await page.textContent("#touch-gauge-label")) > 1.0, 5000);
 }
 
 // A person drags the finger down beside the cube and pushes it along +x: the cube slides in world.csv.
@@ -172,16 +165,25 @@ async function letgo(procs, browser) {
   check(true, "and takes it again when shown");
   await pressFloor(page);
 
-  const closedAt = monotonicNs();
+  // The page is gone somewhere between the call to close it and that call's return: a starved browser takes its time
+  // to tear a page down (over 100 ms here under load), and heartbeats go on until it does.
+  const closeCalled = monotonicNs();
   await page.close();
+  const closeReturned = monotonicNs();
   await sleep(300);
   await procs.stop(haptic);
   const s = summary();
-  const delayMs = Number(BigInt(s.device.last_release_ns) - closedAt) / 1e6;
+  const release = BigInt(s.device.last_release_ns);
+  const afterCallMs = Number(release - closeCalled) / 1e6;
+  const afterGoneMs = Number(release - closeReturned) / 1e6;
   console.log(`  web hand: taken ${s.device.holds} times, let go ${s.device.releases} times when told and ` +
-    `${s.device.timeouts} on silence (a page starved of CPU here)`);
+    `${s.device.timeouts} on silence (a page starved of CPU here); the browser took ` +
+    `${(Number(closeReturned - closeCalled) / 1e6).toFixed(1)} ms to close the page`);
   // Negative: a silence let go before the close did (the force was off already).
-  check(delayMs <= 50, `closing the page mid-press took the force off ${delayMs.toFixed(1)} ms later`);
+  check(afterGoneMs <= 50, `closing the page mid-press took the force off ${afterCallMs.toFixed(1)} ms after the ` +
+    `close was asked for, ${afterGoneMs.toFixed(1)} ms after the page was gone`);
+  check(s.device.max_release_delay_s <= 0.05, `every let-go came within 50 ms of the page's last word or silence ` +
+    `(the longest ${(s.device.max_release_delay_s * 1e3).toFixed(1)} ms)`);
   const log = readCsv(path.join(outDir, "haptic.csv"));
   const fz = log.column("force_z_N"), flags = log.column("flags");
   const present = log.rows.map((row) => (row[flags] & 1) === 1);

@@ -359,7 +359,7 @@ TEST_CASE("impulse coupling: a push beyond what friction holds moves the cube at
 TEST_CASE("a finger that comes back after its device stalled meets the face it went in by, not the far face") {
   // The tap scene's cube (1 kg, 5 cm, centre x = 0.03 m): the proxy at its −x face, then the device stalls (reports
   // without a finger) for 5 world steps while the finger goes on moving, and comes back with its proxy 1 cm past the
-  // cube's centre. The world must still give the −x face (the one the proxy went in by): the far face would put the
+  // cube's centre. The world must give the −x face meanwhile and after (the one the proxy went in by): the far face would put the
   // proxy outside through the +x side and pull the finger on through.
   impetus::prepare_engines();
   const impetus::Scene scene = impetus::load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json");
@@ -376,7 +376,7 @@ TEST_CASE("a finger that comes back after its device stalled meets the face it w
   report.finger_valid = 0;
   for (int step = 0; step < 5; ++step) {
     ++report.tick;
-    CHECK(world.step(&report).plane_count == 0);
+    CHECK(cube_plane_normal_x(world.step(&report)) < -0.99);  // meanwhile the planes around where the proxy was
   }
   ++report.tick;
   report.finger_valid = 1;
