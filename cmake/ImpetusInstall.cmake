@@ -9,8 +9,8 @@ set(IMPETUS_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/Impetus)
 set(IMPETUS_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/impetus)
 
 # Library targets, the name each has after `Impetus::`.
-set(IMPETUS_EXPORTED impetus_common common impetus_world_manager world impetus_haptic_controller haptic
-    impetus_spidar_sim device impetus_loop loop)
+set(IMPETUS_EXPORTED impetus_common common impetus_mesh mesh impetus_world_manager world
+    impetus_haptic_controller haptic impetus_spidar_sim device impetus_loop loop)
 set(exported_targets "")
 while(IMPETUS_EXPORTED)
   list(POP_FRONT IMPETUS_EXPORTED target export_name)
@@ -29,11 +29,10 @@ endforeach()
 foreach(dir common world_manager haptic_controller spidar_sim loop)
   # dds_codec.h and dds_entities.h need Cyclone's headers and the idlc-generated types, which the package does not ship.
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/impetus/${dir} COMPONENT dev
-          FILES_MATCHING PATTERN "*.h" PATTERN "dds_codec.h" EXCLUDE PATTERN "dds_entities.h" EXCLUDE
-          PATTERN "mesh" EXCLUDE)  # users' meshes: not yet a part of the installed library (docs/meshes.md)
+          FILES_MATCHING PATTERN "*.h" PATTERN "dds_codec.h" EXCLUDE PATTERN "dds_entities.h" EXCLUDE)
 endforeach()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${IMPETUS_INSTALL_DATADIR}/scenes
-        FILES_MATCHING PATTERN "*.json")
+        FILES_MATCHING PATTERN "*.json" PATTERN "*.obj" PATTERN "*.stl")  # scenes and the meshes they name
 install(FILES ${PROJECT_SOURCE_DIR}/common/spidar/desktop_spidar.json DESTINATION ${IMPETUS_INSTALL_DATADIR})
 install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/THIRD_PARTY.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR})
@@ -73,11 +72,12 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Multi-rate haptic rendering with force in
 set(CPACK_RESOURCE_FILE_LICENSE ${PROJECT_SOURCE_DIR}/LICENSE)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
-set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "libode8, libbullet3.24, libddsc0debian, libstdc++6, libc6")
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "libode8, libbullet3.24, libddsc0debian, libassimp5, libstdc++6, libc6")
 if(IMPETUS_PYTHON_DEB_DEPENDS)
   string(APPEND CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS ", ${IMPETUS_PYTHON_DEB_DEPENDS}")
 endif()
-set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
-    "impetus (= ${PROJECT_VERSION}), libode-dev, libbullet-dev, libeigen3-dev, libboost-dev, nlohmann-json3-dev, libcli11-dev")
+string(CONCAT CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
+       "impetus (= ${PROJECT_VERSION}), libode-dev, libbullet-dev, libassimp-dev, libeigen3-dev, libboost-dev, "
+       "nlohmann-json3-dev, libcli11-dev")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 include(CPack)

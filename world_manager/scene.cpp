@@ -5,10 +5,12 @@
 #include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
 #include "world_manager/engine/engine_registry.h"
+#include "world_manager/mesh_objects.h"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <span>
 #include <set>
@@ -147,15 +149,16 @@ constexpr std::string_view kObjectKeys[] = {
     "name", "shape", "dynamic", "mass_kg", "density_kgpm3", "position_m", "orientation_wxyz", "linear_velocity_mps",
     "angular_velocity_radps", "static_friction", "dynamic_friction", "restitution"};
 
-SceneObject parse_object(const Node& node) {
+SceneObject parse_object(const Node& node, const std::string& scene_dir) {
   node.expect_object();
   SceneObject object;
   const ShapeKind kind = parse_shape_kind(node.required("shape"));
   node.expect_keys({std::span<const std::string_view>(kObjectKeys), shape_keys(kind)});
   object.name = node.required("name").string();
   if (object.name.empty()) node.child("name").fail("name must not be empty");
-  object.shape = parse_shape(node, kind);
   object.dynamic = node.required("dynamic").boolean();
+  // A mesh's triangles come from a file beside the scene (the shape module cannot read files).
+  object.shape = kind == ShapeKind::mesh ? load_mesh_shape(node, scene_dir, object.dynamic) : parse_shape(node, kind);
 
   if (object.dynamic) {
     const bool has_mass = node.has("mass_kg");
@@ -254,10 +257,15 @@ Scene parse_scene(const nlohmann::json& document, const std::string& source_name
     objects.fail("a scene holds at most " + std::to_string(SceneLimits::kMaxObjects) + " objects, this one has " +
                  std::to_string(objects.value().size()));
   }
+  // Mesh files are named relative to the scene file's folder (the working directory for a scene given as text).
+  std::error_code not_a_file;
+  const std::string scene_dir = std::filesystem::is_regular_file(source_name, not_a_file)
+                                    ? std::filesystem::path(source_name).parent_path().string()
+                                    : std::string();
   std::set<std::string> names;
   for (std::size_t i = 0; i < objects.value().size(); ++i) {
     const Node node = objects.element(i);
-    SceneObject object = parse_object(node);
+    SceneObject object = parse_object(node, scene_dir);
     if (!names.insert(object.name).second) node.child("name").fail("duplicate object name");
     scene.objects.push_back(std::move(object));
   }

@@ -118,7 +118,10 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   simulated_object_steps_ += engine_->moved().size();
   if (scene_.floor.present) {
     for (const std::size_t id : engine_->moved()) {
-      const double lowest_m = world_bounds(scene_.objects[id].shape, states_[id].pose).min().z();
+      // The lowest point: the support along −z in the body frame (exact for any shape, also off-centre meshes).
+      const BodyPose& pose = states_[id].pose;
+      const Eigen::Vector3d down_body = pose.orientation.conjugate() * -Eigen::Vector3d::UnitZ();
+      const double lowest_m = pose.position_m.z() - support_m(scene_.objects[id].shape, down_body);
       floor_penetration_max_m_ = std::max(floor_penetration_max_m_, scene_.floor.height_m - lowest_m);
     }
   }

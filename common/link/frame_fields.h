@@ -30,6 +30,7 @@ void visit_shape(A& a, B& b, F&& f) {
   f(a.box_size_m, b.box_size_m);
   f(a.radius_m, b.radius_m);
   f(a.length_m, b.length_m);
+  f(a.mesh_hash, b.mesh_hash);
 }
 
 template <class A, class B, class F>

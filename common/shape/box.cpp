@@ -184,7 +184,7 @@ constexpr std::string_view kKeys[] = {"size_m"};
 
 const ShapeKindOps kBoxOps{
     .name = "box",
-    .traits = {.carries_axes = true, .flat_faces = true, .round = false, .normal_through_core = false},
+    .traits = {.carries_axes = true, .flat_faces = true, .round = false, .normal_through_core = false, .convex = true},
     .keys = kKeys,
     .parse = parse,
     .problem = problem,

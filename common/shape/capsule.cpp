@@ -108,7 +108,7 @@ constexpr std::string_view kKeys[] = {"radius_m", "length_m"};
 
 const ShapeKindOps kCapsuleOps{
     .name = "capsule",
-    .traits = {.carries_axes = true, .flat_faces = false, .round = false, .normal_through_core = true},
+    .traits = {.carries_axes = true, .flat_faces = false, .round = false, .normal_through_core = true, .convex = true},
     .keys = kKeys,
     .parse = parse,
     .problem = problem,

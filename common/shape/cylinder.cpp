@@ -155,7 +155,7 @@ constexpr std::string_view kKeys[] = {"radius_m", "length_m"};
 
 const ShapeKindOps kCylinderOps{
     .name = "cylinder",
-    .traits = {.carries_axes = true, .flat_faces = false, .round = false, .normal_through_core = false},
+    .traits = {.carries_axes = true, .flat_faces = false, .round = false, .normal_through_core = false, .convex = true},
     .keys = kKeys,
     .parse = parse,
     .problem = problem,

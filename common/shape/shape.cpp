@@ -41,6 +41,7 @@ const ShapeKindOps* const kKinds[kShapeKindCount] = {
     &shape_detail::kSphereOps,
     &shape_detail::kCapsuleOps,
     &shape_detail::kCylinderOps,
+    &shape_detail::kMeshOps,
 };
 
 const ShapeKindOps& ops(ShapeKind kind) {

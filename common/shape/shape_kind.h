@@ -41,6 +41,7 @@ extern const ShapeKindOps kBoxOps;
 extern const ShapeKindOps kSphereOps;
 extern const ShapeKindOps kCapsuleOps;
 extern const ShapeKindOps kCylinderOps;
+extern const ShapeKindOps kMeshOps;
 
 // Shared by the kind files.
 

@@ -56,7 +56,7 @@ constexpr std::string_view kKeys[] = {"radius_m"};
 
 const ShapeKindOps kSphereOps{
     .name = "sphere",
-    .traits = {.carries_axes = false, .flat_faces = false, .round = true, .normal_through_core = true},
+    .traits = {.carries_axes = false, .flat_faces = false, .round = true, .normal_through_core = true, .convex = true},
     .keys = kKeys,
     .parse = parse,
     .problem = problem,

@@ -155,11 +155,30 @@ TEST_CASE("every kind has a name that reads back, its own keys, a volume, an ine
   ShapeKind read = ShapeKind::box;
   CHECK_FALSE(impetus::shape_kind_from_string("none", read));
   CHECK_FALSE(impetus::shape_kind_from_string("Box", read));
-  CHECK(impetus::shape_kind_names() == "box, sphere, capsule or cylinder");
+  CHECK(impetus::shape_kind_names() == "box, sphere, capsule, cylinder or mesh");
   const Shape none;
   CHECK(impetus::volume_m3(none) == 0.0);
   CHECK(impetus::plane_extent_m(none) == 0.0);
   CHECK_FALSE(impetus::segment_enters_body(none, Vector3d(-1, 0, 0), Vector3d(1, 0, 0)));
+}
+
+TEST_CASE("a mesh this process has not loaded answers as the ball that holds it, one naming no triangles is refused") {
+  // The haptic controller and a viewer get a mesh's descriptor from the world, not its triangles
+  // (common/shape/mesh_geometry.h): its radius still bounds it, and its planes are used as sent.
+  Shape mesh;
+  mesh.kind = ShapeKind::mesh;
+  mesh.radius_m = 0.04;
+  mesh.box_size_m = {0.05, 0.06, 0.07};
+  mesh.mesh_hash = 0x1234'5678'9abc'def0ULL;
+  CHECK(impetus::shape_problem(mesh) == nullptr);
+  CHECK(impetus::traits(ShapeKind::mesh).planes_as_sent);
+  CHECK_FALSE(impetus::traits(ShapeKind::mesh).convex);
+  const impetus::SurfacePoint above = impetus::nearest_surface_point_body(mesh, Vector3d(0.0, 0.0, 0.1));
+  CHECK(above.signed_distance_m == Approx(0.06));
+  CHECK(impetus::plane_extent_m(mesh) == Approx(0.08));  // no two of its points are farther apart
+  CHECK(impetus::world_bounds(mesh, BodyPose{}).sizes().maxCoeff() == Approx(0.08));
+  mesh.mesh_hash = 0;
+  CHECK(impetus::shape_problem(mesh) != nullptr);
 }
 
 TEST_CASE("a received shape with a size that is not finite, not positive or out of the scene's range is refused") {

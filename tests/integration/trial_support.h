@@ -14,7 +14,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 #include <thread>
 #include <vector>
@@ -44,6 +46,19 @@ inline std::string read_text(const std::filesystem::path& path) {
 }
 
 inline nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(read_text(path)); }
+
+// How far the impulse the world applied to object `id` for endpoint 0 is from what that endpoint rendered on it: the
+// largest |rendered − applied| / (1 + |rendered|) over the three axes (0 when the ledger is exact).
+inline double ledger_gap(const nlohmann::json& summary, const std::string& id) {
+  const nlohmann::json& rendered = summary["haptic"]["endpoints"][0]["impulse_by_object_Ns"][id];
+  const nlohmann::json& applied = summary["world"]["endpoints"][0]["impulse_by_object_Ns"][id];
+  double gap = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double r = rendered[axis].get<double>();
+    gap = std::max(gap, std::abs(r - applied[axis].get<double>()) / (1.0 + std::abs(r)));
+  }
+  return gap;
+}
 
 // Runs a shell command; returns its exit status (or -1 if it did not exit normally).
 inline int shell(const std::string& command) {

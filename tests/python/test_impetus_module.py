@@ -158,6 +158,13 @@ class Arguments(unittest.TestCase):
         self.assertEqual(processes["followers"][0]["haptic"]["impulse_by_object_Ns"],
                          trial.summary["followers"][0]["haptic"]["impulse_by_object_Ns"])
 
+    def test_a_mesh_scene_runs(self):
+        # The shipped mesh scene: its files named relative to it, read by the world; the tap pushes the mesh cube.
+        trial = impetus.run_trial(impetus.shipped_scene("meshes"), "tap", "local", out_dir=OUT / "meshes",
+                                  logs=False)
+        self.assertEqual(set(trial.summary["objects"]), {"cube", "pebble"})  # the dynamic ones
+        self.assertGreater(trial.summary["objects"]["cube"]["position"][0], 0.13)
+
     def test_users_on_one_world(self):
         # Two users squeeze the tap scene's cube (sides at x = 0.005 and 0.055 m) 10 mm deep from either side: the
         # pushes cancel, the cube stays, and the world applied for each user exactly what that user rendered.
@@ -367,7 +374,7 @@ class Defaults(unittest.TestCase):
         self.assertEqual(impetus.defaults(), printed)
         self.assertEqual(impetus.COUPLINGS, ("impulse", "position", "local"))
         self.assertIn("ode", printed["engines"])
-        self.assertEqual(printed["shapes"], ["box", "sphere", "capsule", "cylinder"])
+        self.assertEqual(printed["shapes"], ["box", "sphere", "capsule", "cylinder", "mesh"])
         # A scene that leaves its haptic and physics keys out runs with what the defaults say.
         OUT.mkdir(parents=True, exist_ok=True)
         bare = OUT / "bare-scene.json"

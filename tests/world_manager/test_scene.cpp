@@ -61,7 +61,7 @@ TEST_CASE("density gives mass from the shape's volume") {
 }
 
 TEST_CASE("shipped scenes load") {
-  for (const char* file : {"tap.json", "spheres.json", "stack.json"}) {
+  for (const char* file : {"tap.json", "spheres.json", "stack.json", "meshes.json"}) {
     INFO(file);
     const Scene scene = impetus::load_scene(impetus::test::scene_path(file));
     CHECK_FALSE(scene.objects.empty());

@@ -183,7 +183,7 @@ TEST_CASE("bodies a scene places inside each other or the floor are found at the
   CHECK(overlaps[1].b == 2);
   CHECK(overlaps[1].depth_m == Approx(0.005).epsilon(1e-6));
   // The shipped scenes start clean.
-  for (const char* scene : {"tap.json", "stack.json", "shapes.json"}) {
+  for (const char* scene : {"tap.json", "stack.json", "shapes.json", "meshes.json"}) {
     INFO(scene);
     CHECK(make_world(impetus::load_scene(impetus::test::scene_path(scene)))->start_overlaps().empty());
   }

@@ -242,6 +242,10 @@ function shapeOf(body) {
       const l = nonNegative(body.length_m) ? body.length_m : 0;
       return { key: `capsule:${r}:${l}`, kind: 'capsule', radius: r, length: l, boundingRadius: r + l / 2 };
     }
+    case 'mesh':
+      // Its triangles stay with the world (docs/meshes.md): drawn as the faceted ball about its centre of mass that
+      // holds it (radius_m), so the page shows where it is and how it turns, not its form.
+      return { key: `mesh:${r}`, kind: 'mesh', radius: r, boundingRadius: r };
     default: {
       if (body.shape !== 'box') {
         console.warn(`impetus viewer: unknown shape ${body.shape} of ${body.name}, drawn as a box`);
@@ -260,6 +264,7 @@ function solidGeometry(shape, detail) {
   const radial = [6, 12, 32][detail];
   switch (shape.kind) {
     case 'sphere': return new THREE.SphereGeometry(shape.radius, radial, [4, 8, 20][detail]);
+    case 'mesh': return new THREE.IcosahedronGeometry(shape.radius, 1);
     case 'cylinder':
       return new THREE.CylinderGeometry(shape.radius, shape.radius, shape.length, radial).rotateX(Math.PI / 2);
     case 'capsule':
@@ -296,7 +301,8 @@ function outlinePositions(shape, detail) {
   const O = [0, 0, 0];
   const out = [];
   switch (shape.kind) {
-    case 'sphere': {
+    case 'sphere':
+    case 'mesh': {
       const r = shape.radius * 1.002;    // just outside the tessellated surface
       pushArc(out, O, X, Y, r, 0, 2 * Math.PI, n);
       pushArc(out, O, Y, Z, r, 0, 2 * Math.PI, n);

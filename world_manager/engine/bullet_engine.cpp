@@ -68,6 +68,9 @@ std::unique_ptr<btCollisionShape> make_shape(const SceneObject& object) {
     case ShapeKind::cylinder:
       out = std::make_unique<btCylinderShapeZ>(btVector3(shape.radius_m, shape.radius_m, shape.length_m / 2.0));
       break;
+    case ShapeKind::mesh:  // docs/meshes.md: ODE collides meshes; this adapter does not yet
+      throw SceneError("object '" + object.name + "': the bullet engine does not collide meshes yet; use " +
+                       "\"engine\": \"ode\" (the default)");
     case ShapeKind::none:
       throw SceneError("object '" + object.name + "' has no shape");
   }

@@ -5,6 +5,8 @@
 #include "world_manager/engine/sleeping_bodies.h"
 #include "world_manager/engine/speculative_contacts.h"
 
+#include "common/mesh/mesh_body.h"
+
 #include <ode/ode.h>
 
 #include <algorithm>
@@ -86,6 +88,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
   std::vector<RestingPose> resting_pose;  // per object, while it sleeps
   std::vector<dMass> masses;              // per object, to rebuild a body that wakes
   std::vector<std::size_t> nearby;        // scratch
+  std::vector<dTriMeshDataID> mesh_data;  // one per mesh geom; ODE reads the MeshBody's arrays, it copies nothing
 
   dGeomID geom_of(std::size_t id) const { return id < geoms.size() ? geoms[id] : floor; }
 
@@ -243,6 +246,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
     if (resting_space != nullptr) dSpaceDestroy(resting_space);
     if (space != nullptr) dSpaceDestroy(space);  // destroys the geoms it holds (cleanup mode on)
     if (world != nullptr) dWorldDestroy(world);  // destroys the bodies
+    for (dTriMeshDataID data : mesh_data) dGeomTriMeshDataDestroy(data);  // after the geoms that use it
   }
 
   // The recorded contacts into the graph, each with the normal force the step found: |f·n| of the force the joint put
@@ -395,6 +399,24 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
         geom = dCreateCylinder(home, shape.radius_m, shape.length_m);
         if (object.dynamic) dMassSetCylinderTotal(&mass, object.mass_kg, kAxisZ, shape.radius_m, shape.length_m);
         break;
+      case ShapeKind::mesh: {
+        const auto* body = dynamic_cast<const MeshBody*>(find_mesh_geometry(shape.mesh_hash));
+        if (body == nullptr) throw SceneError("object '" + object.name + "': its mesh was not loaded");
+        const TriangleMesh& mesh = body->bvh().mesh();
+        static_assert(sizeof(dTriIndex) == sizeof(std::uint32_t));
+        dTriMeshDataID data = dGeomTriMeshDataCreate();
+        dGeomTriMeshDataBuildDouble(data, mesh.vertices_m.data(), sizeof(Eigen::Vector3d),
+                                    static_cast<int>(mesh.vertices_m.size()), mesh.triangles.data(),
+                                    static_cast<int>(3 * mesh.triangles.size()), sizeof(mesh.triangles[0]));
+        ode.mesh_data.push_back(data);
+        geom = dCreateTriMesh(home, data, nullptr, nullptr, nullptr);
+        if (object.dynamic) {
+          const Eigen::Matrix3d inertia = object.mass_kg * body->inertia_per_kg();
+          dMassSetParameters(&mass, object.mass_kg, 0.0, 0.0, 0.0, inertia(0, 0), inertia(1, 1), inertia(2, 2),
+                             inertia(0, 1), inertia(0, 2), inertia(1, 2));
+        }
+        break;
+      }
       case ShapeKind::none:
         throw SceneError("object '" + object.name + "' has no shape");
     }

@@ -93,7 +93,7 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
     BodyPose frame = state.pose;
     if (kind.round) frame.orientation = Eigen::Quaterniond::Identity();
     const Eigen::Vector3d query_local_m = frame.orientation.conjugate() * (finger.position_m - frame.position_m);
-    if (memory != nullptr) {
+    if (memory != nullptr && kind.convex) {
       // Inside, or swept over within the step: keep the face of the last step, if the query is behind it
       // (feature_memory.h).
       if (const FeatureMemory::Face* kept = memory->previous(id); kept != nullptr) {

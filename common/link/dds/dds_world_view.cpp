@@ -67,6 +67,7 @@ void DdsWorldViewPublisher::publish_scene(const ViewScene& scene) {
     to.box_size_m = to_dds(body.shape.box_size_m);
     to.radius_m = body.shape.radius_m;
     to.length_m = body.shape.length_m;
+    to.mesh_hash = body.shape.mesh_hash;
     std::memcpy(to.name, body.name.data(), kMaxViewNameBytes);
   }
   out.bodies._length = count;
@@ -180,6 +181,7 @@ bool DdsWorldViewReader::read_scene(ViewScene& out) {
     to.shape.box_size_m = from_dds(from.box_size_m);
     to.shape.radius_m = from.radius_m;
     to.shape.length_m = from.length_m;
+    to.shape.mesh_hash = from.mesh_hash;
     std::memcpy(to.name.data(), from.name, kMaxViewNameBytes);
     to.name.back() = '\0';
   }

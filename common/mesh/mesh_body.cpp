@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "common/mesh/mesh_body.h"
+
+#include "common/mesh/mass_properties.h"
+#include "common/mesh/mesh_check.h"
+#include "common/mesh/mesh_file.h"
+#include "common/runtime/input_error.h"
+
+#include <algorithm>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <tuple>
+
+namespace impetus {
+namespace {
+
+// The body's origin in the file's frame: the centre of mass of a closed mesh, the centre of an open one's box.
+Eigen::Vector3d body_origin(const TriangleMesh& mesh, bool closed) {
+  if (closed) return mass_properties(mesh, 1.0).centre_of_mass_m;
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : mesh.vertices_m) box.extend(v);
+  return box.center();
+}
+
+TriangleMesh moved_by(TriangleMesh mesh, const Eigen::Vector3d& offset_m) {
+  for (Eigen::Vector3d& v : mesh.vertices_m) v += offset_m;
+  return mesh;
+}
+
+}  // namespace
+
+const MeshBody& MeshBody::load(const std::string& path, const Eigen::Vector3d& scale, bool dynamic) {
+  // Read once per file, scale and use: a scene with many copies of one object, or Python running trial after
+  // trial, does not read and build it again. Bodies stay for the process's life (the registry points at them).
+  static std::mutex mutex;
+  static std::map<std::tuple<std::string, double, double, double, bool>, std::unique_ptr<MeshBody>> loaded;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto key = std::make_tuple(path, scale.x(), scale.y(), scale.z(), dynamic);
+  if (const auto found = loaded.find(key); found != loaded.end()) return *found->second;
+
+  TriangleMesh mesh = load_mesh(path, scale);
+  bool flipped = false;
+  const MeshReport report = require_usable(mesh, dynamic, path, flipped);
+  auto body = std::unique_ptr<MeshBody>(new MeshBody(std::move(mesh), report.closed(), flipped));
+  register_mesh_geometry(body->shape_.mesh_hash, body.get());
+  return *loaded.emplace(key, std::move(body)).first->second;
+}
+
+MeshBody::MeshBody(TriangleMesh mesh, bool closed, bool flipped)
+    : origin_in_file_m_(body_origin(mesh, closed)),
+      closed_(closed),
+      flipped_(flipped),
+      bvh_(moved_by(std::move(mesh), -origin_in_file_m_)) {
+  const TriangleMesh& placed = bvh_.mesh();
+  if (closed_) {
+    const MassProperties unit = mass_properties(placed, 1.0);  // 1 kg/m³: the mass is the volume
+    volume_m3_ = unit.volume_m3;
+    inertia_per_kg_ = unit.inertia_about_com_kgm2 / unit.mass_kg;
+  }
+  Eigen::AlignedBox3d box;
+  double radius_m = 0.0;
+  for (const Eigen::Vector3d& v : placed.vertices_m) {
+    box.extend(v);
+    radius_m = std::max(radius_m, v.norm());
+  }
+  shape_.kind = ShapeKind::mesh;
+  shape_.box_size_m = to_vec3(box.sizes());
+  shape_.radius_m = radius_m;
+  shape_.mesh_hash = mesh_hash(placed);
+  if (shape_.mesh_hash == 0) shape_.mesh_hash = 1;  // 0 means "no mesh" on the link; FNV-1a gives it 1 in 2^64
+}
+
+SurfacePoint MeshBody::nearest(const Eigen::Vector3d& query_m) const {
+  MeshPoint point;
+  if (!bvh_.nearest(query_m, point)) return {Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0};
+  return {point.point_m, point.normal, point.signed_distance_m};
+}
+
+double MeshBody::support(const Eigen::Vector3d& normal) const {
+  double best = -std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& v : bvh_.mesh().vertices_m) best = std::max(best, normal.dot(v));
+  return best;
+}
+
+Eigen::Vector3d MeshBody::bounds_half(const Eigen::Matrix3d& rotation) const {
+  Eigen::Vector3d half = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& v : bvh_.mesh().vertices_m) half = half.cwiseMax((rotation * v).cwiseAbs());
+  return half;
+}
+
+}  // namespace impetus

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// The geometry behind a mesh shape (ShapeKind::mesh), found by the content hash its descriptor carries.
+//
+// A mesh's triangles are too many for the fixed-size descriptor that crosses the links, so the descriptor carries
+// their hash and each process that needs the geometry loads the same file and registers it here (the world manager
+// does, when it loads a scene: common/mesh/mesh_body.h). A process that has not loaded it (the haptic controller,
+// a viewer) still has the descriptor's bounding box and radius, and renders the planes the world sends as they are.
+//
+// Frames and units: the body frame (its origin the mesh's centre of mass), SI. Registered geometry is immutable and
+// lives until the process ends; lookups take no lock and allocate nothing, so any thread may query at any rate.
+
+#include "common/shape/shape.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+
+namespace impetus {
+
+// What the shape module asks of a mesh. Every function is const, allocation-free and never throws.
+class MeshGeometry {
+ public:
+  virtual ~MeshGeometry() = default;
+  // Nearest surface point and its outward (pseudo-)normal; signed distance negative inside (closed meshes).
+  virtual SurfacePoint nearest(const Eigen::Vector3d& query_m) const = 0;
+  // max over the vertices of normal·x.
+  virtual double support(const Eigen::Vector3d& normal) const = 0;
+  // Half extents of the smallest world-aligned box centred on the origin that holds the mesh turned by `rotation`:
+  // max over the vertices of |(rotation·x)_i| (shape.h's bounds are centred on the body's origin).
+  virtual Eigen::Vector3d bounds_half(const Eigen::Matrix3d& rotation) const = 0;
+  virtual double volume_m3() const = 0;
+  virtual Eigen::Matrix3d inertia_per_kg() const = 0;  // m², about the centre of mass, body frame
+};
+
+// Registers `geometry` under `hash` (no-op if a geometry of that hash is there: the same triangles). Throws
+// std::length_error past kMaxMeshGeometries distinct meshes in one process. Not for the 1 kHz path.
+void register_mesh_geometry(std::uint64_t hash, const MeshGeometry* geometry);
+// The geometry registered under `hash`, or nullptr.
+const MeshGeometry* find_mesh_geometry(std::uint64_t hash);
+
+inline constexpr std::size_t kMaxMeshGeometries = 256;
+
+}  // namespace impetus
