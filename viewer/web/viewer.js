@@ -243,7 +243,7 @@ function shapeOf(body) {
       return { key: `capsule:${r}:${l}`, kind: 'capsule', radius: r, length: l, boundingRadius: r + l / 2 };
     }
     case 'mesh':
-      // Its triangles stay with the world (docs/meshes.md): drawn as the faceted ball about its centre of mass that
+      // Its triangles stay with the world (docs/meshes.md): drawn as a coarse ball about its centre of mass that
       // holds it (radius_m), so the page shows where it is and how it turns, not its form.
       return { key: `mesh:${r}`, kind: 'mesh', radius: r, boundingRadius: r };
     default: {
@@ -264,7 +264,7 @@ function solidGeometry(shape, detail) {
   const radial = [6, 12, 32][detail];
   switch (shape.kind) {
     case 'sphere': return new THREE.SphereGeometry(shape.radius, radial, [4, 8, 20][detail]);
-    case 'mesh': return new THREE.IcosahedronGeometry(shape.radius, 1);
+    case 'mesh': return new THREE.SphereGeometry(shape.radius, 8, 6);  // coarse: a bound, not the form
     case 'cylinder':
       return new THREE.CylinderGeometry(shape.radius, shape.radius, shape.length, radial).rotateX(Math.PI / 2);
     case 'capsule':
