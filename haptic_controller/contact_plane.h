@@ -29,9 +29,8 @@ struct ContactPlane : ShapePlane {
   double dynamic_friction = 0.0;
   double extent_m = 0.0;  // how far from point_m the plane describes its object; 0: unbounded (Plane::extent_m)
 
-  // Whether the plane carries a shape the haptic side takes it again from (the floor's carries none; a mesh's is used
-  // as sent: ShapeTraits::planes_as_sent).
-  bool shaped() const { return shape.kind != ShapeKind::none && !shape_traits().planes_as_sent; }
+  // Whether the plane carries its body's shape (the floor's does not).
+  bool shaped() const { return shape.kind != ShapeKind::none; }
   const ShapeTraits& shape_traits() const { return traits(shape.kind); }
 
   // How far from point_m the plane still describes its object (0: unbounded), for telling a plane whose object is

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// haptic_controller: the 1 kHz haptic servo (docs/architecture.md §1.2). Parses the flags, creates the device port,
-// opens the world link and runs a HapticNode on them; writes the haptic half of summary.json at exit.
+// haptic_controller: the 1 kHz haptic servo (docs/architecture.md §1.2). Parses the flags, hosts the device, opens
+// the world link and runs a HapticNode on them; writes the haptic half of summary.json at exit.
 
 #include "common/link/dds/open_world_link.h"
+#include "common/mesh/mesh_object.h"
 #include "common/runtime/cli.h"
 #include "haptic_controller/device/device_registry.h"
 #include "haptic_controller/device/hosted_device.h"
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
   std::string device_spec = "spidar";
   std::string world_shm;  // "": the same as --shm
   unsigned fingers = 1;
+  std::string mesh_scene;
   LinkOptions link_options;
   CLI::App app{"haptic_controller: the 1 kHz haptic servo of Impetus. Interpolates the world's planes, renders the "
                "god-object force on the SPIDAR and integrates it into impulses for the world."};
@@ -52,16 +54,18 @@ int main(int argc, char** argv) {
                  "lockstep, the first of several users' controllers on one world: wait for this many more to attach "
                  "(with --world-shm) before the first tick; they follow this one's ticks (0)")
       ->check(CLI::Range(0u, kMaxEndpoints - 1));
-  app.add_option("--world-shm", world_shm,
-                 "the world link's NAME when it differs from --shm: several users' controllers, each with its own "
-                 "--shm for its device, on one world");
+  app.add_option("--world-shm", world_shm, "the world link's NAME when it differs from --shm: several users' "
+                 "controllers, each with its own --shm for its device, on one world");
   app.add_flag("!--no-realtime-priority", options.realtime_priority,
                "do not ask for SCHED_FIFO and mlockall in real time");
+  app.add_option("--meshes-from", mesh_scene, "the world's scene: its meshes are read, so the servo follows their "
+                 "triangles between frames (else a mesh's planes are used as sent)");
   if (const std::optional<int> status = parse_flags(app, "haptic_controller", argc, argv)) return *status;
 
   return run_node("haptic_controller", [&] {
     options.haptic_session = new_session_id();
     const std::unique_ptr<DeviceType> device_type = parse_device(device_spec);
+    if (!mesh_scene.empty()) load_scene_meshes(mesh_scene);
     if (link_options.kind == LinkKind::dds && !world_shm.empty()) {
       throw std::invalid_argument("--world-shm names a shared-memory world link; with --link dds the world is found "
                                   "by --dds-domain and --dds-partition");

@@ -116,7 +116,8 @@ add_log world_args world
 [ -n "$substeps" ] && world_args+=(--substeps "$substeps")
 [ -n "$engine" ] && world_args+=(--engine "$engine")
 [ -n "$passivity" ] && world_args+=(--passivity "$passivity")
-haptic_args=(--clock "$clock" --shm "$shm" --summary "$out/haptic.json" "${haptic_extra[@]}")
+# --meshes-from: the servo reads the scene's meshes too, to follow their triangles between world frames.
+haptic_args=(--clock "$clock" --shm "$shm" --summary "$out/haptic.json" --meshes-from "$scene" "${haptic_extra[@]}")
 [ -n "$duration" ] && haptic_args+=(--duration "$duration")
 haptic_args+=(--device "$device")
 add_log haptic_args haptic
@@ -213,7 +214,7 @@ if ((${#users[@]})); then
   fi
   for ((u = 1; u <= ${#users[@]}; ++u)); do
     user_haptic_args=(--clock "$clock" --duration "$duration" --shm "${shm}_u$u" --world-shm "$shm"
-                      --summary "$out/user$u.haptic.json" "${haptic_extra[@]}")
+                      --summary "$out/user$u.haptic.json" --meshes-from "$scene" "${haptic_extra[@]}")
     add_log user_haptic_args "user$u.haptic"
     user_device_args=(--clock "$clock" --shm "${shm}_u$u" --trajectory "${users[u - 1]}"
                       --summary "$out/user$u.device.json")

@@ -4,13 +4,12 @@
 #include "common/contract/limits.h"
 #include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
+#include "common/mesh/mesh_object.h"
 #include "world_manager/engine/engine_registry.h"
-#include "world_manager/mesh_objects.h"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <span>
 #include <set>
@@ -258,10 +257,7 @@ Scene parse_scene(const nlohmann::json& document, const std::string& source_name
                  std::to_string(objects.value().size()));
   }
   // Mesh files are named relative to the scene file's folder (the working directory for a scene given as text).
-  std::error_code not_a_file;
-  const std::string scene_dir = std::filesystem::is_regular_file(source_name, not_a_file)
-                                    ? std::filesystem::path(source_name).parent_path().string()
-                                    : std::string();
+  const std::string scene_dir = scene_folder(source_name);
   std::set<std::string> names;
   for (std::size_t i = 0; i < objects.value().size(); ++i) {
     const Node node = objects.element(i);

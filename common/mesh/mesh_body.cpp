@@ -84,6 +84,12 @@ double MeshBody::support(const Eigen::Vector3d& normal) const {
   return best;
 }
 
+bool MeshBody::segment_enters(const Eigen::Vector3d& a, const Eigen::Vector3d& d, double margin_m) const {
+  if (nearest(a).signed_distance_m < -margin_m || nearest(a + d).signed_distance_m < -margin_m) return true;
+  const double length_m = d.norm();
+  return length_m > margin_m && bvh_.segment_crosses(a, a + d, margin_m / length_m);
+}
+
 Eigen::Vector3d MeshBody::bounds_half(const Eigen::Matrix3d& rotation) const {
   Eigen::Vector3d half = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& v : bvh_.mesh().vertices_m) half = half.cwiseMax((rotation * v).cwiseAbs());

@@ -34,6 +34,7 @@ class MeshBody final : public MeshGeometry {
 
   SurfacePoint nearest(const Eigen::Vector3d& query_m) const override;
   double support(const Eigen::Vector3d& normal) const override;
+  bool segment_enters(const Eigen::Vector3d& a, const Eigen::Vector3d& d, double margin_m) const override;
   Eigen::Vector3d bounds_half(const Eigen::Matrix3d& rotation) const override;
   double volume_m3() const override { return volume_m3_; }
   Eigen::Matrix3d inertia_per_kg() const override { return inertia_per_kg_; }

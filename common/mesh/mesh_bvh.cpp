@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 namespace impetus {
 
@@ -223,6 +224,71 @@ bool MeshBvh::search(const Eigen::Vector3d& query_m, double best_squared, bool s
   out.triangle = best_triangle;
   out.feature = best_feature;
   return true;
+}
+
+namespace {
+
+// The segment a + t·d, t in [0, 1], clipped to the box by the slab method: whether any of it lies in the box.
+bool segment_meets_box(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& a, const Eigen::Vector3d& d) {
+  double t0 = 0.0, t1 = 1.0;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0.0) {
+      if (a[i] < box.min()[i] || a[i] > box.max()[i]) return false;
+      continue;
+    }
+    double near = (box.min()[i] - a[i]) / d[i];
+    double far = (box.max()[i] - a[i]) / d[i];
+    if (near > far) std::swap(near, far);
+    t0 = std::max(t0, near);
+    t1 = std::min(t1, far);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+// Möller–Trumbore: the parameter t at which a + t·d meets triangle pqr, or −1 if it does not (parallel, or
+// outside the triangle's edges).
+double segment_meets_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d, const Eigen::Vector3d& p,
+                              const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
+  const Eigen::Vector3d e1 = q - p, e2 = r - p;
+  const Eigen::Vector3d h = d.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) < 1e-300) return -1.0;
+  const double inverse = 1.0 / det;
+  const Eigen::Vector3d s = a - p;
+  const double u = inverse * s.dot(h);
+  if (u < 0.0 || u > 1.0) return -1.0;
+  const Eigen::Vector3d k = s.cross(e1);
+  const double v = inverse * d.dot(k);
+  if (v < 0.0 || u + v > 1.0) return -1.0;
+  return inverse * e2.dot(k);
+}
+
+}  // namespace
+
+bool MeshBvh::segment_crosses(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double t_min) const {
+  if (nodes_.empty()) return false;
+  const Eigen::Vector3d d = b - a;
+  std::array<std::uint32_t, kMaxDepth + 1> stack{};
+  std::size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!segment_meets_box(node.bounds, a, d)) continue;
+    if (node.count > 0) {
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        const auto& tri = mesh_.triangles[order_[i]];
+        const double t = segment_meets_triangle(a, d, mesh_.vertices_m[tri[0]], mesh_.vertices_m[tri[1]],
+                                                mesh_.vertices_m[tri[2]]);
+        if (t > t_min && t <= 1.0) return true;
+      }
+      continue;
+    }
+    const std::uint32_t self = static_cast<std::uint32_t>(&node - nodes_.data());
+    stack[top++] = node.first;  // right
+    stack[top++] = self + 1;    // left
+  }
+  return false;
 }
 
 std::size_t MeshBvh::memory_bytes() const {

@@ -45,6 +45,10 @@ class MeshBvh {
   // little since has its nearest point on or beside that triangle, so the walk skips nearly every box at once.
   bool nearest_from(const Eigen::Vector3d& query_m, const MeshPoint& hint, MeshPoint& out) const;
 
+  // Whether the segment from `a` to `b` crosses a triangle at a parameter t in (t_min, 1] (t = 0 at `a`): the
+  // triangle's plane between its two ends, within its edges (Möller and Trumbore's test). Both sides count.
+  bool segment_crosses(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double t_min) const;
+
   const TriangleMesh& mesh() const { return mesh_; }
   const Eigen::AlignedBox3d& bounds() const { return nodes_.front().bounds; }
   std::size_t node_count() const { return nodes_.size(); }

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // A triangle mesh a user brings (docs/meshes.md): its triangles, in the body frame about their centre of mass, are
-// in the process's mesh registry under the hash the descriptor carries (mesh_geometry.h). The world manager, which
-// loads the scene, has them; the haptic side renders the planes the world sends as they are (the paper's §3.1), so
-// a mesh's plane is not retaken from the shape. Without its geometry (a process that did not load the file) a mesh
-// answers as the ball of its radius_m, which holds it. A mesh may be concave (traits().convex is false): the world
-// takes its plane at the nearest point every step and keeps no face.
+// in the process's mesh registry under the hash the descriptor carries (mesh_geometry.h). The world manager loads
+// them with the scene, the haptic controller with --meshes-from the same scene. Without them (a process that did not
+// load the file) a mesh answers as the ball of its radius_m, which holds it, and its plane is left as sent. A mesh
+// may be concave (traits().convex is false): the world takes its plane at the nearest point every step and keeps no
+// face.
 #include "common/shape/shape_kind.h"
 
 #include "common/shape/mesh_geometry.h"
@@ -49,30 +49,45 @@ Eigen::Matrix3d inertia_per_kg(const Shape& shape) {
   return mesh != nullptr ? mesh->inertia_per_kg() : Eigen::Matrix3d::Zero();
 }
 
+bool segment_enters(const Shape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& d, double margin_m) {
+  const MeshGeometry* mesh = find_mesh_geometry(shape.mesh_hash);
+  return mesh != nullptr && mesh->segment_enters(a, d, margin_m);
+}
+
+// The tangent plane at the mesh's point nearest `around_m` (the proxy), with the pseudo-normal of the face, edge or
+// vertex it lies on, as a sphere's is retaken: the proxy follows the surface tick by tick between world frames.
+void retake(ShapePlane& plane, const Eigen::Vector3d& around_m) {
+  const MeshGeometry* mesh = find_mesh_geometry(plane.shape.mesh_hash);
+  if (mesh == nullptr) return;  // the triangles are not here: the plane as sent
+  const SurfacePoint nearest = mesh->nearest(plane.axes.transpose() * (around_m - plane.com_m));
+  plane.point_m = plane.com_m + plane.axes * nearest.point_m;
+  plane.normal = plane.axes * nearest.normal;
+}
+
 // No two points of the mesh are farther apart than the diameter of the ball about its centre of mass that holds it.
 double plane_extent(const Shape& shape) { return 2.0 * shape.radius_m; }
 
-// Read from a scene by the world manager, which loads the file (world_manager/mesh_objects.h).
+// Read from a scene by the world manager and the haptic controller, which load the file (common/mesh/mesh_object.h).
 constexpr std::string_view kKeys[] = {"file", "scale"};
 
 }  // namespace
 
 const ShapeKindOps kMeshOps{
     .name = "mesh",
-    .traits = {.carries_axes = false, .flat_faces = false, .round = false, .normal_through_core = false,
-               .convex = false, .planes_as_sent = true},
+    .traits = {.carries_axes = true, .flat_faces = false, .round = false, .normal_through_core = false,
+               .convex = false},
     .keys = kKeys,
     .parse = nullptr,
     .problem = problem,
     .nearest = nearest,
     .support = support,
     .bounds_half = bounds_half,
-    .segment_enters = nullptr,  // asked only of convex shapes' kept faces (traits().convex)
+    .segment_enters = segment_enters,
     .volume = volume,
     .inertia_per_kg = inertia_per_kg,
     .plane_extent = plane_extent,
     .describes_within = plane_extent,
-    .retake = nullptr,
+    .retake = retake,
     .nearest_faces = nullptr,
     .support_corners = nullptr,
 };

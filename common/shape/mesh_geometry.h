@@ -4,8 +4,9 @@
 //
 // A mesh's triangles are too many for the fixed-size descriptor that crosses the links, so the descriptor carries
 // their hash and each process that needs the geometry loads the same file and registers it here (the world manager
-// does, when it loads a scene: common/mesh/mesh_body.h). A process that has not loaded it (the haptic controller,
-// a viewer) still has the descriptor's bounding box and radius, and renders the planes the world sends as they are.
+// does when it loads a scene, and the haptic controller given the same scene: common/mesh/mesh_object.h). A process
+// that has not loaded it (a viewer; a haptic controller without the scene) still has the descriptor's bounding box
+// and radius, and uses the planes the world sends as they are.
 //
 // Frames and units: the body frame (its origin the mesh's centre of mass), SI. Registered geometry is immutable and
 // lives until the process ends; lookups take no lock and allocate nothing, so any thread may query at any rate.
@@ -26,6 +27,10 @@ class MeshGeometry {
   virtual SurfacePoint nearest(const Eigen::Vector3d& query_m) const = 0;
   // max over the vertices of normal·x.
   virtual double support(const Eigen::Vector3d& normal) const = 0;
+  // Whether `a` + t·`d`, t in [0, 1], passes through the mesh's inside deeper than `margin_m`: an end inside by more
+  // than the margin, or a crossing of the surface past the first `margin_m` of the way (a way that starts on the
+  // surface and leaves does not enter; one through a thin wall does).
+  virtual bool segment_enters(const Eigen::Vector3d& a, const Eigen::Vector3d& d, double margin_m) const = 0;
   // Half extents of the smallest world-aligned box centred on the origin that holds the mesh turned by `rotation`:
   // max over the vertices of |(rotation·x)_i| (shape.h's bounds are centred on the body's origin).
   virtual Eigen::Vector3d bounds_half(const Eigen::Matrix3d& rotation) const = 0;

@@ -52,9 +52,6 @@ struct ShapeTraits {
   // Convex: its supporting planes (support_m) touch its surface, so the world may keep the face a finger went in by
   // and take its plane again from the support function (a primitive; not a mesh, which may be concave).
   bool convex = false;
-  // The haptic side renders its planes as the world sent them: it has not the geometry to take them again (a mesh,
-  // whose triangles only the world loaded; the paper's §3.1 plane, interpolated between frames).
-  bool planes_as_sent = false;
 };
 
 // Pose of a body: world = orientation · body + position.

@@ -171,7 +171,6 @@ TEST_CASE("a mesh this process has not loaded answers as the ball that holds it,
   mesh.box_size_m = {0.05, 0.06, 0.07};
   mesh.mesh_hash = 0x1234'5678'9abc'def0ULL;
   CHECK(impetus::shape_problem(mesh) == nullptr);
-  CHECK(impetus::traits(ShapeKind::mesh).planes_as_sent);
   CHECK_FALSE(impetus::traits(ShapeKind::mesh).convex);
   const impetus::SurfacePoint above = impetus::nearest_surface_point_body(mesh, Vector3d(0.0, 0.0, 0.1));
   CHECK(above.signed_distance_m == Approx(0.06));

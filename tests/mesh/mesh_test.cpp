@@ -3,6 +3,7 @@
 // forms, and the nearest-point tree against brute force.
 
 #include "common/mesh/mass_properties.h"
+#include "common/mesh/mesh_body.h"
 #include "common/mesh/mesh_bvh.h"
 #include "common/mesh/mesh_check.h"
 #include "common/mesh/mesh_file.h"
@@ -237,4 +238,32 @@ TEST_CASE("mesh: the hash is the same for the same mesh and differs when a verte
   CHECK(mesh_hash(a) == mesh_hash(b));
   b.vertices_m[5].x() += 1e-12;
   CHECK(mesh_hash(a) != mesh_hash(b));
+}
+
+TEST_CASE("mesh: a segment crosses the surface where it does, and enters a body or a thin wall only by going in") {
+  const MeshBvh tree(box_mesh(Eigen::Vector3d(0.02, 0.02, 0.02)));
+  // Through the box along x: two crossings; from the centre out: one; beside it: none.
+  CHECK(tree.segment_crosses(Eigen::Vector3d(-0.05, 0.0, 0.0), Eigen::Vector3d(0.05, 0.0, 0.0), 0.0));
+  CHECK(tree.segment_crosses(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.05, 0.0, 0.0), 0.0));
+  CHECK_FALSE(tree.segment_crosses(Eigen::Vector3d(-0.05, 0.02, 0.0), Eigen::Vector3d(0.05, 0.02, 0.0), 0.0));
+  // A crossing at the very start does not count past t_min: a way that starts on the face and leaves.
+  CHECK_FALSE(tree.segment_crosses(Eigen::Vector3d(0.01, 0.0, 0.0), Eigen::Vector3d(0.05, 0.0, 0.0), 1e-9));
+
+  // A 1 mm shell: the outer face at z = 0.0105, the inner one at z = 0.0095 (two boxes, one inside the other, wound
+  // against each other), as MeshBody tests it through the shape module.
+  TriangleMesh shell = box_mesh(Eigen::Vector3d(0.021, 0.021, 0.021));
+  TriangleMesh inner = box_mesh(Eigen::Vector3d(0.019, 0.019, 0.019));
+  flip_winding(inner);
+  const auto offset = static_cast<std::uint32_t>(shell.vertices_m.size());
+  for (const Eigen::Vector3d& v : inner.vertices_m) shell.vertices_m.push_back(v);
+  for (const auto& t : inner.triangles) shell.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "impetus-mesh-shell.obj";
+  impetus::test::write_obj(shell, file.string());
+  const impetus::MeshBody& body = impetus::MeshBody::load(file.string(), Eigen::Vector3d::Ones(), false);
+  const Eigen::Vector3d above(0.0, 0.0, 0.02), on_top(0.0, 0.0, 0.0105), cavity(0.0, 0.0, 0.0);
+  CHECK(body.segment_enters(above, on_top - above, 1e-9) == false);   // up to the wall, not into it
+  CHECK(body.segment_enters(on_top, above - on_top, 1e-9) == false);  // off the wall, outward
+  CHECK(body.segment_enters(on_top, cavity - on_top, 1e-9));          // through the 1 mm wall
+  CHECK(body.segment_enters(above, cavity - above, 1e-9));            // from outside through it
+  CHECK(body.segment_enters(above, Eigen::Vector3d(0.0, 0.0, 0.01) - above, 1e-9));  // into the wall's middle
 }

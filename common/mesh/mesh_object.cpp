@@ -1,10 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "world_manager/mesh_objects.h"
+#include "common/mesh/mesh_object.h"
 
 #include "common/mesh/mesh_body.h"
 #include "common/runtime/input_error.h"
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace impetus {
 namespace {
@@ -35,6 +39,39 @@ Shape load_mesh_shape(const JsonNode& object, const std::string& scene_dir, bool
   } catch (const InputError& error) {
     file.fail(error.what());
   }
+}
+
+std::string scene_folder(const std::string& scene_source) {
+  std::error_code not_a_file;
+  return std::filesystem::is_regular_file(scene_source, not_a_file)
+             ? std::filesystem::path(scene_source).parent_path().string()
+             : std::string();
+}
+
+std::size_t load_scene_meshes(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw InputError(path + ": cannot open scene file");
+  std::stringstream text;
+  text << file.rdbuf();
+  nlohmann::json document;
+  try {
+    document = nlohmann::json::parse(text.str());
+  } catch (const nlohmann::json::exception& error) {
+    throw InputError(path + ": not JSON: " + error.what());
+  }
+  const JsonNode root(document, "", path);
+  if (!root.has("objects") || !document["objects"].is_array()) return 0;
+  const JsonNode objects = root.child("objects");
+  const std::string folder = scene_folder(path);
+  std::size_t meshes = 0;
+  for (std::size_t i = 0; i < document["objects"].size(); ++i) {
+    const JsonNode object = objects.element(i);
+    if (!object.value().is_object() || !object.has("shape") || object.value()["shape"] != "mesh") continue;
+    const bool dynamic = object.has("dynamic") && object.child("dynamic").boolean();
+    load_mesh_shape(object, folder, dynamic);
+    ++meshes;
+  }
+  return meshes;
 }
 
 }  // namespace impetus
