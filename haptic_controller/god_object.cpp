@@ -80,7 +80,7 @@ const GodObjectResult& GodObject::solve(const PlaneSet& planes, const Eigen::Vec
   const FrictionResult friction = apply_friction(armed, result_.contact, finger_m, dt_s, anchor_);
   result_.contact.proxy_m = friction.proxy_m;
   result_.sticking = friction.sticking;
-  // What the finger presses and how deep, for a session that ends now to be resumed (resumes()).
+  // What the finger presses and how deep: what end_finger_session keeps if the finger vanishes after this tick.
   pressed_count_ = 0;
   for (int j = 0; j < listed_constraints(result_.contact); ++j) {
     const int index = result_.contact.active[j].plane;
@@ -123,7 +123,7 @@ void GodObject::end_finger_session() {
 }
 
 void GodObject::begin_finger_session(const Eigen::Vector3d& finger_m) {
-  forget_contact();  // what the last session held, if it ended, is kept for resumes()
+  forget_contact();  // what the last session held, if it ended, is kept for armed_planes at the first solve
   session_starting_ = true;
   session_start_finger_m_ = finger_m;
 }

@@ -45,8 +45,9 @@ class GodObject {
   void reset();
 
   // The finger has just become known at `finger_m` (first valid device reading after none): the next solve that sees
-  // planes disarms those of resting objects that both this starting position and the current finger are behind —
-  // the finger was inside from the start, not driven in while the first world frame was on its way.
+  // planes sets back those of resting objects that both this starting position and the current finger are behind —
+  // the finger was inside from the start, not driven in while the first world frame was on its way: by what it sank
+  // since it vanished from an object it pressed, entirely (disarmed) from any other.
   void begin_finger_session(const Eigen::Vector3d& finger_m);
 
   // The finger vanished: forget the contact memory, but keep the objects the last solve pressed and how deep, for

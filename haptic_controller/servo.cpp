@@ -117,7 +117,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
     else ++counters_.no_device_ticks;
     report.finger_valid = 0;
     report.finger_velocity_mps = {};
-    if (finger_known_) god_object_.end_finger_session();  // what it pressed, to resume if it comes back no deeper
+    if (finger_known_) god_object_.end_finger_session();  // what it pressed, to resume the press if it comes back
     finger_known_ = false;
     idle_tick(finger != nullptr);
     return result_;
