@@ -20,6 +20,8 @@
 #      tests/bench/bench_closed_loop.py
 #  11. nearest point on a user's mesh of 10^3 to 10^6 triangles: tree build, memory, query percentiles
 #      build/tests/bench_mesh_query
+#  12. the servo's tick on a mesh ball of 10^3 to 10^6 triangles, beside the primitive box and sphere
+#      build/tests/bench_mesh_tick
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -221,3 +223,6 @@ fi
 
 section "11. Nearest point on a user's mesh (docs/meshes.md): a sphere of 10^3 to 10^6 triangles, 3 mm inside and on the surface"
 bench bench_mesh_query
+
+section "12. Haptic tick on a mesh (docs/meshes.md): pressed 3 mm into a ball of 10^3 to 10^6 triangles and sliding, beside the primitive box and sphere"
+bench bench_mesh_tick

@@ -73,8 +73,16 @@ MeshBody::MeshBody(TriangleMesh mesh, bool closed, bool flipped)
 }
 
 SurfacePoint MeshBody::nearest(const Eigen::Vector3d& query_m) const {
+  // The servo asks at the proxy every tick, which moves little: the walk starts from this thread's last answer on
+  // this mesh (MeshBvh::nearest_from: the same answer, most boxes skipped at once). One hint per thread, so any
+  // number of threads may ask; one that alternates between meshes only loses the head start.
+  thread_local const MeshBody* last_body = nullptr;
+  thread_local MeshPoint last{};
   MeshPoint point;
-  if (!bvh_.nearest(query_m, point)) return {Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0};
+  const bool found = last_body == this ? bvh_.nearest_from(query_m, last, point) : bvh_.nearest(query_m, point);
+  if (!found) return {Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0};
+  last_body = this;
+  last = point;
   return {point.point_m, point.normal, point.signed_distance_m};
 }
 
