@@ -46,18 +46,14 @@ int main(int argc, char** argv) {
   app.add_option("--device", device_spec, "the device: " + device_forms() +
                      " (spidar: the built-in geometry; web: a simulated hand a person steers from the viewer's page, "
                      "with viewer --touch; real time only)");
-  app.add_option("--fingers", fingers,
-                 "fingers of the device, one endpoint of the world each, 1 to 8 (1); finger k has the device port "
-                 "NAME.device (k = 0) or NAME.device<k>, and a string set of the device's geometry")
-      ->check(CLI::Range(1u, kMaxFingers));
-  app.add_option("--followers", options.followers,
-                 "lockstep, the first of several users' controllers on one world: wait for this many more to attach "
-                 "(with --world-shm) before the first tick; they follow this one's ticks (0)")
+  app.add_option("--fingers", fingers, "fingers of the device, one endpoint of the world each, 1 to 8 (1); finger "
+                 "k's device port is NAME.device (k = 0) or NAME.device<k>")->check(CLI::Range(1u, kMaxFingers));
+  app.add_option("--followers", options.followers, "lockstep, the first of several users' controllers on one "
+                 "world: wait for this many more (with --world-shm); they follow this one's ticks (0)")
       ->check(CLI::Range(0u, kMaxEndpoints - 1));
   app.add_option("--world-shm", world_shm, "the world link's NAME when it differs from --shm: several users' "
                  "controllers, each with its own --shm for its device, on one world");
-  app.add_flag("!--no-realtime-priority", options.realtime_priority,
-               "do not ask for SCHED_FIFO and mlockall in real time");
+  app.add_flag("!--no-realtime-priority", options.realtime_priority, "no SCHED_FIFO and mlockall in real time");
   app.add_option("--meshes-from", mesh_scene, "the world's scene: its meshes are read, so the servo follows their "
                  "triangles between frames (else a mesh's planes are used as sent)");
   if (const std::optional<int> status = parse_flags(app, "haptic_controller", argc, argv)) return *status;
