@@ -47,6 +47,8 @@ void check_accepted(const PlaneFrame& frame) {
                all_finite(plane.velocity_mps) && all_finite(plane.angular_velocity_radps));
     FUZZ_CHECK(std::isfinite(plane.inverse_mass_per_kg));
     FUZZ_CHECK(std::isfinite(plane.extent_m) && plane.extent_m >= 0.0);
+    FUZZ_CHECK(plane.yield_force_N >= 0.0 && plane.yield_depth_mpNs >= 0.0 && plane.yield_radius_m >= 0.0 &&
+               plane.yield_room_m >= 0.0);
     for (double value : plane.inverse_inertia_world) FUZZ_CHECK(std::isfinite(value));
     const double norm = std::hypot(plane.normal[0], plane.normal[1], plane.normal[2]);
     FUZZ_CHECK(std::fabs(norm - 1.0) < kUnitSlack);
@@ -70,7 +72,9 @@ void check_accepted(const HapticReport& report) {
     const ObjectImpulse& entry = report.entries[k];
     FUZZ_CHECK(all_finite(entry.impulse_Ns) && all_finite(entry.angular_impulse_Nms) &&
                all_finite(entry.impulse_moment_Nss) && all_finite(entry.angular_impulse_moment_Nmss) &&
-               std::isfinite(entry.hand_input_J));
+               std::isfinite(entry.hand_input_J) && std::isfinite(entry.press_Ns) &&
+               all_finite(entry.press_point_Nsm) && std::isfinite(entry.press_time_Nss) &&
+               std::isfinite(entry.press_time2_Nsss) && all_finite(entry.press_point_time_Nssm));
   }
 }
 

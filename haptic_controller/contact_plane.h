@@ -22,12 +22,17 @@ namespace impetus {
 // the shape module retakes every tick; plus what friction and the sharing of the reaction need.
 struct ContactPlane : ShapePlane {
   std::int32_t object_id = -1;
-  std::uint32_t flags = 0;  // kPlaneDynamic, as sent by the world
+  std::uint32_t flags = 0;  // kPlaneDynamic, kPlaneDeformable, as sent by the world
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();
   double static_friction = 0.0;
   double dynamic_friction = 0.0;
   double extent_m = 0.0;  // how far from point_m the plane describes its object; 0: unbounded (Plane::extent_m)
+  // A deformable surface's yield (Plane::yield_force_N, yield_depth_mpNs, yield_radius_m); zero for the rigid.
+  double yield_force_N = 0.0;
+  double yield_depth_mpNs = 0.0;
+  double yield_radius_m = 0.0;
+  double yield_room_m = 0.0;
 
   // Whether the plane carries its body's shape (the floor's does not).
   bool shaped() const { return shape.kind != ShapeKind::none; }
@@ -42,6 +47,7 @@ struct ContactPlane : ShapePlane {
     return velocity_mps + angular_velocity_radps.cross(x_m - com_m);
   }
   bool dynamic() const { return (flags & kPlaneDynamic) != 0; }
+  bool deformable() const { return (flags & kPlaneDeformable) != 0; }
 
   // Angular impulse about the CoM of `impulse_Ns` applied by a finger at `proxy_m`. On a flat face the push acts at
   // the proxy. Where a push along the normal passes through the body's core (ShapeTraits::normal_through_core: a

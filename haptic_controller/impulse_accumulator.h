@@ -13,8 +13,9 @@
 //     impulse_Ns          += J_k (the share of −f_k·Δt)
 //     angular_impulse_Nms += (contact − com) × J_k      (contact = the proxy, com interpolated; through the centre
 //                                                        for a sphere's normal part, contact_plane.h)
-// rather than the paper's single F_i at one point p_i. Planes without kPlaneDynamic (floor, fixed objects) feed
-// report.static_impulse_Ns.
+// rather than the paper's single F_i at one point p_i. Planes without kPlaneDynamic or kPlaneDeformable (floor, fixed
+// objects) feed report.static_impulse_Ns. Each entry also records where and when its surface was pressed
+// (ObjectImpulse::press_*), which a deformable object dents by.
 //
 // The report holds running totals (ObjectImpulse in common/contract/frames.h). When all kMaxImpulseEntries entries are
 // in use, an entry whose last_tick ≤ the world's report_tick_applied (for this haptic session) is final — the world has
@@ -55,6 +56,7 @@ struct ImpulseShare {
   bool dynamic = false;
   Eigen::Vector3d impulse_Ns = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_impulse_Nms = Eigen::Vector3d::Zero();  // about the plane's com_m
+  double yielding_Ns = 0.0;  // a deformable plane's push beyond yield (ObjectImpulse::press_Ns's part), else 0
 };
 
 class ImpulseAccumulator {

@@ -40,6 +40,10 @@ ContactPlane to_contact_plane(const Plane& plane) {
   out.static_friction = plane.static_friction;
   out.dynamic_friction = plane.dynamic_friction;
   out.extent_m = plane.extent_m;
+  out.yield_force_N = plane.yield_force_N;
+  out.yield_depth_mpNs = plane.yield_depth_mpNs;
+  out.yield_radius_m = plane.yield_radius_m;
+  out.yield_room_m = plane.yield_room_m;
   out.shape = plane.shape;
   if (traits(plane.shape.kind).carries_axes) {
     const Eigen::Vector3d x = to_eigen(plane.body_axis_x);

@@ -2,6 +2,7 @@
 #include "haptic_controller/servo.h"
 
 #include "common/runtime/staleness.h"
+#include "haptic_controller/local_yield.h"
 #include "haptic_controller/plane_interpolator.h"
 #include "haptic_controller/plane_matching.h"
 #include "haptic_controller/shape_planes.h"
@@ -40,6 +41,7 @@ void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
     counters_.local_replay_gaps = local_.replay_gaps();
     counters_.local_unlogged_shares = local_.unlogged_shares();
   }
+  if (!continues) local_yield_.clear();  // a new world: its first frame shows none of our pushes
   frame_since_last_tick_ = true;
   copy_used(frame, current_frame_);
   have_frame_ = true;
@@ -159,6 +161,8 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   // Planes that carry their shape taken again at the last proxy, or at the finger past a body the way to it does not
   // enter (shape_planes.h).
   retake_shape_planes(planes_, to_eigen(result_.proxy_m), finger_m);
+  // Deformable surfaces yield by the push beyond yield the world has not yet dented them by (local_yield.h).
+  if (have_frame_) local_yield_.apply(current_frame_, report.haptic_session, to_eigen(result_.proxy_m), planes_);
 
   // 3. Proxy D_j (god-object with friction).
   planes_.valid_within_m =
@@ -205,6 +209,8 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   accumulator_.add(planes_, contact.contact, force_N, hold_s > 0.0 && std::isfinite(hold_s) ? hold_s : 0.0,
                    counters_.ticks);
   counters_.dropped_impulse_shares = accumulator_.dropped_shares();
+  local_yield_.record(counters_.ticks, contact.contact.proxy_m, accumulator_.last_shares(),
+                      accumulator_.last_share_count());
   // The objects give way at the haptic rate (local coupling, paper §6.3): this tick's shares move the model.
   if (have_frame_) motion_->take_shares(accumulator_.last_shares(), accumulator_.last_share_count());
 

@@ -14,6 +14,7 @@
 #include "haptic_controller/god_object.h"
 #include "haptic_controller/impulse_accumulator.h"
 #include "haptic_controller/local_dynamics.h"
+#include "haptic_controller/local_yield.h"
 #include "haptic_controller/plane_motion.h"
 
 #include <array>
@@ -133,6 +134,7 @@ class HapticServo {
   ImpulseAccumulator accumulator_;
   InterpolatedPlanes interpolated_;
   LocalDynamics local_;
+  LocalYield local_yield_;  // deformable surfaces between frames
   PlaneMotion* motion_ = &interpolated_;  // the coupling's, chosen by each frame
   bool frame_since_last_tick_ = false;
   std::array<WatchedPlane, kMaxActiveConstraints + 1> watched_{};

@@ -226,3 +226,6 @@ bench bench_mesh_query
 
 section "12. Haptic tick on a mesh (docs/meshes.md): pressed 3 mm into a ball of 10^3 to 10^6 triangles and sliding, beside the primitive box and sphere"
 bench bench_mesh_tick
+
+section "13. A plastic slab (docs/deformation.md): a 128 × 128-cell slab's step on the world side, the haptic tick on its face beside a rigid box's"
+bench bench_deform

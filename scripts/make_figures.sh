@@ -33,6 +33,10 @@ cp out/figures/edge/edge_release.png docs/edge_release.png
 /usr/bin/python3 scripts/latency_experiment.py --out out/figures/latency
 cp out/figures/latency/latency.png docs/latency.png
 cp out/figures/latency/latency.md docs/latency_table.md
+# Deformation from integrated force against the previous method (paper §6.4, docs/deformation.md).
+/usr/bin/python3 scripts/deformation_experiment.py --out out/figures/deformation
+cp out/figures/deformation/deformation.png docs/deformation.png
+cp out/figures/deformation/deformation.md docs/deformation_table.md
 # The phase experiment and the hard cases on every engine (docs/engines.md).
 /usr/bin/python3 scripts/engines.py --quiet --out out/figures/engines --doc docs/engines.md
 # The viewer replaying a lockstep tap trial at its hardest push, in headless Chromium (the browser test's replay case

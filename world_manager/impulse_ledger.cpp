@@ -1,7 +1,28 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/impulse_ledger.h"
 
+#include <cmath>
+
 namespace impetus {
+
+PressMoments PressMoments::of(const ObjectImpulse& entry) {
+  return {entry.press_Ns, to_eigen(entry.press_point_Nsm), entry.press_time_Nss, entry.press_time2_Nsss,
+          to_eigen(entry.press_point_time_Nssm)};
+}
+
+PressMoments PressMoments::operator-(const PressMoments& other) const {
+  return {push_Ns - other.push_Ns, point_Nsm - other.point_Nsm, time_Nss - other.time_Nss,
+          time2_Nsss - other.time2_Nsss, point_time_Nssm - other.point_time_Nssm};
+}
+
+PressMoments PressMoments::scaled(double factor) const {
+  return {factor * push_Ns, factor * point_Nsm, factor * time_Nss, factor * time2_Nsss, factor * point_time_Nssm};
+}
+
+bool PressMoments::all_finite() const {
+  return std::isfinite(push_Ns) && point_Nsm.allFinite() && std::isfinite(time_Nss) && std::isfinite(time2_Nsss) &&
+         point_time_Nssm.allFinite();
+}
 
 ImpulseLedger::ImpulseLedger(std::size_t id_count) : id_count_(id_count) {}
 
@@ -15,12 +36,14 @@ ImpulseDelta ImpulseLedger::take(const CounterOwner& owner, const ObjectImpulse&
   Baseline& baseline = baselines_of(owner).objects[static_cast<std::size_t>(entry.object_id)];
   if (!baseline.seen || baseline.epoch != entry.epoch) {
     // A new counter starts at zero (contract/frames.h, ObjectImpulse::epoch).
-    baseline = Baseline{true, entry.epoch, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0};
+    baseline = Baseline{true, entry.epoch, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, PressMoments{}};
   }
   const Eigen::Vector3d total_Ns = to_eigen(entry.impulse_Ns);
   const Eigen::Vector3d total_angular_Nms = to_eigen(entry.angular_impulse_Nms);
+  const PressMoments press = PressMoments::of(entry);
   ImpulseDelta delta{total_Ns - baseline.impulse_Ns, total_angular_Nms - baseline.angular_impulse_Nms,
-                     entry.hand_input_J - baseline.hand_input_J};
+                     entry.hand_input_J - baseline.hand_input_J, press - baseline.press};
+  baseline.press = press;
   baseline.impulse_Ns = total_Ns;
   baseline.angular_impulse_Nms = total_angular_Nms;
   baseline.hand_input_J = entry.hand_input_J;

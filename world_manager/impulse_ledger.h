@@ -19,10 +19,26 @@
 
 namespace impetus {
 
+// The moments of the push into an object's surface (common/contract/frames.h ObjectImpulse::press_*), over some span
+// of haptic ticks: what a deformable object dents by (deform/press_path.h).
+struct PressMoments {
+  double push_Ns = 0.0;                                        // Σ p_k
+  Eigen::Vector3d point_Nsm = Eigen::Vector3d::Zero();         // Σ p_k·x_k, world frame
+  double time_Nss = 0.0;                                       // Σ p_k·t_k
+  double time2_Nsss = 0.0;                                     // Σ p_k·t_k²
+  Eigen::Vector3d point_time_Nssm = Eigen::Vector3d::Zero();   // Σ p_k·x_k·t_k
+
+  static PressMoments of(const ObjectImpulse& entry);
+  PressMoments operator-(const PressMoments& other) const;
+  PressMoments scaled(double factor) const;  // every moment times `factor` (a clipped report's push)
+  bool all_finite() const;
+};
+
 struct ImpulseDelta {
   Eigen::Vector3d impulse_Ns = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_impulse_Nms = Eigen::Vector3d::Zero();  // about the centre of mass, world frame
   double hand_input_J = 0.0;  // the energy the hand put in behind it (ObjectImpulse::hand_input_J)
+  PressMoments press;         // where and when the surface was pressed (ObjectImpulse::press_*)
 };
 
 // Whose counters: one endpoint of one haptic session.
@@ -50,6 +66,7 @@ class ImpulseLedger {
     Eigen::Vector3d impulse_Ns = Eigen::Vector3d::Zero();
     Eigen::Vector3d angular_impulse_Nms = Eigen::Vector3d::Zero();
     double hand_input_J = 0.0;
+    PressMoments press;
   };
   struct OwnerBaselines {
     std::vector<Baseline> objects;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/scene.h"
 
+#include "world_manager/deform/plastic_surface.h"
+
 #include "common/contract/limits.h"
 #include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
@@ -146,7 +148,53 @@ ShapeKind parse_shape_kind(const Node& node) {
 // The keys every object may have; its shape's own come from the shape module.
 constexpr std::string_view kObjectKeys[] = {
     "name", "shape", "dynamic", "mass_kg", "density_kgpm3", "position_m", "orientation_wxyz", "linear_velocity_mps",
-    "angular_velocity_radps", "static_friction", "dynamic_friction", "restitution"};
+    "angular_velocity_radps", "static_friction", "dynamic_friction", "restitution", "deformable"};
+
+// A "deformable" block (docs/scene-format.md): a plastic top face for a static box. The ranges span the materials a
+// finger can dent (wet clay at ~1 kPa to stiff wax at ~1 MPa) with room either side, and grids a step can yield in
+// milliseconds (PlasticSurface::kMaxCells).
+PlasticMaterial parse_deformable(const Node& node, const SceneObject& object) {
+  node.expect_object();
+  node.expect_keys({"rule", "yield_stress_Pa", "flow_resistance_Paspm", "contact_radius_m", "cell_m", "plasticity"});
+  if (object.dynamic) node.fail("only a static object can be deformable (\"dynamic\": false)");
+  if (object.shape.kind != ShapeKind::box) node.fail("only a box can be deformable (its top face yields)");
+  PlasticMaterial material;
+  if (node.has("rule")) {
+    const std::string rule = node.child("rule").string();
+    if (rule == "impulse") {
+      material.rule = PlasticMaterial::Rule::impulse;
+    } else if (rule == "penetration") {
+      material.rule = PlasticMaterial::Rule::penetration;
+    } else {
+      node.child("rule").fail("unknown rule, expected impulse or penetration");
+    }
+  }
+  if (node.has("yield_stress_Pa")) material.yield_stress_Pa = node.child("yield_stress_Pa").in_range(0.0, 1e8, " Pa");
+  if (node.has("flow_resistance_Paspm")) {
+    material.flow_resistance_Paspm = node.child("flow_resistance_Paspm").in_range(1e2, 1e12, " Pa·s/m");
+  }
+  if (node.has("contact_radius_m")) {
+    material.contact_radius_m = node.child("contact_radius_m").in_range(1e-4, 0.1, " m");
+  }
+  if (node.has("cell_m")) material.cell_m = node.child("cell_m").in_range(1e-5, 0.05, " m");
+  if (node.has("plasticity")) {
+    material.plasticity = node.child("plasticity").in_range(0.0, 1.0, "");
+    if (!(material.plasticity > 0.0)) node.child("plasticity").fail("must be above 0 (0 never dents)");
+  }
+  if (material.cell_m > 0.5 * material.contact_radius_m) {
+    const Node at = node.has("cell_m") ? node.child("cell_m") : node;
+    at.fail("cell_m must be at most half of contact_radius_m (" + readable(material.contact_radius_m) +
+            " m), so the contact pad spans cells");
+  }
+  const Eigen::Vector3d half_m = 0.5 * Eigen::Vector3d(object.shape.box_size_m[0], object.shape.box_size_m[1],
+                                                       object.shape.box_size_m[2]);
+  if (PlasticSurface::cells_for(material, half_m) > PlasticSurface::kMaxCells) {
+    const Node at = node.has("cell_m") ? node.child("cell_m") : node;
+    at.fail("the top face would have more than " + std::to_string(PlasticSurface::kMaxCells) +
+            " cells; use larger cells or a smaller box");
+  }
+  return material;
+}
 
 SceneObject parse_object(const Node& node, const std::string& scene_dir) {
   node.expect_object();
@@ -205,6 +253,7 @@ SceneObject parse_object(const Node& node, const std::string& scene_dir) {
         node.child("angular_velocity_radps").vector_up_to(SceneLimits::kMaxAngularSpeed_radps, " rad/s");
   }
   object.material = parse_material(node, Material{});
+  if (node.has("deformable")) object.deformable = parse_deformable(node.child("deformable"), object);
   return object;
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/world.h"
 
+#include "world_manager/deform/press_path.h"
 #include "world_manager/engine/engine_registry.h"
 
 #include <algorithm>
@@ -42,6 +43,7 @@ World::World(const Scene& scene, const WorldOptions& options)
   const CouplingContext context{scene_, period_s_, scene_.physics.substeps, *engine_, states_, applied_, *port_};
   coupling_ = make_coupling(options.coupling, context, stiffness_Npm, damping_Nspm);
 
+  surfaces_.resize(states_.size());
   for (std::size_t id = 0; id < states_.size(); ++id) {
     const SceneObject& object = scene_.objects[id];
     ObjectState& state = states_[id];
@@ -49,6 +51,10 @@ World::World(const Scene& scene, const WorldOptions& options)
       const auto& q = object.orientation_wxyz;
       state.pose.position_m = to_eigen(object.position_m);
       state.pose.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+    }
+    if (object.deformable) {
+      surfaces_[id] = std::make_unique<PlasticSurface>(*object.deformable, 0.5 * to_eigen(object.shape.box_size_m),
+                                                       state.pose.position_m, state.pose.orientation);
     }
   }
   refresh_states(engine_->moved());
@@ -105,6 +111,13 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   for (std::size_t slot = 0; slot < kMaxEndpoints; ++slot) {
     fingers_[slot] = slot < reports.size() ? endpoints_[slot].finger : FingerState{};
   }
+  // The penetration rule dents by the finger as sampled now (the previous method of paper §6.4).
+  for (const auto& surface : surfaces_) {
+    if (!surface || surface->material().rule != PlasticMaterial::Rule::penetration) continue;
+    for (std::size_t slot = 0; slot < reports.size(); ++slot) {
+      if (fingers_[slot].valid) surface->press_by_penetration(fingers_[slot].finger.position_m);
+    }
+  }
   coupling_->before_step(std::span<const FingerState>(fingers_.data(), reports.size()), features_);
   port_->settle();  // the velocity changes the reports made, against the hand input they brought
 
@@ -112,6 +125,9 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   engine_->step(scene_.physics.substeps, period_s_ / scene_.physics.substeps, coupling_->needs_contacts(), *coupling_);
   coupling_->after_step();
   port_->settle();
+  for (const auto& surface : surfaces_) {
+    if (surface) surface->yield_period();
+  }
   ++steps_taken_;
   time_s_ = static_cast<double>(steps_taken_) * period_s_;  // no drift from summing periods
   refresh_states(engine_->moved());
@@ -240,6 +256,7 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
     if (scale < 1.0) {
       t.delta.impulse_Ns *= scale;
       t.delta.angular_impulse_Nms *= scale;
+      t.delta.press = t.delta.press.scaled(scale);
       t.moment.impulse_Ns *= scale;
       t.moment.angular_impulse_Nms *= scale;
     }
@@ -253,6 +270,11 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
     const bool nothing_new = t.delta.impulse_Ns.isZero(0.0) && t.delta.angular_impulse_Nms.isZero(0.0) &&
                              t.moment.impulse_Ns.isZero(0.0) && t.moment.angular_impulse_Nms.isZero(0.0);
     if (nothing_new) continue;
+    if (id < floor_id && surfaces_[id]) {
+      surfaces_[id]->absorb(t.delta.impulse_Ns);
+      // The push beyond yield, where and when it was given (deform/press_path.h).
+      if (surfaces_[id]->material().rule == PlasticMaterial::Rule::impulse) surfaces_[id]->press(stroke_of(t.delta.press));
+    }
     if (id < floor_id && scene_.objects[id].dynamic) {
       coupling_->take_impulse(id, t.delta, t.moment, t.moment_finite, window);
     } else {
@@ -310,6 +332,30 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
   frame.plane_count =
       near_finger ? features_.extract(endpoint.plane_query, states_, period_s_, frame.planes, &endpoint.plane_faces)
                   : 0;
+  // A deformable object's top face is its grid's, dented: the plane under the proxy, as sent (no shape to take it
+  // again from), good within the contact pad. Its other faces are a fixed box's, whose pushes dent nothing.
+  for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
+    Plane& plane = frame.planes[k];
+    if (plane.object_id < 0 || static_cast<std::size_t>(plane.object_id) >= surfaces_.size()) continue;
+    const PlasticSurface* surface = surfaces_[static_cast<std::size_t>(plane.object_id)].get();
+    if (surface == nullptr) continue;
+    const Eigen::Vector3d query_body_m = surface->to_body(endpoint.plane_query.position_m);
+    if (!surface->over_face(query_body_m)) continue;
+    plane.flags |= kPlaneDeformable;
+    const PlasticMaterial& material = surface->material();
+    plane.yield_force_N = material.yield_force_N();
+    plane.yield_depth_mpNs = material.yield_depth_mpNs();
+    plane.yield_radius_m = material.contact_radius_m;
+    Eigen::Vector3d point_m, normal;
+    surface->tangent_plane(query_body_m, point_m, normal);
+    plane.yield_room_m = surface->room_m(query_body_m.x(), query_body_m.y());
+    plane.point_m = to_vec3(point_m);
+    plane.normal = to_vec3(normal);
+    plane.shape = Shape{};
+    plane.body_axis_x = {};
+    plane.body_axis_y = {};
+    plane.extent_m = surface->material().contact_radius_m;
+  }
   // Planes past the count stay value-initialised (frames.h copy_used): only those the last frame used need it.
   for (std::uint32_t k = frame.plane_count; k < used_before; ++k) frame.planes[k] = Plane{};
   coupling_->annotate(frame);

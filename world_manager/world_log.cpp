@@ -17,9 +17,9 @@ constexpr std::size_t kMinRows = 2;
 constexpr std::size_t kMaxRows = 64;
 
 std::size_t records_per_row(const Scene& scene) {
-  const auto dynamic = static_cast<std::size_t>(
-      std::count_if(scene.objects.begin(), scene.objects.end(), [](const SceneObject& o) { return o.dynamic; }));
-  return dynamic + 2;  // the time, the objects, the static reaction
+  const auto logged = static_cast<std::size_t>(std::count_if(
+      scene.objects.begin(), scene.objects.end(), [](const SceneObject& o) { return o.dynamic || o.deformable; }));
+  return logged + 2;  // the time, the objects (dynamic and deformable), the static reaction
 }
 
 std::size_t ring_records(const Scene& scene) {
@@ -56,6 +56,11 @@ std::string WorldLog::header(const Scene& scene) {
     out << ',' << n << ".jx_Ns," << n << ".jy_Ns," << n << ".jz_Ns";
     out << ',' << n << ".jx_total_Ns," << n << ".jy_total_Ns," << n << ".jz_total_Ns";
   }
+  for (const SceneObject& object : scene.objects) {
+    if (!object.deformable) continue;
+    const std::string& n = object.name;
+    out << ',' << n << ".dent_m," << n << ".dent_volume_m3," << n << ".yielding_Ns";
+  }
   out << ",static.jx_total_Ns,static.jy_total_Ns,static.jz_total_Ns";
   out << ",haptic_time_s";
   return out.str();
@@ -84,6 +89,15 @@ void WorldLog::record() {
     put(record.values, 13, world_.step_impulse_Ns(id));
     put(record.values, 16, world_.total_impulse_Ns(id));
   }
+  for (std::size_t id = 0; id < objects.size(); ++id) {
+    const PlasticSurface* surface = world_.deformable(id);
+    if (surface == nullptr) continue;
+    WorldLogRecord& record = row_[next++];
+    record.part = WorldLogRecord::Part::deformable;
+    record.values[0] = surface->max_dent_m();
+    record.values[1] = surface->dent_volume_m3();
+    record.values[2] = surface->yielding_Ns();
+  }
   WorldLogRecord& statics = row_[next++];
   statics.part = WorldLogRecord::Part::statics;
   put(statics.values, 0, world_.total_static_impulse_Ns());
@@ -102,6 +116,11 @@ void WorldLog::format(std::ostream& out, const WorldLogRecord& record) {
     case WorldLogRecord::Part::object: {
       CsvLine line(out, CsvLine::Part::middle);
       for (const double value : record.values) line.number(value);
+      break;
+    }
+    case WorldLogRecord::Part::deformable: {
+      CsvLine line(out, CsvLine::Part::middle);
+      line.number(record.values[0]).number(record.values[1]).number(record.values[2]);
       break;
     }
     case WorldLogRecord::Part::statics: {

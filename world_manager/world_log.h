@@ -23,10 +23,11 @@
 namespace impetus {
 
 struct WorldLogRecord {
-  enum class Part : std::uint32_t { time, object, statics };
+  enum class Part : std::uint32_t { time, object, deformable, statics };
   static constexpr std::size_t kObjectColumns = 19;  // position 3, quaternion 4, velocity 3 + 3, impulse 3 + 3
   Part part = Part::time;
-  std::array<double, kObjectColumns> values{};  // time: values[0]; statics: the first three
+  // time: values[0]; deformable: dent, volume, push; statics: the first four
+  std::array<double, kObjectColumns> values{};
 };
 
 class WorldLog {

@@ -281,6 +281,22 @@ nlohmann::json WorldNode::summary() const {
       port_objects[scene_.objects[id].name] = port_json(books);
     }
   }
+  // Each deformable object's dent (deform/plastic_surface.h) and the push it absorbed.
+  nlohmann::json deformable = nlohmann::json::object();
+  for (std::size_t id = 0; id < scene_.objects.size(); ++id) {
+    const PlasticSurface* surface = world_.deformable(id);
+    if (surface == nullptr) continue;
+    deformable[scene_.objects[id].name] = {{"rule", to_string(surface->material().rule)},
+                                           {"max_dent_m", surface->max_dent_m()},
+                                           {"dent_volume_m3", surface->dent_volume_m3()},
+                                           {"absorbed_Ns", surface->absorbed_Ns()},
+                                           {"yielding_Ns", surface->yielding_Ns()},
+                                           {"lost_Ns", surface->lost_Ns()},
+                                           {"clamped_m3", surface->clamped_m3()}};
+    const PlasticSurface::Profile row = surface->deepest_row();
+    deformable[scene_.objects[id].name]["deepest_row"] = {
+        {"y_m", row.y_m}, {"x0_m", row.x0_m}, {"dx_m", row.dx_m}, {"depth_m", row.depth_m}};
+  }
   nlohmann::json port = port_json(world_.port().total());
   port["layer"] = world_.port().enabled();
   port["objects"] = port_objects;
@@ -288,6 +304,7 @@ nlohmann::json WorldNode::summary() const {
           {"world",
            {{"steps", world_.steps_taken()},
             {"port", port},
+            {"deformable", deformable},
             {"endpoints", endpoints},
             {"time_s", world_.time_s()},
             {"period_s", world_.world_period_s()},

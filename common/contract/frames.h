@@ -39,6 +39,9 @@ inline constexpr std::uint32_t kMaxLocalContacts = 4;
 
 // Plane flags.
 inline constexpr std::uint32_t kPlaneDynamic = 1u << 0;  // the object moves; impulses on it are applied by the world
+// The object is fixed but yields where it is pressed (a plastic slab, world_manager/deform/plastic_surface.h): its
+// share of the reaction gets an entry (with where it pressed, ObjectImpulse::press_*) instead of the static total.
+inline constexpr std::uint32_t kPlaneDeformable = 1u << 1;
 // A plane's shape travels in Plane::shape (a tagged descriptor, common/shape/shape_descriptor.h), not in flags.
 
 // LocalContact flags.
@@ -74,6 +77,15 @@ struct Plane {
   // How far from point_m the plane still describes the object (common/shape/shape.h plane_extent_m): a
   // sphere's radius, a box's diagonal. 0: unbounded (the floor).
   double extent_m = 0.0;
+  // A deformable object's surface under the finger (kPlaneDeformable; world_manager/deform/plastic_material.h): the
+  // push it holds without yielding (N; 0: it yields to any push, or is rigid), how far the surface under the pad's
+  // centre goes in per N·s of push beyond that (m/(N·s); 0: it does not yield between frames), the radius of the
+  // pad the push is spread over (m), and how much further in the surface can go at point_m (m; the slab's unyielding
+  // floor), so the haptic side yields it locally as the world will (haptic_controller/local_yield.h).
+  double yield_force_N = 0.0;
+  double yield_depth_mpNs = 0.0;
+  double yield_radius_m = 0.0;
+  double yield_room_m = 0.0;
   // The body's shape (kind none for the floor), so the haptic side takes the plane again from it every tick
   // (common/shape/shape.h retake_plane). For a kind whose traits carry axes, the body's x and y axes in the world frame
   // (unit, orthogonal; z = x × y) about its centre com_m; zero otherwise (a sphere's plane carries its centre as
@@ -136,6 +148,16 @@ struct ObjectImpulse {
   // rule), where it pushed. The world holds what its couplings give the object to it
   // (world_manager/couplings/passivity_layer.h).
   double hand_input_J = 0.0;
+  // Where and when the object's surface was pressed (the push into it, p_k = max(0, −J_k·n_k), at the proxy x_k, at
+  // session time t_k): Σ p_k (N·s), Σ p_k·x_k (N·s·m, world frame), Σ p_k·t_k (N·s²), Σ p_k·t_k² (N·s³) and
+  // Σ p_k·x_k·t_k (N·s²·m). The differences over a world period give the push, where it was centred, and how the
+  // contact moved while pressing (a straight stroke is recovered exactly), so a deformable object dents along the
+  // finger's path (world_manager/deform/press_path.h). Kept for every entry; only deformable objects use them.
+  double press_Ns = 0.0;
+  Vec3 press_point_Nsm{};
+  double press_time_Nss = 0.0;
+  double press_time2_Nsss = 0.0;
+  Vec3 press_point_time_Nssm{};
   std::uint64_t last_tick = 0;    // last haptic tick that added to this entry
 };
 

@@ -45,6 +45,10 @@ void visit_plane(A& a, B& b, F&& f) {
   f(a.static_friction, b.static_friction);
   f(a.dynamic_friction, b.dynamic_friction);
   f(a.extent_m, b.extent_m);
+  f(a.yield_force_N, b.yield_force_N);
+  f(a.yield_depth_mpNs, b.yield_depth_mpNs);
+  f(a.yield_radius_m, b.yield_radius_m);
+  f(a.yield_room_m, b.yield_room_m);
   visit_shape(a.shape, b.shape, f);
   f(a.body_axis_x, b.body_axis_x);
   f(a.body_axis_y, b.body_axis_y);
@@ -81,6 +85,11 @@ void visit_entry(A& a, B& b, F&& f) {
   f(a.impulse_moment_Nss, b.impulse_moment_Nss);
   f(a.angular_impulse_moment_Nmss, b.angular_impulse_moment_Nmss);
   f(a.hand_input_J, b.hand_input_J);
+  f(a.press_Ns, b.press_Ns);
+  f(a.press_point_Nsm, b.press_point_Nsm);
+  f(a.press_time_Nss, b.press_time_Nss);
+  f(a.press_time2_Nsss, b.press_time2_Nsss);
+  f(a.press_point_time_Nssm, b.press_point_time_Nssm);
   f(a.last_tick, b.last_tick);
 }
 

@@ -72,6 +72,9 @@ TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {
   CHECK(rejected([](PlaneFrame& f) { f.coupling = static_cast<Coupling>(9); }) == FrameError::bad_coupling);
   CHECK(rejected([](PlaneFrame& f) { f.planes[0].dynamic_friction = 0.9; }) == FrameError::bad_friction);
   CHECK(rejected([](PlaneFrame& f) { f.reach_radius_m = -0.05; }) == FrameError::bad_reach);
+  CHECK(rejected([](PlaneFrame& f) { f.planes[0].yield_force_N = -0.5; }) == FrameError::bad_yield);
+  CHECK(rejected([](PlaneFrame& f) { f.planes[0].yield_depth_mpNs = -1e-3; }) == FrameError::bad_yield);
+  CHECK(rejected([&](PlaneFrame& f) { f.planes[0].yield_radius_m = nan; }) == FrameError::not_finite);
   CHECK(rejected([](PlaneFrame& f) {
           f.planes[0].local_contact_count = 1;
           f.planes[0].local_contacts[0].normal = {0, 0, 1};

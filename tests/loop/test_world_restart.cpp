@@ -91,3 +91,51 @@ TEST_CASE("a restarted world applies only the impulse rendered against its own f
 }
 
 }  // namespace impetus
+
+namespace impetus {
+namespace {
+
+// The clay (scenes/clay.json) pressed 2 mm into its face from 0.1 s on, held; the world restarts at 0.6 s. The new
+// world starts from the scene (no dent) and dents by what was pushed against its own frames only.
+TEST_CASE("a restarted world dents clay only by the push given against its own frames") {
+  prepare_engines();
+  const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/clay.json");
+  WorldOptions options;
+  options.world_session = 21;
+  auto world = std::make_unique<World>(scene, options);
+  HapticServo servo(ServoOptions{}, 98);
+  const auto finger_at = [](double t_s) {
+    FingerSample sample;
+    sample.position_m = Eigen::Vector3d(0.0, 0.0, 0.035 - std::min(t_s / 0.1, 1.0) * 0.007);
+    sample.valid = true;
+    return sample;
+  };
+  double first_world_yielding_Ns = 0.0;
+  for (int tick = 0; tick <= kLastTick; ++tick) {
+    const double now_s = tick * kTick_s;
+    const FingerSample finger = finger_at(now_s);
+    servo.tick(&finger, now_s, kTick_s);
+    if (tick == kRestartTick) {
+      first_world_yielding_Ns = world->deformable(0)->yielding_Ns();
+      options.world_session = 22;
+      world = std::make_unique<World>(scene, options);
+    }
+    if (tick % kTicksPerStep != 0) continue;
+    servo.on_plane_frame(world->step(&servo.report()), now_s);
+  }
+  REQUIRE(first_world_yielding_Ns > 0.01);  // the first world was dented
+  const PlasticSurface& clay = *world->deformable(0);
+  const HapticReport& report = servo.report();
+  REQUIRE(report.world_session == 22);
+  REQUIRE(report.entry_count == 1);
+  // The new world took exactly the push beyond yield rendered since its first frame (a sum of differences of one
+  // running total, equal up to rounding), and its dent is that push over the flow resistance: nothing of the dead
+  // world's push, whose running total was abandoned.
+  CHECK(report.entries[0].press_Ns > 0.01);
+  CHECK(clay.yielding_Ns() == Approx(report.entries[0].press_Ns).epsilon(1e-12));
+  CHECK(clay.dent_volume_m3() * scene.objects[0].deformable->flow_resistance_Paspm ==
+        Approx(clay.yielding_Ns()).epsilon(1e-12));
+}
+
+}  // namespace
+}  // namespace impetus

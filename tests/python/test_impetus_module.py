@@ -165,6 +165,18 @@ class Arguments(unittest.TestCase):
         self.assertEqual(set(trial.summary["objects"]), {"cube", "pebble"})  # the dynamic ones
         self.assertGreater(trial.summary["objects"]["cube"]["position"][0], 0.13)
 
+    def test_clay_is_dented_and_logged(self):
+        # The shipped clay: a press dents it; the summary and the world log say how deep, and the dent's volume is the
+        # push beyond yield over the flow resistance (docs/deformation.md).
+        trial = impetus.run_trial(impetus.shipped_scene("clay"), "press:surface_z=0.03,depth=0.006,hold=0.5",
+                                  "impulse", out_dir=OUT / "clay")
+        clay = trial.summary["world"]["deformable"]["clay"]
+        self.assertGreater(clay["max_dent_m"], 1e-3)
+        self.assertAlmostEqual(clay["dent_volume_m3"] * 1e6, clay["yielding_Ns"], delta=1e-12)
+        dent = trial.logs["world"]["clay.dent_m"]
+        self.assertEqual(dent[0], 0.0)
+        self.assertEqual(dent[-1], clay["max_dent_m"])
+
     def test_users_on_one_world(self):
         # Two users squeeze the tap scene's cube (sides at x = 0.005 and 0.055 m) 10 mm deep from either side: the
         # pushes cancel, the cube stays, and the world applied for each user exactly what that user rendered.

@@ -76,6 +76,7 @@ const char* to_string(FrameError error) {
     case FrameError::bad_coupling: return "unknown coupling";
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
     case FrameError::bad_reach: return "reach radius or plane extent is negative";
+    case FrameError::bad_yield: return "a deformable plane's yield force, depth rate, pad radius or room is negative";
     case FrameError::bad_mass: return "a local contact's inverse mass is negative";
     case FrameError::bad_shape: return "a plane's shape is unknown or out of range, or its body axes not orthonormal";
   }
@@ -115,10 +116,15 @@ FrameError validate(const wire::PlaneFrame& frame) {
     if (!all_finite(plane.point_m) || !all_finite(plane.normal) || !all_finite(plane.com_m) ||
         !all_finite(plane.velocity_mps) || !all_finite(plane.angular_velocity_radps) ||
         !finite(plane.static_friction) || !finite(plane.dynamic_friction) || !finite(plane.inverse_mass_per_kg) ||
-        !finite(plane.extent_m)) {
+        !finite(plane.extent_m) || !finite(plane.yield_force_N) || !finite(plane.yield_depth_mpNs) ||
+        !finite(plane.yield_radius_m) || !finite(plane.yield_room_m)) {
       return FrameError::not_finite;
     }
     if (plane.extent_m < 0.0) return FrameError::bad_reach;
+    if (plane.yield_force_N < 0.0 || plane.yield_depth_mpNs < 0.0 || plane.yield_radius_m < 0.0 ||
+        plane.yield_room_m < 0.0) {
+      return FrameError::bad_yield;
+    }
     if (!all_finite(plane.body_axis_x) || !all_finite(plane.body_axis_y) || !all_finite(plane.shape.box_size_m) ||
         !finite(plane.shape.radius_m) || !finite(plane.shape.length_m)) {
       return FrameError::not_finite;
@@ -171,7 +177,8 @@ FrameError validate(const wire::HapticReport& report) {
     const wire::ObjectImpulse& entry = report.entries[k];
     if (!all_finite(entry.impulse_Ns) || !all_finite(entry.angular_impulse_Nms) ||
         !all_finite(entry.impulse_moment_Nss) || !all_finite(entry.angular_impulse_moment_Nmss) ||
-        !finite(entry.hand_input_J)) {
+        !finite(entry.hand_input_J) || !finite(entry.press_Ns) || !all_finite(entry.press_point_Nsm) ||
+        !finite(entry.press_time_Nss) || !finite(entry.press_time2_Nsss) || !all_finite(entry.press_point_time_Nssm)) {
       return FrameError::not_finite;
     }
   }

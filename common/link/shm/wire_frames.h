@@ -42,6 +42,10 @@ struct Plane {
   double static_friction = 0.0;
   double dynamic_friction = 0.0;
   double extent_m = 0.0;
+  double yield_force_N = 0.0;
+  double yield_depth_mpNs = 0.0;
+  double yield_radius_m = 0.0;
+  double yield_room_m = 0.0;
   Shape shape;
   Vec3 body_axis_x{};
   Vec3 body_axis_y{};
@@ -80,6 +84,11 @@ struct ObjectImpulse {
   Vec3 impulse_moment_Nss{};
   Vec3 angular_impulse_moment_Nmss{};
   double hand_input_J = 0.0;
+  double press_Ns = 0.0;
+  Vec3 press_point_Nsm{};
+  double press_time_Nss = 0.0;
+  double press_time2_Nsss = 0.0;
+  Vec3 press_point_time_Nssm{};
   std::uint64_t last_tick = 0;
 };
 
@@ -135,6 +144,7 @@ enum class FrameError : std::uint32_t {
   bad_reach,
   bad_mass,
   bad_shape,
+  bad_yield,
 };
 const char* to_string(FrameError error);
 

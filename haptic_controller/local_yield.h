@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// A deformable surface yields between world frames (paper §6.4 with §6.3's idea; docs/deformation.md). The world
+// dents it once per period from the push beyond yield it was sent, so a finger pressing on the frame's surface alone
+// would meet clay that stands still for a period and then gives way by a step: it pushes harder than on clay that
+// yields as it is pressed, and dents it deeper, the more so the slower the world. So each deformable plane is frame
+// i's surface, not interpolated (frame i already shows every dent the world made from the reports up to the one it
+// applied, PlaneFrame::report_tick_applied), moved in along its normal by what the push beyond yield of the later
+// ticks will dent under the proxy, by the world's own law (world_manager/deform/plastic_material.h):
+//     offset = yield_depth_mpNs · Σ_{ticks k after the applied report} e_k · max(0, 1 − |x_k − proxy|² / a²)
+// e_k the tick's push beyond yield into that object (ImpulseShare::yielding_Ns), x_k where it was given, a the pad's
+// radius (Plane::yield_radius_m), and never beyond how far the surface there can still go (Plane::yield_room_m). The
+// world's next frame shows the same dent, made from the same pushes.
+//
+// Fixed capacity (kMaxSamples pushes: a second at 1 kHz with a finger on one surface, far more than a world period and
+// a link's round trip); when full, the oldest is forgotten and counted (its dent then shows at the next frame).
+// Allocation-free; owned by the servo thread.
+
+#include "common/contract/frames.h"
+#include "haptic_controller/contact_plane.h"
+#include "haptic_controller/impulse_accumulator.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+
+namespace impetus {
+
+class LocalYield {
+ public:
+  static constexpr std::size_t kMaxSamples = 1024;
+
+  // This tick's shares (ImpulseAccumulator::last_shares) at haptic tick `tick`, given at `proxy_m`.
+  void record(std::uint64_t tick, const Eigen::Vector3d& proxy_m, const ImpulseShare* shares, int count);
+  // Replaces each deformable plane of `planes` that yields (yield_depth_mpNs > 0) by its object's plane in `frame`,
+  // moved in by the offset above about `proxy_m`, counting the pushes after the report `frame` says the world applied
+  // (all of them if it applied none of `haptic_session`'s).
+  void apply(const PlaneFrame& frame, std::uint64_t haptic_session, const Eigen::Vector3d& proxy_m,
+             PlaneSet& planes) const;
+  // A new world session or finger session: nothing recorded belongs to the planes to come.
+  void clear() { count_ = 0; }
+
+  std::uint64_t forgotten() const { return forgotten_; }
+
+ private:
+  struct Sample {
+    std::uint64_t tick = 0;
+    std::int32_t object_id = -1;
+    double yielding_Ns = 0.0;
+    Eigen::Vector3d at_m = Eigen::Vector3d::Zero();
+  };
+  std::array<Sample, kMaxSamples> samples_{};
+  std::size_t next_ = 0;   // where the next sample goes
+  std::size_t count_ = 0;  // samples held, the newest just before next_
+  std::uint64_t forgotten_ = 0;
+};
+
+}  // namespace impetus

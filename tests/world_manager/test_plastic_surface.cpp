@@ -1,0 +1,214 @@
+// SPDX-License-Identifier: Apache-2.0
+// The plastic slab (world_manager/deform/): its law, where a push lands, its limits, and its scene keys.
+
+#include "world_manager/deform/plastic_surface.h"
+#include "world_manager/deform/press_path.h"
+#include "world_manager/scene.h"
+
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace impetus {
+namespace {
+
+using Eigen::Vector3d;
+
+// A 10 × 10 × 2 cm slab centred at the origin, top face at z = 0.01, with the scene's default clay.
+PlasticSurface slab(PlasticMaterial material = {}) {
+  return PlasticSurface(material, Vector3d(0.05, 0.05, 0.01), Vector3d::Zero(), Eigen::Quaterniond::Identity());
+}
+
+PressStroke at(const Vector3d& point_m, double push_Ns) { return {push_Ns, point_m, point_m}; }
+
+TEST_CASE("a plastic slab dents by the push beyond yield it is given: volume = push / flow resistance") {
+  const PlasticMaterial clay;
+  PlasticSurface surface = slab(clay);
+  const double push_Ns = 0.01;
+  surface.press(at(Vector3d(0.003, -0.002, 0.01), push_Ns));
+  CHECK(surface.max_dent_m() == 0.0);  // nothing yields before the period ends
+  surface.yield_period();
+  CHECK(surface.yielding_Ns() == Approx(push_Ns).epsilon(1e-12));
+  CHECK(surface.dent_volume_m3() * clay.flow_resistance_Paspm == Approx(push_Ns).epsilon(1e-12));
+  // The pad's centre goes in by about 2·e/(π·a²·η) (plastic_material.h), what the haptic side yields it by between
+  // frames: the grid's paraboloid sampled at 1 mm cells under a 6 mm pad differs from the continuous one by a few
+  // percent of the dent (the step a finger meets at the next frame).
+  const double centre_m = clay.yield_depth_mpNs() * push_Ns;
+  CHECK(surface.max_dent_m() == Approx(centre_m).epsilon(0.03));
+  CHECK(surface.height_m(0.003, -0.002) == Approx(0.01 - surface.max_dent_m()).epsilon(0.02));
+  // Outside the pad nothing moved.
+  CHECK(surface.height_m(0.003 + 0.008, -0.002) == 0.01);
+  // A second period with nothing received changes nothing.
+  const double volume_m3 = surface.dent_volume_m3();
+  surface.yield_period();
+  CHECK(surface.dent_volume_m3() == volume_m3);
+}
+
+TEST_CASE("a plastic slab's threshold is the material's yield force over the contact pad") {
+  PlasticMaterial clay;
+  clay.yield_stress_Pa = 5000.0;
+  clay.contact_radius_m = 0.006;
+  clay.flow_resistance_Paspm = 1e6;
+  CHECK(clay.yield_force_N() == Approx(5000.0 * M_PI * 0.006 * 0.006));
+  CHECK(clay.yield_depth_mpNs() == Approx(2.0 / (M_PI * 0.006 * 0.006 * 1e6)));
+  clay.rule = PlasticMaterial::Rule::penetration;  // the previous method: the push does not dent it
+  CHECK(clay.yield_force_N() == 0.0);
+  CHECK(clay.yield_depth_mpNs() == 0.0);
+}
+
+TEST_CASE("a stroke's push is laid along the path it was given on, from the moments of a world period") {
+  // A finger moving at 5 cm/s along x for 50 ticks of 1 ms, pushing 2 mN·s per tick, in a session 12.3 s old.
+  PressMoments moments;
+  const Vector3d start_m(-0.01, 0.002, 0.01);
+  const Vector3d velocity_mps(0.05, 0.0, 0.0);
+  for (int k = 0; k < 50; ++k) {
+    const double t_s = 12.3 + 0.001 * k;
+    const Vector3d x_m = start_m + velocity_mps * (0.001 * k);
+    const double p_Ns = 0.002;
+    moments.push_Ns += p_Ns;
+    moments.point_Nsm += p_Ns * x_m;
+    moments.time_Nss += p_Ns * t_s;
+    moments.time2_Nsss += p_Ns * t_s * t_s;
+    moments.point_time_Nssm += p_Ns * t_s * x_m;
+  }
+  const PressStroke stroke = stroke_of(moments);
+  CHECK(stroke.push_Ns == Approx(0.1));
+  // Fifty samples uniform over [0, 49] ms: the uniform stroke with their spread runs half a tick beyond the first
+  // and last (σ² = (n² − 1)/12 ticks², the continuous uniform's is n²/12): within 0.5 ms·5 cm/s = 25 µm each end.
+  CHECK((stroke.from_m - start_m).norm() < 26e-6);
+  CHECK((stroke.to_m - (start_m + velocity_mps * 0.049)).norm() < 26e-6);
+  CHECK(std::abs(stroke.from_m.y() - 0.002) < 1e-12);
+
+  // A finger that did not move presses at one point.
+  PressMoments still;
+  for (int k = 0; k < 50; ++k) {
+    const double t_s = 300.0 + 0.001 * k;
+    still.push_Ns += 0.001;
+    still.point_Nsm += 0.001 * start_m;
+    still.time_Nss += 0.001 * t_s;
+    still.time2_Nsss += 0.001 * t_s * t_s;
+    still.point_time_Nssm += 0.001 * t_s * start_m;
+  }
+  const PressStroke press = stroke_of(still);
+  CHECK((press.from_m - start_m).norm() < 1e-6);
+  CHECK((press.to_m - start_m).norm() < 1e-6);
+
+  // Nothing, or nothing usable, presses nowhere.
+  CHECK(stroke_of(PressMoments{}).push_Ns == 0.0);
+  PressMoments broken = moments;
+  broken.time2_Nsss = std::numeric_limits<double>::quiet_NaN();
+  CHECK(stroke_of(broken).push_Ns == 0.0);
+}
+
+TEST_CASE("a plastic slab conserves a stroke's push and keeps what lands off its face as lost") {
+  const PlasticMaterial clay;
+  PlasticSurface surface = slab(clay);
+  surface.press({0.02, Vector3d(-0.02, 0.0, 0.01), Vector3d(0.02, 0.0, 0.01)});
+  surface.press(at(Vector3d(0.3, 0.0, 0.01), 0.005));  // 30 cm off the slab
+  surface.yield_period();
+  CHECK(surface.yielding_Ns() == Approx(0.02).epsilon(1e-12));
+  CHECK(surface.lost_Ns() == Approx(0.005).epsilon(1e-12));
+  CHECK(surface.dent_volume_m3() * clay.flow_resistance_Paspm == Approx(0.02).epsilon(1e-12));
+  // A groove: as deep in its middle at x = −5 mm as at x = +5 mm (the push was even along it).
+  CHECK(surface.height_m(-0.005, 0.0) == Approx(surface.height_m(0.005, 0.0)).epsilon(1e-3));
+  CHECK(surface.height_m(0.0, 0.0) < 0.01);
+}
+
+TEST_CASE("no push goes through a plastic slab: its last tenth does not yield") {
+  const PlasticMaterial clay;
+  PlasticSurface surface = slab(clay);
+  for (int period = 0; period < 100; ++period) {
+    surface.press(at(Vector3d::Zero(), 10.0));  // 200 N for 50 ms, a hundred times over
+    surface.yield_period();
+  }
+  CHECK(std::isfinite(surface.dent_volume_m3()));
+  CHECK(surface.max_dent_m() == Approx(0.9 * 0.02));
+  CHECK(surface.clamped_m3() > 0.0);
+  CHECK(surface.height_m(0.0, 0.0) == Approx(0.01 - 0.018));
+  // Its surface there is still a surface: a tangent plane with a unit normal.
+  Vector3d point_m, normal;
+  surface.tangent_plane(Vector3d(0.0, 0.0, 0.0), point_m, normal);
+  CHECK(point_m.allFinite());
+  CHECK(normal.norm() == Approx(1.0));
+}
+
+TEST_CASE("the penetration rule moves the surface by plasticity times the sampled penetration") {
+  PlasticMaterial clay;
+  clay.rule = PlasticMaterial::Rule::penetration;
+  clay.plasticity = 0.5;
+  PlasticSurface surface = slab(clay);
+  surface.press_by_penetration(Vector3d(0.0005, 0.0005, 0.01 + 0.002));  // above: nothing
+  CHECK(surface.max_dent_m() == 0.0);
+  surface.press_by_penetration(Vector3d(0.0005, 0.0005, 0.01 - 0.002));  // 2 mm in, over a cell centre
+  CHECK(surface.max_dent_m() == Approx(0.001).epsilon(1e-12));
+  CHECK(surface.height_m(0.0005, 0.0005) == Approx(0.009).epsilon(1e-12));
+  surface.press_by_penetration(Vector3d(0.0005, 0.0005, 0.009 - 0.002));  // 2 mm below the new surface
+  CHECK(surface.max_dent_m() == Approx(0.002).epsilon(1e-12));
+}
+
+TEST_CASE("a tilted plastic slab takes pushes and gives planes in its own frame") {
+  const PlasticMaterial clay;
+  const Eigen::Quaterniond tilt(Eigen::AngleAxisd(0.3, Vector3d::UnitX()));
+  const Vector3d centre_m(0.1, 0.0, 0.05);
+  PlasticSurface surface(clay, Vector3d(0.05, 0.05, 0.01), centre_m, tilt);
+  const Vector3d on_top_m = centre_m + tilt * Vector3d(0.0, 0.0, 0.01);
+  Vector3d point_m, normal;
+  surface.tangent_plane(surface.to_body(on_top_m + tilt * Vector3d(0, 0, 0.003)), point_m, normal);
+  CHECK((point_m - on_top_m).norm() < 1e-12);
+  CHECK((normal - tilt * Vector3d::UnitZ()).norm() < 1e-12);
+  surface.press(at(on_top_m, 0.01));
+  surface.yield_period();
+  surface.tangent_plane(surface.to_body(on_top_m), point_m, normal);
+  CHECK((point_m - on_top_m).dot(tilt * Vector3d::UnitZ()) == Approx(-surface.max_dent_m()).epsilon(0.02));
+}
+
+nlohmann::json clay_scene() {
+  return nlohmann::json::parse(R"({
+    "objects": [{"name": "clay", "shape": "box", "size_m": [0.2, 0.2, 0.03], "dynamic": false,
+                 "position_m": [0, 0, 0.015], "deformable": {}}]})");
+}
+
+std::string error_of(const nlohmann::json& scene) {
+  try {
+    parse_scene(scene, "clay.json");
+  } catch (const SceneError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST_CASE("a scene's deformable block: defaults, and errors that name the file, the key and the value") {
+  nlohmann::json scene = clay_scene();
+  const Scene parsed = parse_scene(scene, "clay.json");
+  REQUIRE(parsed.objects[0].deformable.has_value());
+  CHECK(parsed.objects[0].deformable->rule == PlasticMaterial::Rule::impulse);
+  CHECK(parsed.objects[0].deformable->yield_stress_Pa == PlasticMaterial{}.yield_stress_Pa);
+
+  scene["objects"][0]["deformable"] = {{"rule", "melt"}};
+  CHECK_THAT(error_of(scene), Catch::Contains("clay.json: /objects/0/deformable/rule") &&
+                                  Catch::Contains("impulse or penetration"));
+  scene["objects"][0]["deformable"] = {{"cell_m", 0.004}};
+  CHECK_THAT(error_of(scene), Catch::Contains("/objects/0/deformable/cell_m") && Catch::Contains("half"));
+  scene["objects"][0]["deformable"] = {{"cell_m", 1e-5}};
+  CHECK_THAT(error_of(scene), Catch::Contains("cells"));
+  scene["objects"][0]["deformable"] = {{"yield_stress_Pa", -1}};
+  CHECK_THAT(error_of(scene), Catch::Contains("/objects/0/deformable/yield_stress_Pa"));
+  scene["objects"][0]["deformable"] = {{"softness", 1}};
+  CHECK_THAT(error_of(scene), Catch::Contains("softness"));
+  scene = clay_scene();
+  scene["objects"][0]["dynamic"] = true;
+  scene["objects"][0]["mass_kg"] = 1.0;
+  CHECK_THAT(error_of(scene), Catch::Contains("only a static object"));
+  scene = clay_scene();
+  scene["objects"][0]["shape"] = "sphere";
+  scene["objects"][0].erase("size_m");
+  scene["objects"][0]["radius_m"] = 0.05;
+  CHECK_THAT(error_of(scene), Catch::Contains("only a box"));
+}
+
+}  // namespace
+}  // namespace impetus

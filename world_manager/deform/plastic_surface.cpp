@@ -1,0 +1,202 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "world_manager/deform/plastic_surface.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace impetus {
+
+namespace {
+
+// Cells along an edge of `length_m` at most `cell_m` each (the grid fits the face exactly).
+std::size_t cells_along(double length_m, double cell_m) {
+  return static_cast<std::size_t>(std::max(1.0, std::ceil(length_m / cell_m - 1e-9)));
+}
+
+}  // namespace
+
+std::size_t PlasticSurface::cells_for(const PlasticMaterial& material, const Eigen::Vector3d& half_size_m) {
+  const double columns = std::ceil(2.0 * half_size_m.x() / material.cell_m);
+  const double rows = std::ceil(2.0 * half_size_m.y() / material.cell_m);
+  const double cells = columns * rows;
+  return cells > static_cast<double>(kMaxCells) ? kMaxCells + 1 : static_cast<std::size_t>(cells);
+}
+
+PlasticSurface::PlasticSurface(const PlasticMaterial& material, const Eigen::Vector3d& half_size_m,
+                               const Eigen::Vector3d& position_m, const Eigen::Quaterniond& orientation)
+    : material_(material), half_size_m_(half_size_m), position_m_(position_m), orientation_(orientation.normalized()) {
+  if (cells_for(material, half_size_m) > kMaxCells) {
+    throw std::invalid_argument("a deformable slab of more than " + std::to_string(kMaxCells) + " cells");
+  }
+  columns_ = cells_along(2.0 * half_size_m.x(), material.cell_m);
+  rows_ = cells_along(2.0 * half_size_m.y(), material.cell_m);
+  cell_x_m_ = 2.0 * half_size_m.x() / static_cast<double>(columns_);
+  cell_y_m_ = 2.0 * half_size_m.y() / static_cast<double>(rows_);
+  max_depth_m_ = (1.0 - PlasticMaterial::kUnyieldingFraction) * 2.0 * half_size_m.z();
+  depth_m_.assign(columns_ * rows_, 0.0);
+  received_Ns_.assign(columns_ * rows_, 0.0);
+}
+
+Eigen::Vector3d PlasticSurface::to_body(const Eigen::Vector3d& world_m) const {
+  return orientation_.conjugate() * (world_m - position_m_);
+}
+
+bool PlasticSurface::spread(double x_m, double y_m, double amount, std::vector<double>& grid, bool touch) {
+  const double radius_m = material_.contact_radius_m;
+  const auto first = [](double low_m, double cell_m, double half_m) {
+    return static_cast<long>(std::floor((low_m + half_m) / cell_m));
+  };
+  const long c0 = std::max(0L, first(x_m - radius_m, cell_x_m_, half_size_m_.x()));
+  const long c1 = std::min(static_cast<long>(columns_) - 1, first(x_m + radius_m, cell_x_m_, half_size_m_.x()));
+  const long r0 = std::max(0L, first(y_m - radius_m, cell_y_m_, half_size_m_.y()));
+  const long r1 = std::min(static_cast<long>(rows_) - 1, first(y_m + radius_m, cell_y_m_, half_size_m_.y()));
+  if (c0 > c1 || r0 > r1) return false;
+  // The pad's pressure: a paraboloid, 1 − r²/a² at a cell's centre (zero beyond a).
+  weights_.clear();
+  double total = 0.0;
+  for (long r = r0; r <= r1; ++r) {
+    const double dy = -half_size_m_.y() + (static_cast<double>(r) + 0.5) * cell_y_m_ - y_m;
+    for (long c = c0; c <= c1; ++c) {
+      const double dx = -half_size_m_.x() + (static_cast<double>(c) + 0.5) * cell_x_m_ - x_m;
+      const double weight = std::max(0.0, 1.0 - (dx * dx + dy * dy) / (radius_m * radius_m));
+      weights_.push_back(weight);
+      total += weight;
+    }
+  }
+  if (!(total > 0.0)) return false;
+  std::size_t k = 0;
+  for (long r = r0; r <= r1; ++r) {
+    for (long c = c0; c <= c1; ++c, ++k) {
+      if (weights_[k] > 0.0) grid[static_cast<std::size_t>(r) * columns_ + static_cast<std::size_t>(c)] +=
+          amount * weights_[k] / total;
+    }
+  }
+  if (touch) {
+    const auto lo_c = static_cast<std::size_t>(c0), hi_c = static_cast<std::size_t>(c1);
+    const auto lo_r = static_cast<std::size_t>(r0), hi_r = static_cast<std::size_t>(r1);
+    column_lo_ = touched_ ? std::min(column_lo_, lo_c) : lo_c;
+    column_hi_ = touched_ ? std::max(column_hi_, hi_c) : hi_c;
+    row_lo_ = touched_ ? std::min(row_lo_, lo_r) : lo_r;
+    row_hi_ = touched_ ? std::max(row_hi_, hi_r) : hi_r;
+    touched_ = true;
+  }
+  return true;
+}
+
+void PlasticSurface::press(const PressStroke& stroke) {
+  if (!(stroke.push_Ns > 0.0)) return;
+  const Eigen::Vector3d from_m = to_body(stroke.from_m);
+  const Eigen::Vector3d to_m = to_body(stroke.to_m);
+  // Points half a cell apart along the stroke, so its push lies along it as finely as the grid can show.
+  const double length_m = (to_m - from_m).head<2>().norm();
+  constexpr double kMaxPoints = 4096.0;  // a 2 m stroke in one period at 1 mm cells; more shows nothing finer
+  const double points = std::clamp(std::ceil(length_m / (0.5 * std::min(cell_x_m_, cell_y_m_))), 1.0, kMaxPoints);
+  const auto count = static_cast<std::size_t>(points);
+  const double share_Ns = stroke.push_Ns / points;
+  for (std::size_t k = 0; k < count; ++k) {
+    const Eigen::Vector3d at_m = from_m + (static_cast<double>(k) + 0.5) / points * (to_m - from_m);
+    if (spread(at_m.x(), at_m.y(), share_Ns, received_Ns_, true)) {
+      pressed_Ns_ += share_Ns;
+    } else {
+      lost_Ns_ += share_Ns;
+    }
+  }
+}
+
+void PlasticSurface::deepen(std::size_t cell, double by_m) {
+  double& depth_m = depth_m_[cell];
+  const double wanted_m = depth_m + by_m;
+  const double area_m2 = cell_x_m_ * cell_y_m_;
+  if (wanted_m > max_depth_m_) clamped_m3_ += (wanted_m - max_depth_m_) * area_m2;
+  const double new_m = std::min(wanted_m, max_depth_m_);
+  volume_m3_ += (new_m - depth_m) * area_m2;
+  depth_m = new_m;
+  max_dent_m_ = std::max(max_dent_m_, depth_m);
+}
+
+void PlasticSurface::press_by_penetration(const Eigen::Vector3d& finger_m) {
+  const Eigen::Vector3d body_m = to_body(finger_m);
+  if (!over_face(body_m)) return;
+  const double penetration_m = height_m(body_m.x(), body_m.y()) - body_m.z();
+  if (!(penetration_m > 0.0)) return;
+  const double radius_m = material_.contact_radius_m;
+  const double centre_m = material_.plasticity * penetration_m;
+  for (std::size_t r = 0; r < rows_; ++r) {
+    const double dy = -half_size_m_.y() + (static_cast<double>(r) + 0.5) * cell_y_m_ - body_m.y();
+    if (std::abs(dy) > radius_m) continue;
+    for (std::size_t c = 0; c < columns_; ++c) {
+      const double dx = -half_size_m_.x() + (static_cast<double>(c) + 0.5) * cell_x_m_ - body_m.x();
+      const double weight = 1.0 - (dx * dx + dy * dy) / (radius_m * radius_m);
+      if (weight > 0.0) deepen(r * columns_ + c, centre_m * weight);
+    }
+  }
+}
+
+void PlasticSurface::absorb(const Eigen::Vector3d& impulse_Ns) {
+  absorbed_Ns_ += std::max(0.0, -impulse_Ns.dot(orientation_ * Eigen::Vector3d::UnitZ()));
+}
+
+void PlasticSurface::yield_period() {
+  if (!touched_) return;
+  const double area_m2 = cell_x_m_ * cell_y_m_;
+  // plastic_material.h: Δdepth_c = Σ e_k·w_c / (A·η), the push beyond yield each cell received.
+  for (std::size_t r = row_lo_; r <= row_hi_; ++r) {
+    for (std::size_t c = column_lo_; c <= column_hi_; ++c) {
+      const std::size_t cell = r * columns_ + c;
+      const double received_Ns = received_Ns_[cell];
+      received_Ns_[cell] = 0.0;
+      if (received_Ns > 0.0) deepen(cell, received_Ns / (area_m2 * material_.flow_resistance_Paspm));
+    }
+  }
+  touched_ = false;
+}
+
+double PlasticSurface::height_m(double x_m, double y_m) const {
+  // Bilinear between cell centres, constant beyond the outer centres.
+  const double fx = std::clamp((x_m + half_size_m_.x()) / cell_x_m_ - 0.5, 0.0, static_cast<double>(columns_ - 1));
+  const double fy = std::clamp((y_m + half_size_m_.y()) / cell_y_m_ - 0.5, 0.0, static_cast<double>(rows_ - 1));
+  const auto c0 = static_cast<std::size_t>(fx);
+  const auto r0 = static_cast<std::size_t>(fy);
+  const std::size_t c1 = std::min(c0 + 1, columns_ - 1);
+  const std::size_t r1 = std::min(r0 + 1, rows_ - 1);
+  const double tx = fx - static_cast<double>(c0);
+  const double ty = fy - static_cast<double>(r0);
+  const double low = (1.0 - tx) * depth_m_[r0 * columns_ + c0] + tx * depth_m_[r0 * columns_ + c1];
+  const double high = (1.0 - tx) * depth_m_[r1 * columns_ + c0] + tx * depth_m_[r1 * columns_ + c1];
+  return half_size_m_.z() - ((1.0 - ty) * low + ty * high);
+}
+
+bool PlasticSurface::over_face(const Eigen::Vector3d& body_m) const {
+  return std::abs(body_m.x()) <= half_size_m_.x() && std::abs(body_m.y()) <= half_size_m_.y() &&
+         body_m.z() >= -half_size_m_.z();
+}
+
+void PlasticSurface::tangent_plane(const Eigen::Vector3d& body_m, Eigen::Vector3d& point_m,
+                                   Eigen::Vector3d& normal) const {
+  const double x_m = std::clamp(body_m.x(), -half_size_m_.x(), half_size_m_.x());
+  const double y_m = std::clamp(body_m.y(), -half_size_m_.y(), half_size_m_.y());
+  // The slope by central differences half a cell each way: the bilinear surface's own slope there.
+  const double hx = 0.5 * cell_x_m_;
+  const double hy = 0.5 * cell_y_m_;
+  const double slope_x = (height_m(x_m + hx, y_m) - height_m(x_m - hx, y_m)) / (2.0 * hx);
+  const double slope_y = (height_m(x_m, y_m + hy) - height_m(x_m, y_m - hy)) / (2.0 * hy);
+  point_m = position_m_ + orientation_ * Eigen::Vector3d(x_m, y_m, height_m(x_m, y_m));
+  normal = orientation_ * Eigen::Vector3d(-slope_x, -slope_y, 1.0).normalized();
+}
+
+PlasticSurface::Profile PlasticSurface::deepest_row() const {
+  Profile profile;
+  const auto deepest = static_cast<std::size_t>(std::max_element(depth_m_.begin(), depth_m_.end()) - depth_m_.begin());
+  const std::size_t row = deepest / columns_;
+  profile.y_m = -half_size_m_.y() + (static_cast<double>(row) + 0.5) * cell_y_m_;
+  profile.x0_m = -half_size_m_.x() + 0.5 * cell_x_m_;
+  profile.dx_m = cell_x_m_;
+  profile.depth_m.assign(depth_m_.begin() + static_cast<long>(row * columns_),
+                         depth_m_.begin() + static_cast<long>((row + 1) * columns_));
+  return profile;
+}
+
+
+}  // namespace impetus

@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// The top face of a static box made of a plastic material (plastic_material.h; paper §6.4; docs/deformation.md): a
+// grid of cells, each dented below the face by its own depth, yielding by the material's law once per world period.
+//
+// Frames and units: the slab's body frame (the box's centre, its axes; the top face is z = +half height), metres,
+// newton-seconds. Pushes are given in the world frame with the slab's pose. The surface between cell centres is
+// bilinear in their depths.
+//
+// Use, once per world step: press(...) for each stroke of push beyond yield the reports brought (impulse rule) or
+// press_by_penetration(...) for each sampled finger (penetration rule), then yield_period(). Not thread-safe; owned by
+// the World.
+
+#include "world_manager/deform/plastic_material.h"
+#include "world_manager/deform/press_path.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace impetus {
+
+class PlasticSurface {
+ public:
+  // `half_size_m`: the box's half extents; `pose`: its fixed pose. Throws std::invalid_argument if the grid would
+  // exceed kMaxCells (the scene parser checks first, with the file and key).
+  PlasticSurface(const PlasticMaterial& material, const Eigen::Vector3d& half_size_m, const Eigen::Vector3d& position_m,
+                 const Eigen::Quaterniond& orientation);
+
+  // The grid's cells: 10^6 (4096 × 256 or 1000 × 1000: a 1 m slab at 1 mm) keeps a world step's yield within
+  // milliseconds and its two grids within 16 MB.
+  static constexpr std::size_t kMaxCells = 1'000'000;
+  static std::size_t cells_for(const PlasticMaterial& material, const Eigen::Vector3d& half_size_m);
+
+  // Impulse rule: a stroke's push beyond yield, spread along it (points half a cell apart) and over the contact pad at
+  // each, received in this period. A push off the top face's cells is kept where it still meets cells, else counted
+  // lost.
+  void press(const PressStroke& stroke);
+  // The whole push a report brought into the slab (N·s, world frame; its part into the top face is counted).
+  void absorb(const Eigen::Vector3d& impulse_Ns);
+  // Penetration rule: the finger sampled at `finger_m` (world frame); where it is below the surface over the top face,
+  // the surface under its pad moves in by plasticity × the penetration, paraboloid-shaped (the centre by all of it).
+  void press_by_penetration(const Eigen::Vector3d& finger_m);
+  // The impulse rule's law (plastic_material.h) over the pushes received since the last call.
+  void yield_period();
+
+  // The surface's height above the body's centre at body-frame (x, y), clamped to the face: the top minus the dent.
+  double height_m(double x_m, double y_m) const;
+  // How much further in the surface at body-frame (x, y) can go before the slab's unyielding floor.
+  double room_m(double x_m, double y_m) const { return std::max(0.0, height_m(x_m, y_m) - (half_size_m_.z() - max_depth_m_)); }
+  // Whether a body-frame point lies over the top face (within its edges) and above the slab's bottom: there the
+  // surface is this grid's, not the box's (a finger that came in over the top, however deep, is pushed back up, never
+  // out through the bottom).
+  bool over_face(const Eigen::Vector3d& body_m) const;
+  // The surface under a body-frame point over the face: the point on it straight below or above, and its unit
+  // outward normal (from the bilinear surface's slope), both in the world frame.
+  void tangent_plane(const Eigen::Vector3d& body_m, Eigen::Vector3d& point_m, Eigen::Vector3d& normal) const;
+  Eigen::Vector3d to_body(const Eigen::Vector3d& world_m) const;
+
+  const PlasticMaterial& material() const { return material_; }
+  double max_dent_m() const { return max_dent_m_; }
+  double dent_volume_m3() const { return volume_m3_; }  // Σ depth·area over the cells
+  // The row of cells through the deepest one (along body x): a groove's profile. `y_m` its body-frame y, `x0_m` the
+  // first cell centre's x, `dx_m` the cell edge; `depth_m` one value per column.
+  struct Profile {
+    double y_m = 0.0;
+    double x0_m = 0.0;
+    double dx_m = 0.0;
+    std::vector<double> depth_m;
+  };
+  Profile deepest_row() const;
+  double absorbed_Ns() const { return absorbed_Ns_; }             // all the push into the top face (absorb)
+  double yielding_Ns() const { return pressed_Ns_; }              // the push beyond yield it dented by (press)
+  double lost_Ns() const { return lost_Ns_; }                     // pushed where no cell is
+  double clamped_m3() const { return clamped_m3_; }               // volume the unyielding floor of the slab refused
+  std::size_t columns() const { return columns_; }
+  std::size_t rows() const { return rows_; }
+  double depth_m(std::size_t column, std::size_t row) const { return depth_m_[row * columns_ + column]; }
+
+ private:
+  // Spreads `amount` over the pad around body-frame (x, y) into `grid` by the paraboloid's weights, normalised over
+  // the cells it meets; returns false if it meets none.
+  bool spread(double x_m, double y_m, double amount, std::vector<double>& grid, bool touch);
+  void deepen(std::size_t cell, double by_m);
+
+  PlasticMaterial material_;
+  Eigen::Vector3d half_size_m_;
+  Eigen::Vector3d position_m_;
+  Eigen::Quaterniond orientation_;
+  std::size_t columns_ = 0;  // along body x
+  std::size_t rows_ = 0;     // along body y
+  double cell_x_m_ = 0.0;
+  double cell_y_m_ = 0.0;
+  double max_depth_m_ = 0.0;
+  std::vector<double> depth_m_;    // per cell, ≥ 0
+  std::vector<double> received_Ns_;  // per cell, this period
+  std::vector<double> weights_;      // scratch for spread()
+  // The cells received_Ns_ may be nonzero in, if touched_: [column_lo, column_hi] × [row_lo, row_hi].
+  bool touched_ = false;
+  std::size_t column_lo_ = 0, column_hi_ = 0, row_lo_ = 0, row_hi_ = 0;
+  double pressed_Ns_ = 0.0;
+  double absorbed_Ns_ = 0.0;
+  double lost_Ns_ = 0.0;
+  double clamped_m3_ = 0.0;
+  double max_dent_m_ = 0.0;  // depths only grow, so both are kept as they grow
+  double volume_m3_ = 0.0;
+};
+
+}  // namespace impetus
