@@ -6,12 +6,44 @@
 namespace impetus {
 namespace {
 
+constexpr double kLast = kDentPatchSide - 1;  // the patch's last sample index
+
 const Plane* frame_plane(const PlaneFrame& frame, std::int32_t object_id) {
   const std::uint32_t count = std::min(frame.plane_count, kMaxPlanes);
   for (std::uint32_t k = 0; k < count; ++k) {
     if (frame.planes[k].object_id == object_id) return &frame.planes[k];
   }
   return nullptr;
+}
+
+// The patch's surface under `at_m` (frames.h DentPatch): its point and unit outward normal there, bilinear between the
+// samples. False when `at_m` lies beyond the patch's outer samples.
+bool patch_plane(const DentPatch& patch, const Eigen::Vector3d& at_m, Eigen::Vector3d& point_m,
+                 Eigen::Vector3d& normal) {
+  const Eigen::Vector3d axis_x = to_eigen(patch.axis_x);
+  const Eigen::Vector3d axis_y = to_eigen(patch.axis_y);
+  const Eigen::Vector3d up = axis_x.cross(axis_y);
+  const Eigen::Vector3d offset_m = at_m - to_eigen(patch.origin_m);
+  const double u = offset_m.dot(axis_x) / patch.spacing_m;
+  const double v = offset_m.dot(axis_y) / patch.spacing_m;
+  if (!(u >= 0.0 && u <= kLast && v >= 0.0 && v <= kLast)) return false;
+  const auto height = [&patch](double uu, double vv) {
+    const double cu = std::clamp(uu, 0.0, kLast);
+    const double cv = std::clamp(vv, 0.0, kLast);
+    const auto i0 = static_cast<std::uint32_t>(std::min(cu, kLast - 1.0));
+    const auto j0 = static_cast<std::uint32_t>(std::min(cv, kLast - 1.0));
+    const double tu = cu - i0;
+    const double tv = cv - j0;
+    const auto at = [&patch](std::uint32_t i, std::uint32_t j) { return patch.height_m[j * kDentPatchSide + i]; };
+    return (1.0 - tv) * ((1.0 - tu) * at(i0, j0) + tu * at(i0 + 1, j0)) +
+           tv * ((1.0 - tu) * at(i0, j0 + 1) + tu * at(i0 + 1, j0 + 1));
+  };
+  // The slope by central differences half a sample each way, per metre.
+  const double slope_x = (height(u + 0.5, v) - height(u - 0.5, v)) / patch.spacing_m;
+  const double slope_y = (height(u, v + 0.5) - height(u, v - 0.5)) / patch.spacing_m;
+  point_m = to_eigen(patch.origin_m) + u * patch.spacing_m * axis_x + v * patch.spacing_m * axis_y + height(u, v) * up;
+  normal = (up - slope_x * axis_x - slope_y * axis_y).normalized();
+  return true;
 }
 
 }  // namespace
@@ -44,8 +76,11 @@ void LocalYield::apply(const PlaneFrame& frame, std::uint64_t haptic_session, co
       pending_Ns += sample.yielding_Ns * std::max(0.0, 1.0 - (sample.at_m - proxy_m).squaredNorm() / radius2_m2);
     }
     plane.normal = to_eigen(sent->normal);
+    plane.point_m = to_eigen(sent->point_m);
+    // The surface under the proxy from the frame's heights, where it has them for this object; else the plane sent.
+    if (frame.dent_patch.object_id == plane.object_id) patch_plane(frame.dent_patch, proxy_m, plane.point_m, plane.normal);
     const double offset_m = std::min(sent->yield_depth_mpNs * pending_Ns, sent->yield_room_m);
-    plane.point_m = to_eigen(sent->point_m) - offset_m * plane.normal;
+    plane.point_m -= offset_m * plane.normal;
   }
 }
 

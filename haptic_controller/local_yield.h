@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// A deformable surface yields between world frames (paper §6.4 with §6.3's idea; docs/deformation.md). The world
+// A deformable surface between world frames (paper §6.4 with §6.3's idea; docs/deformation.md): taken again under the
+// proxy every tick from the frame's heights around it (PlaneFrame::dent_patch), as a shape's plane is, since a finger
+// moving over a dent leaves the plane of where it was; and yielding. The world
 // dents it once per period from the push beyond yield it was sent, so a finger pressing on the frame's surface alone
 // would meet clay that stands still for a period and then gives way by a step: it pushes harder than on clay that
 // yields as it is pressed, and dents it deeper, the more so the slower the world. So each deformable plane is frame

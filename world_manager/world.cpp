@@ -332,8 +332,10 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
   frame.plane_count =
       near_finger ? features_.extract(endpoint.plane_query, states_, period_s_, frame.planes, &endpoint.plane_faces)
                   : 0;
-  // A deformable object's top face is its grid's, dented: the plane under the proxy, as sent (no shape to take it
-  // again from), good within the contact pad. Its other faces are a fixed box's, whose pushes dent nothing.
+  // A deformable object's top face is its grid's, dented: the plane under the proxy, good within the contact pad, and
+  // (the nearest such object's) the heights around it, from which the haptic side takes the plane again every tick.
+  // Its other faces are a fixed box's, whose pushes dent nothing.
+  frame.dent_patch = DentPatch{};
   for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
     Plane& plane = frame.planes[k];
     if (plane.object_id < 0 || static_cast<std::size_t>(plane.object_id) >= surfaces_.size()) continue;
@@ -355,6 +357,7 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
     plane.body_axis_x = {};
     plane.body_axis_y = {};
     plane.extent_m = surface->material().contact_radius_m;
+    if (frame.dent_patch.object_id < 0) surface->patch_about(query_body_m, plane.object_id, frame.dent_patch);
   }
   // Planes past the count stay value-initialised (frames.h copy_used): only those the last frame used need it.
   for (std::uint32_t k = frame.plane_count; k < used_before; ++k) frame.planes[k] = Plane{};

@@ -104,6 +104,21 @@ struct Plane {
   std::array<LocalContact, kMaxLocalContacts> local_contacts{};
 };
 
+// A deformable surface around the proxy as heights (world_manager/deform/plastic_surface.h): a square of
+// kDentPatchSide × kDentPatchSide samples `spacing_m` apart, sample (i, j) at origin_m + i·spacing·axis_x +
+// j·spacing·axis_y + height_m[j·kDentPatchSide + i]·(axis_x × axis_y), the surface bilinear between them. The haptic
+// side takes the object's plane again from it under the proxy every tick (haptic_controller/local_yield.h), as a
+// shape's plane is taken again: a plane alone goes stale as the finger moves over a dent.
+inline constexpr std::uint32_t kDentPatchSide = 16;
+struct DentPatch {
+  std::int32_t object_id = -1;  // the deformable object; -1: no patch
+  Vec3 origin_m{};
+  Vec3 axis_x{};                // unit, orthogonal to axis_y; their cross product is the surface's outward normal
+  Vec3 axis_y{};
+  double spacing_m = 0.0;       // > 0 when object_id >= 0
+  std::array<double, kDentPatchSide * kDentPatchSide> height_m{};
+};
+
 // World → haptic, published once per world step i (docs/architecture.md §1.1 step 4).
 struct PlaneFrame {
   std::uint64_t frame_index = 0;       // i; 0 is the first frame of a world session
@@ -126,6 +141,7 @@ struct PlaneFrame {
   // beyond, so the planes describe the world only that far (the god-object's bound on a meaningful solution).
   // 0: unknown, no bound.
   double reach_radius_m = 0.0;
+  DentPatch dent_patch;  // the nearest deformable surface under the proxy, if any
   std::array<Plane, kMaxPlanes> planes{};
 };
 

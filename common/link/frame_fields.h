@@ -74,6 +74,12 @@ void visit_frame_header(A& a, B& b, F&& f) {
   f(a.gravity_mps2, b.gravity_mps2);
   f(a.world_substep_s, b.world_substep_s);
   f(a.reach_radius_m, b.reach_radius_m);
+  f(a.dent_patch.object_id, b.dent_patch.object_id);
+  f(a.dent_patch.origin_m, b.dent_patch.origin_m);
+  f(a.dent_patch.axis_x, b.dent_patch.axis_x);
+  f(a.dent_patch.axis_y, b.dent_patch.axis_y);
+  f(a.dent_patch.spacing_m, b.dent_patch.spacing_m);
+  f(a.dent_patch.height_m, b.dent_patch.height_m);
 }
 
 template <class A, class B, class F>

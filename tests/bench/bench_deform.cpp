@@ -3,7 +3,8 @@
 //   world:  one world step's denting of a 128 × 128-cell slab (12.8 cm at 1 mm): a 5 mm stroke of push laid along
 //           its path and over the pad, then the law over the touched cells; and the penetration rule's step;
 //   haptic: the servo's tick with a finger pressing 3 mm into the slab's face and circling (2 cm radius, 6 cm/s), the
-//           face as a deformable plane that yields between frames, beside the same face as a rigid box's plane. The
+//           face as a deformable plane taken again from the frame's heights every tick and yielding between frames,
+//           beside the same face as a rigid box's plane. The
 //           world's frame comes every 50 ticks (20 Hz) and has applied the reports up to the tick before it; and the
 //           worst case of a world that never applies any (every push since the start pending, up to the record's
 //           capacity).
@@ -55,7 +56,10 @@ void world_steps() {
   ns.clear();
   for (int step = 0; step < 2000; ++step) {
     const double angle = 0.125 * step;
-    const Eigen::Vector3d finger_m(0.04 * std::cos(angle), 0.04 * std::sin(angle), kTop_m - 1e-5);
+    const double x_m = 0.04 * std::cos(angle);
+    const double y_m = 0.04 * std::sin(angle);
+    // 10 µm below the surface there (its height in the body frame, whose centre is 15 mm up).
+    const Eigen::Vector3d finger_m(x_m, y_m, 0.015 + penetrated.height_m(x_m, y_m) - 1e-5);
     const auto start = std::chrono::steady_clock::now();
     penetrated.press_by_penetration(finger_m);
     ns.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count());
@@ -92,6 +96,14 @@ PlaneFrame frame_at(const Eigen::Vector3d& proxy_m, std::uint64_t index, std::ui
     plane.yield_depth_mpNs = clay.yield_depth_mpNs();
     plane.yield_radius_m = clay.contact_radius_m;
     plane.yield_room_m = 0.027;
+    // The heights around the proxy the world sends with it (a flat face here: the cost is the same).
+    DentPatch& patch = frame.dent_patch;
+    patch.object_id = 0;
+    patch.origin_m = {proxy_m.x() - 0.0075, proxy_m.y() - 0.0075, 0.0};
+    patch.axis_x = {1.0, 0.0, 0.0};
+    patch.axis_y = {0.0, 1.0, 0.0};
+    patch.spacing_m = 0.001;
+    patch.height_m.fill(kTop_m);
   } else {
     plane.shape.kind = ShapeKind::box;
     plane.shape.box_size_m = {0.2, 0.2, 0.03};

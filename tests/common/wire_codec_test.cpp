@@ -73,6 +73,19 @@ TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {
   CHECK(rejected([](PlaneFrame& f) { f.planes[0].dynamic_friction = 0.9; }) == FrameError::bad_friction);
   CHECK(rejected([](PlaneFrame& f) { f.reach_radius_m = -0.05; }) == FrameError::bad_reach);
   CHECK(rejected([](PlaneFrame& f) { f.planes[0].yield_force_N = -0.5; }) == FrameError::bad_yield);
+  CHECK(rejected([](PlaneFrame& f) {
+          f.dent_patch.object_id = 0;
+          f.dent_patch.axis_x = {1, 0, 0};
+          f.dent_patch.axis_y = {0, 1, 0};
+          f.dent_patch.spacing_m = 0.0;  // no spacing
+        }) == FrameError::bad_yield);
+  CHECK(rejected([&](PlaneFrame& f) {
+          f.dent_patch.object_id = 0;
+          f.dent_patch.axis_x = {1, 0, 0};
+          f.dent_patch.axis_y = {0, 1, 0};
+          f.dent_patch.spacing_m = 1e-3;
+          f.dent_patch.height_m[7] = nan;
+        }) == FrameError::not_finite);
   CHECK(rejected([](PlaneFrame& f) { f.planes[0].yield_depth_mpNs = -1e-3; }) == FrameError::bad_yield);
   CHECK(rejected([&](PlaneFrame& f) { f.planes[0].yield_radius_m = nan; }) == FrameError::not_finite);
   CHECK(rejected([](PlaneFrame& f) {

@@ -137,3 +137,31 @@ TEST_CASE("local yield keeps its newest pushes when more come than it holds, and
   CHECK(planes.planes[0].point_m.z() ==
         Approx(0.03 - kYieldDepth_mpNs * 1e-4 * static_cast<double>(LocalYield::kMaxSamples)).epsilon(1e-12));
 }
+
+TEST_CASE("a deformable plane is taken again under the proxy from the frame's heights, and as sent beyond them") {
+  // A patch of 1 mm samples over the clay's face (z = 0.03), a linear slope of 0.1 along x (a dent's wall).
+  PlaneFrame frame = test::make_frame({clay_plane()});
+  DentPatch& patch = frame.dent_patch;
+  patch.object_id = 0;
+  patch.origin_m = {-0.0075, -0.0075, 0.0};
+  patch.axis_x = {1.0, 0.0, 0.0};
+  patch.axis_y = {0.0, 1.0, 0.0};
+  patch.spacing_m = 0.001;
+  for (std::uint32_t j = 0; j < kDentPatchSide; ++j) {
+    for (std::uint32_t i = 0; i < kDentPatchSide; ++i) patch.height_m[j * kDentPatchSide + i] = 0.03 - 0.1e-3 * i;
+  }
+  LocalYield yield;
+  PlaneSet planes = test::make_set({contact_clay()});
+  const Vector3d proxy_m(0.0021, 0.001, 0.03);
+  yield.apply(frame, kSession, proxy_m, planes);
+  const ContactPlane& plane = planes.planes[0];
+  // Under the proxy: the height at x = 2.1 mm (9.6 samples in), and the wall's normal, tilted toward +x.
+  CHECK(plane.point_m.x() == Approx(0.0021));
+  CHECK(plane.point_m.z() == Approx(0.03 - 0.1 * (0.0021 + 0.0075)).epsilon(1e-12));
+  CHECK((plane.normal - Vector3d(0.1, 0.0, 1.0).normalized()).norm() < 1e-12);
+  // Beyond the patch: the plane the world sent.
+  planes = test::make_set({contact_clay()});
+  yield.apply(frame, kSession, Vector3d(0.02, 0.0, 0.03), planes);
+  CHECK(planes.planes[0].point_m == Vector3d(0, 0, 0.03));
+  CHECK(planes.planes[0].normal == Vector3d::UnitZ());
+}

@@ -186,6 +186,23 @@ void PlasticSurface::tangent_plane(const Eigen::Vector3d& body_m, Eigen::Vector3
   normal = orientation_ * Eigen::Vector3d(-slope_x, -slope_y, 1.0).normalized();
 }
 
+void PlasticSurface::patch_about(const Eigen::Vector3d& body_m, std::int32_t object_id, DentPatch& patch) const {
+  const double spacing_m = std::min(cell_x_m_, cell_y_m_);
+  const double half_span_m = 0.5 * (kDentPatchSide - 1) * spacing_m;
+  const double x0_m = body_m.x() - half_span_m;
+  const double y0_m = body_m.y() - half_span_m;
+  patch.object_id = object_id;
+  patch.origin_m = to_vec3(position_m_ + orientation_ * Eigen::Vector3d(x0_m, y0_m, 0.0));
+  patch.axis_x = to_vec3(orientation_ * Eigen::Vector3d::UnitX());
+  patch.axis_y = to_vec3(orientation_ * Eigen::Vector3d::UnitY());
+  patch.spacing_m = spacing_m;
+  for (std::uint32_t j = 0; j < kDentPatchSide; ++j) {
+    for (std::uint32_t i = 0; i < kDentPatchSide; ++i) {
+      patch.height_m[j * kDentPatchSide + i] = height_m(x0_m + i * spacing_m, y0_m + j * spacing_m);
+    }
+  }
+}
+
 PlasticSurface::Profile PlasticSurface::deepest_row() const {
   Profile profile;
   const auto deepest = static_cast<std::size_t>(std::max_element(depth_m_.begin(), depth_m_.end()) - depth_m_.begin());

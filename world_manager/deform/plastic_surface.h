@@ -11,6 +11,7 @@
 // press_by_penetration(...) for each sampled finger (penetration rule), then yield_period(). Not thread-safe; owned by
 // the World.
 
+#include "common/contract/frames.h"
 #include "world_manager/deform/plastic_material.h"
 #include "world_manager/deform/press_path.h"
 
@@ -59,6 +60,9 @@ class PlasticSurface {
   // outward normal (from the bilinear surface's slope), both in the world frame.
   void tangent_plane(const Eigen::Vector3d& body_m, Eigen::Vector3d& point_m, Eigen::Vector3d& normal) const;
   Eigen::Vector3d to_body(const Eigen::Vector3d& world_m) const;
+  // The heights about a body-frame point over the face, a cell apart (common/contract/frames.h DentPatch), for
+  // object `object_id`.
+  void patch_about(const Eigen::Vector3d& body_m, std::int32_t object_id, DentPatch& patch) const;
 
   const PlasticMaterial& material() const { return material_; }
   double max_dent_m() const { return max_dent_m_; }

@@ -15,7 +15,10 @@ namespace {
 // struct {x, y, z} on the other; the coupling an enum and an unsigned; the rest the same type.
 struct ToDds {
   void operator()(const Vec3& from, impetus_dds_Vec3& to) const { to = {from[0], from[1], from[2]}; }
-  void operator()(const std::array<double, 9>& from, double (&to)[9]) const { std::copy(from.begin(), from.end(), to); }
+  template <std::size_t N>
+  void operator()(const std::array<double, N>& from, double (&to)[N]) const {
+    std::copy(from.begin(), from.end(), to);
+  }
   void operator()(const Coupling& from, std::uint32_t& to) const { to = static_cast<std::uint32_t>(from); }
   void operator()(const ShapeKind& from, std::uint32_t& to) const { to = static_cast<std::uint32_t>(from); }
   template <class T>
@@ -26,7 +29,10 @@ struct ToDds {
 
 struct FromDds {
   void operator()(Vec3& to, const impetus_dds_Vec3& from) const { to = {from.x, from.y, from.z}; }
-  void operator()(std::array<double, 9>& to, const double (&from)[9]) const { std::copy(from, from + 9, to.begin()); }
+  template <std::size_t N>
+  void operator()(std::array<double, N>& to, const double (&from)[N]) const {
+    std::copy(from, from + N, to.begin());
+  }
   void operator()(Coupling& to, const std::uint32_t& from) const { to = static_cast<Coupling>(from); }
   void operator()(ShapeKind& to, const std::uint32_t& from) const { to = static_cast<ShapeKind>(from); }
   template <class T>

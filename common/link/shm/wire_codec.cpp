@@ -76,7 +76,7 @@ const char* to_string(FrameError error) {
     case FrameError::bad_coupling: return "unknown coupling";
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
     case FrameError::bad_reach: return "reach radius or plane extent is negative";
-    case FrameError::bad_yield: return "a deformable plane's yield force, depth rate, pad radius or room is negative";
+    case FrameError::bad_yield: return "a deformable plane's yield force, depth rate, pad radius or room is negative, or its patch is malformed";
     case FrameError::bad_mass: return "a local contact's inverse mass is negative";
     case FrameError::bad_shape: return "a plane's shape is unknown or out of range, or its body axes not orthonormal";
   }
@@ -108,6 +108,22 @@ FrameError validate(const wire::PlaneFrame& frame) {
   if (!(frame.world_period_s > 0.0) || !finite(frame.world_period_s)) return FrameError::bad_period;
   if (frame.world_substep_s < 0.0) return FrameError::bad_period;
   if (frame.reach_radius_m < 0.0) return FrameError::bad_reach;
+  if (frame.dent_patch.object_id >= 0) {
+    const wire::DentPatch& patch = frame.dent_patch;
+    if (!all_finite(patch.origin_m) || !all_finite(patch.axis_x) || !all_finite(patch.axis_y) ||
+        !finite(patch.spacing_m)) {
+      return FrameError::not_finite;
+    }
+    for (double height : patch.height_m) {
+      if (!finite(height)) return FrameError::not_finite;
+    }
+    const auto dot = [](const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+    if (!(patch.spacing_m > 0.0) || std::fabs(dot(patch.axis_x, patch.axis_x) - 1.0) > kUnitNormalTolerance ||
+        std::fabs(dot(patch.axis_y, patch.axis_y) - 1.0) > kUnitNormalTolerance ||
+        std::fabs(dot(patch.axis_x, patch.axis_y)) > kUnitNormalTolerance) {
+      return FrameError::bad_yield;
+    }
+  }
   if (static_cast<std::uint32_t>(frame.coupling) > static_cast<std::uint32_t>(Coupling::local)) {
     return FrameError::bad_coupling;
   }

@@ -56,6 +56,16 @@ struct Plane {
   std::array<LocalContact, kMaxLocalContacts> local_contacts{};
 };
 
+struct DentPatch {
+  std::int32_t object_id = -1;
+  std::uint32_t reserved = 0;
+  Vec3 origin_m{};
+  Vec3 axis_x{};
+  Vec3 axis_y{};
+  double spacing_m = 0.0;
+  std::array<double, kDentPatchSide * kDentPatchSide> height_m{};
+};
+
 struct PlaneFrame {
   std::uint64_t checksum = 0;  // frame_checksum() of the used bytes after it; set by encode()
   std::uint64_t frame_index = 0;
@@ -73,6 +83,7 @@ struct PlaneFrame {
   Vec3 gravity_mps2{};
   double world_substep_s = 0.0;
   double reach_radius_m = 0.0;
+  DentPatch dent_patch;
   std::array<Plane, kMaxPlanes> planes{};  // the first plane_count are used
 };
 
