@@ -78,7 +78,9 @@ void LocalYield::apply(const PlaneFrame& frame, std::uint64_t haptic_session, co
     plane.normal = to_eigen(sent->normal);
     plane.point_m = to_eigen(sent->point_m);
     // The surface under the proxy from the frame's heights, where it has them for this object; else the plane sent.
-    if (frame.dent_patch.object_id == plane.object_id) patch_plane(frame.dent_patch, proxy_m, plane.point_m, plane.normal);
+    if (frame.dent_patch.object_id == plane.object_id) {
+      patch_plane(frame.dent_patch, proxy_m, plane.point_m, plane.normal);
+    }
     const double offset_m = std::min(sent->yield_depth_mpNs * pending_Ns, sent->yield_room_m);
     plane.point_m -= offset_m * plane.normal;
   }

@@ -1,12 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/scene.h"
 
-#include "world_manager/deform/plastic_surface.h"
-
 #include "common/contract/limits.h"
 #include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
 #include "common/mesh/mesh_object.h"
+#include "world_manager/deform/plastic_surface.h"
 #include "world_manager/engine/engine_registry.h"
 
 #include <nlohmann/json.hpp>

@@ -273,7 +273,9 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
     if (id < floor_id && surfaces_[id]) {
       surfaces_[id]->absorb(t.delta.impulse_Ns);
       // The push beyond yield, where and when it was given (deform/press_path.h).
-      if (surfaces_[id]->material().rule == PlasticMaterial::Rule::impulse) surfaces_[id]->press(stroke_of(t.delta.press));
+      if (surfaces_[id]->material().rule == PlasticMaterial::Rule::impulse) {
+        surfaces_[id]->press(stroke_of(t.delta.press));
+      }
     }
     if (id < floor_id && scene_.objects[id].dynamic) {
       coupling_->take_impulse(id, t.delta, t.moment, t.moment_finite, window);

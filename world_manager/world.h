@@ -137,7 +137,9 @@ class World {
   // The yielding top face of deformable object `id` (scene "deformable"), or nullptr for any other object. Pressed by
   // the reports' press moments (impulse rule) or the sampled fingers (penetration rule) and yielded once per step,
   // after the engine; the frames carry its surface under each proxy (kPlaneDeformable).
-  const PlasticSurface* deformable(std::size_t id) const { return id < surfaces_.size() ? surfaces_[id].get() : nullptr; }
+  const PlasticSurface* deformable(std::size_t id) const {
+    return id < surfaces_.size() ? surfaces_[id].get() : nullptr;
+  }
 
   // The impulse port's energy books per dynamic object and their sum (couplings/passivity_layer.h).
   const PassivityLayer& port() const { return *port_; }

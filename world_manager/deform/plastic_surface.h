@@ -51,7 +51,9 @@ class PlasticSurface {
   // The surface's height above the body's centre at body-frame (x, y), clamped to the face: the top minus the dent.
   double height_m(double x_m, double y_m) const;
   // How much further in the surface at body-frame (x, y) can go before the slab's unyielding floor.
-  double room_m(double x_m, double y_m) const { return std::max(0.0, height_m(x_m, y_m) - (half_size_m_.z() - max_depth_m_)); }
+  double room_m(double x_m, double y_m) const {
+    return std::max(0.0, height_m(x_m, y_m) - (half_size_m_.z() - max_depth_m_));
+  }
   // Whether a body-frame point lies over the top face (within its edges) and above the slab's bottom: there the
   // surface is this grid's, not the box's (a finger that came in over the top, however deep, is pushed back up, never
   // out through the bottom).

@@ -76,7 +76,8 @@ const char* to_string(FrameError error) {
     case FrameError::bad_coupling: return "unknown coupling";
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
     case FrameError::bad_reach: return "reach radius or plane extent is negative";
-    case FrameError::bad_yield: return "a deformable plane's yield force, depth rate, pad radius or room is negative, or its patch is malformed";
+    case FrameError::bad_yield:
+      return "a deformable plane's yield force, depth rate, pad radius or room is negative, or its patch is malformed";
     case FrameError::bad_mass: return "a local contact's inverse mass is negative";
     case FrameError::bad_shape: return "a plane's shape is unknown or out of range, or its body axes not orthonormal";
   }
