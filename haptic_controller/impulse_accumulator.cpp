@@ -150,9 +150,10 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     // Where and when the surface was pressed (frames.h ObjectImpulse::press_*): the push into it at the proxy beyond
     // what the surface holds without yielding (a deformable plane's yield force over the tick; the law's threshold
     // taken here, at the haptic rate, so the dent does not depend on how the world's period cut the push).
-    const double press_Ns = std::max(0.0, -impulse_Ns.dot(plane.normal) - plane.yield_force_N * dt_s);
-    last_shares_[static_cast<std::size_t>(last_share_count_++)] = {
-        plane.object_id, plane.dynamic(), impulse_Ns, angular_Nms, plane.deformable() ? press_Ns : 0.0};
+    const double press_Ns =
+        plane.deformable() ? std::max(0.0, -impulse_Ns.dot(plane.normal) - plane.yield_force_N * dt_s) : 0.0;
+    last_shares_[static_cast<std::size_t>(last_share_count_++)] = {plane.object_id, plane.dynamic(), impulse_Ns,
+                                                                   angular_Nms, press_Ns};
     if (!plane.dynamic() && !plane.deformable()) {
       add_to(report_.static_impulse_Ns, impulse_Ns);
       continue;
@@ -169,12 +170,14 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     add_to(entry->impulse_moment_Nss, impulse_Ns * report_.haptic_time_s);
     add_to(entry->angular_impulse_moment_Nmss, angular_Nms * report_.haptic_time_s);
     entry->hand_input_J += std::max(0.0, impulse_Ns.dot(finger_velocity_mps));
-    const double t_s = report_.haptic_time_s;
-    entry->press_Ns += press_Ns;
-    add_to(entry->press_point_Nsm, press_Ns * contact.proxy_m);
-    entry->press_time_Nss += press_Ns * t_s;
-    entry->press_time2_Nsss += press_Ns * t_s * t_s;
-    add_to(entry->press_point_time_Nssm, press_Ns * t_s * contact.proxy_m);
+    if (press_Ns > 0.0) {
+      const double t_s = report_.haptic_time_s;
+      entry->press_Ns += press_Ns;
+      add_to(entry->press_point_Nsm, press_Ns * contact.proxy_m);
+      entry->press_time_Nss += press_Ns * t_s;
+      entry->press_time2_Nsss += press_Ns * t_s * t_s;
+      add_to(entry->press_point_time_Nssm, press_Ns * t_s * contact.proxy_m);
+    }
     entry->last_tick = tick;
   }
 }

@@ -2,10 +2,7 @@
 // world_manager: the rigid-body world at the world rate (docs/architecture.md §1.1). Parses the flags, creates the
 // world link and runs a WorldNode on it; writes the world half of summary.json at exit.
 
-#include "common/link/dds/dds_world_view.h"
 #include "common/link/dds/open_world_link.h"
-#include "common/link/shm/shm_world_view.h"
-#include "common/link/world_view_tee.h"
 #include "common/runtime/cli.h"
 #include "world_manager/defaults.h"
 #include "world_manager/engine/engine_registry.h"
@@ -75,15 +72,8 @@ int main(int argc, char** argv) {
     const std::unique_ptr<WorldLinkServer> link = open_world_link_server(link_options, shm, node.link_info());
     node.connect(*link);
     // The world view: "<shm>.view" for viewers on this host (read-only), and over DDS too with --link dds.
-    ShmWorldViewPublisher shm_view(shm);
-    std::unique_ptr<DdsWorldViewPublisher> dds_view;
-    WorldViewTee view;
-    view.add(shm_view);
-    if (link_options.kind == LinkKind::dds) {
-      dds_view = std::make_unique<DdsWorldViewPublisher>(link_options.dds);
-      view.add(*dds_view);
-    }
-    node.connect_view(view);
+    const std::unique_ptr<WorldViewPublisher> view = open_world_view_publisher(link_options, shm);
+    node.connect_view(*view);
     const WorldLinkInfo info = node.link_info();
     std::fprintf(stderr, "world_manager: '%s', %zu objects, %.1f Hz, %s coupling, %s clock, link %s\n",
                  options.scene_path.c_str(), node.world().scene().objects.size(), info.world_rate_hz,

@@ -168,7 +168,7 @@ struct ObjectImpulse {
   // session time t_k): Σ p_k (N·s), Σ p_k·x_k (N·s·m, world frame), Σ p_k·t_k (N·s²), Σ p_k·t_k² (N·s³) and
   // Σ p_k·x_k·t_k (N·s²·m). The differences over a world period give the push, where it was centred, and how the
   // contact moved while pressing (a straight stroke is recovered exactly), so a deformable object dents along the
-  // finger's path (world_manager/deform/press_path.h). Kept for every entry; only deformable objects use them.
+  // finger's path (world_manager/deform/press_path.h). Zero for any object but a deformable one (kPlaneDeformable).
   double press_Ns = 0.0;
   Vec3 press_point_Nsm{};
   double press_time_Nss = 0.0;

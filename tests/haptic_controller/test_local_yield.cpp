@@ -73,6 +73,13 @@ TEST_CASE("a deformable surface gets an entry with the push beyond its yield for
   other.add(test::make_set({rigid}), contact.contact, Vector3d(0, 0, 2.0), 1e-3, 1);
   CHECK(other.report().entry_count == 0);
   CHECK(other.report().static_impulse_Ns[2] == Approx(-2e-3));
+  // A dynamic rigid body gets its entry, with no press: nothing dents it.
+  rigid.flags = kPlaneDynamic;
+  ImpulseAccumulator moving(kSession);
+  moving.add(test::make_set({rigid}), contact.contact, Vector3d(0, 0, 2.0), 1e-3, 1);
+  REQUIRE(moving.report().entry_count == 1);
+  CHECK(moving.report().entries[0].press_Ns == 0.0);
+  CHECK(moving.last_shares()[0].yielding_Ns == 0.0);
 }
 
 TEST_CASE("a deformable plane yields between frames by the pushes the world has not applied, where they were given") {

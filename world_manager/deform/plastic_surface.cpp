@@ -123,10 +123,17 @@ void PlasticSurface::press_by_penetration(const Eigen::Vector3d& finger_m) {
   if (!(penetration_m > 0.0)) return;
   const double radius_m = material_.contact_radius_m;
   const double centre_m = material_.plasticity * penetration_m;
-  for (std::size_t r = 0; r < rows_; ++r) {
+  // The cells under the pad only: its bounding square, clamped to the grid (the finger is over the face).
+  const auto first = [](double low_m, double cell_m, double half_m, std::size_t count) {
+    return static_cast<std::size_t>(std::clamp(std::floor((low_m + half_m) / cell_m), 0.0, count - 1.0));
+  };
+  const std::size_t c0 = first(body_m.x() - radius_m, cell_x_m_, half_size_m_.x(), columns_);
+  const std::size_t c1 = first(body_m.x() + radius_m, cell_x_m_, half_size_m_.x(), columns_);
+  const std::size_t r0 = first(body_m.y() - radius_m, cell_y_m_, half_size_m_.y(), rows_);
+  const std::size_t r1 = first(body_m.y() + radius_m, cell_y_m_, half_size_m_.y(), rows_);
+  for (std::size_t r = r0; r <= r1; ++r) {
     const double dy = -half_size_m_.y() + (static_cast<double>(r) + 0.5) * cell_y_m_ - body_m.y();
-    if (std::abs(dy) > radius_m) continue;
-    for (std::size_t c = 0; c < columns_; ++c) {
+    for (std::size_t c = c0; c <= c1; ++c) {
       const double dx = -half_size_m_.x() + (static_cast<double>(c) + 0.5) * cell_x_m_ - body_m.x();
       const double weight = 1.0 - (dx * dx + dy * dy) / (radius_m * radius_m);
       if (weight > 0.0) deepen(r * columns_ + c, centre_m * weight);

@@ -2,7 +2,10 @@
 #include "common/link/dds/open_world_link.h"
 
 #include "common/link/dds/dds_world_link.h"
+#include "common/link/dds/dds_world_view.h"
 #include "common/link/shm/shm_world_link.h"
+#include "common/link/shm/shm_world_view.h"
+#include "common/link/world_view_tee.h"
 
 namespace impetus {
 
@@ -18,6 +21,13 @@ std::unique_ptr<WorldLinkServer> open_world_link_server(const LinkOptions& optio
                                                          const WorldLinkInfo& info) {
   if (options.kind == LinkKind::dds) return std::make_unique<DdsWorldLinkServer>(options.dds, info);
   return std::make_unique<ShmWorldLinkServer>(shm, info);
+}
+
+std::unique_ptr<WorldViewPublisher> open_world_view_publisher(const LinkOptions& options, const std::string& shm) {
+  auto tee = std::make_unique<WorldViewTee>();
+  tee->add(std::make_unique<ShmWorldViewPublisher>(shm));
+  if (options.kind == LinkKind::dds) tee->add(std::make_unique<DdsWorldViewPublisher>(options.dds));
+  return tee;
 }
 
 std::string link_name(const WorldLinkServer& link) {

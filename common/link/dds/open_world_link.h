@@ -5,6 +5,7 @@
 
 #include "common/link/link_options.h"
 #include "common/link/world_link.h"
+#include "common/contract/world_view.h"
 #include "common/runtime/lockstep.h"
 
 #include <nlohmann/json.hpp>
@@ -21,6 +22,9 @@ std::unique_ptr<WorldLinkClient> open_world_link_client(const LinkOptions& optio
 // The world's end, serving `info`.
 std::unique_ptr<WorldLinkServer> open_world_link_server(const LinkOptions& options, const std::string& shm,
                                                          const WorldLinkInfo& info);
+// The world view's publisher (docs/architecture.md §1): "<shm>.view" for viewers on this host (read-only), and over DDS
+// too when `options` name DDS.
+std::unique_ptr<WorldViewPublisher> open_world_view_publisher(const LinkOptions& options, const std::string& shm);
 // Where a link is, for messages: "'NAME'" in shared memory, DDS's domain and partition.
 std::string link_name(const WorldLinkServer& link);
 // What a transport adds to a daemon's summary (DDS: domain, partition and its counters), or null for none.
