@@ -68,12 +68,19 @@ void LocalYield::apply(const PlaneFrame& frame, std::uint64_t haptic_session, co
     const Plane* sent = frame_plane(frame, plane.object_id);
     if (sent == nullptr) continue;
     const double radius2_m2 = plane.yield_radius_m * plane.yield_radius_m;
-    double pending_Ns = 0.0;  // Σ e_k·w(|x_k − proxy|), newest first, down to the applied report
+    // Σ e_k·w(|x_k − proxy|) and its gradient in the proxy, Σ e_k·(−2/a²)·(proxy − x_k) over the pad, newest first,
+    // down to the applied report.
+    double pending_Ns = 0.0;
+    Eigen::Vector3d pending_gradient_Nspm = Eigen::Vector3d::Zero();
     for (std::size_t n = 1; n <= count_; ++n) {
       const Sample& sample = samples_[(next_ + kMaxSamples - n) % kMaxSamples];
       if (sample.tick <= applied_tick) break;
       if (sample.object_id != plane.object_id) continue;
-      pending_Ns += sample.yielding_Ns * std::max(0.0, 1.0 - (sample.at_m - proxy_m).squaredNorm() / radius2_m2);
+      const Eigen::Vector3d from_m = proxy_m - sample.at_m;
+      const double weight = 1.0 - from_m.squaredNorm() / radius2_m2;
+      if (!(weight > 0.0)) continue;
+      pending_Ns += sample.yielding_Ns * weight;
+      pending_gradient_Nspm -= (2.0 * sample.yielding_Ns / radius2_m2) * from_m;
     }
     plane.normal = to_eigen(sent->normal);
     plane.point_m = to_eigen(sent->point_m);
@@ -81,8 +88,17 @@ void LocalYield::apply(const PlaneFrame& frame, std::uint64_t haptic_session, co
     if (frame.dent_patch.object_id == plane.object_id) {
       patch_plane(frame.dent_patch, proxy_m, plane.point_m, plane.normal);
     }
-    const double offset_m = std::min(sent->yield_depth_mpNs * pending_Ns, sent->yield_room_m);
+    const double dent_m = sent->yield_depth_mpNs * pending_Ns;
+    const double offset_m = std::min(dent_m, sent->yield_room_m);
     plane.point_m -= offset_m * plane.normal;
+    // The pending dent's slope tilts the surface, as the frame's heights do: along the surface, the height falls by
+    // ∇D, so the outward normal becomes n + ∇D (tangential part). A finger moving over clay it is still denting meets
+    // the front wall of its own dent there, and the push it gives the wall (and so the dent) depends on that slope.
+    // Where the floor stopped the dent, the surface is the floor's: flat.
+    if (dent_m <= sent->yield_room_m) {
+      const Eigen::Vector3d slope = sent->yield_depth_mpNs * pending_gradient_Nspm;
+      plane.normal = (plane.normal + slope - slope.dot(plane.normal) * plane.normal).normalized();
+    }
   }
 }
 

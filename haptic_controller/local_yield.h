@@ -9,10 +9,12 @@
 // i's surface, not interpolated (frame i already shows every dent the world made from the reports up to the one it
 // applied, PlaneFrame::report_tick_applied), moved in along its normal by what the push beyond yield of the later
 // ticks will dent under the proxy, by the world's own law (world_manager/deform/plastic_material.h):
-//     offset = yield_depth_mpNs · Σ_{ticks k after the applied report} e_k · max(0, 1 − |x_k − proxy|² / a²)
+//     D = yield_depth_mpNs · Σ_{ticks k after the applied report} e_k · max(0, 1 − |x_k − proxy|² / a²)
 // e_k the tick's push beyond yield into that object (ImpulseShare::yielding_Ns), x_k where it was given, a the pad's
-// radius (Plane::yield_radius_m), and never beyond how far the surface there can still go (Plane::yield_room_m). The
-// world's next frame shows the same dent, made from the same pushes.
+// radius (Plane::yield_radius_m), and never beyond how far the surface there can still go (Plane::yield_room_m); and
+// tilted by that dent's slope, n ← normalise(n + ∇D along the surface): a finger moving over clay it is still denting
+// pushes against the front wall of its own dent. The world's next frame shows the same dent, made from the same
+// pushes, to the difference between the pad's paraboloid and the world's cells (docs/deformation.md).
 //
 // Fixed capacity (kMaxSamples pushes: a second at 1 kHz with a finger on one surface, far more than a world period and
 // a link's round trip); when full, the oldest is forgotten and counted (its dent then shows at the next frame).

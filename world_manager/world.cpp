@@ -359,7 +359,12 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
     plane.body_axis_x = {};
     plane.body_axis_y = {};
     plane.extent_m = surface->material().contact_radius_m;
-    if (frame.dent_patch.object_id < 0) surface->patch_about(query_body_m, plane.object_id, frame.dent_patch);
+    // The patch reaches as far as the finger goes in two periods along the face: until the next frame, and one
+    // more should that frame be late.
+    const Eigen::Vector3d up = to_eigen(plane.normal);
+    const Eigen::Vector3d velocity_mps = endpoint.plane_query.velocity_mps;
+    const double travel_m = 2.0 * period_s_ * (velocity_mps - velocity_mps.dot(up) * up).norm();
+    if (frame.dent_patch.object_id < 0) surface->patch_about(query_body_m, plane.object_id, travel_m, frame.dent_patch);
   }
   // Planes past the count stay value-initialised (frames.h copy_used): only those the last frame used need it.
   for (std::uint32_t k = frame.plane_count; k < used_before; ++k) frame.planes[k] = Plane{};

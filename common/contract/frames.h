@@ -108,8 +108,10 @@ struct Plane {
 // kDentPatchSide × kDentPatchSide samples `spacing_m` apart, sample (i, j) at origin_m + i·spacing·axis_x +
 // j·spacing·axis_y + height_m[j·kDentPatchSide + i]·(axis_x × axis_y), the surface bilinear between them. The haptic
 // side takes the object's plane again from it under the proxy every tick (haptic_controller/local_yield.h), as a
-// shape's plane is taken again: a plane alone goes stale as the finger moves over a dent.
-inline constexpr std::uint32_t kDentPatchSide = 16;
+// shape's plane is taken again: a plane alone goes stale as the finger moves over a dent. 32 × 32 samples (8 KB):
+// a cell apart (1 mm by default), ±15.5 mm about the proxy, the travel of a 15 cm/s stroke over two 10 Hz periods;
+// a faster finger gets samples further apart rather than a patch it leaves (plastic_surface.h patch_about).
+inline constexpr std::uint32_t kDentPatchSide = 32;
 struct DentPatch {
   std::int32_t object_id = -1;  // the deformable object; -1: no patch
   Vec3 origin_m{};

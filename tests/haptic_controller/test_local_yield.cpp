@@ -99,7 +99,10 @@ TEST_CASE("a deformable plane yields between frames by the pushes the world has 
   yield.apply(frame, kSession, proxy_m, planes);
   const double expected_m = kYieldDepth_mpNs * (5 * 1e-3 + 5 * 0.75e-3);
   CHECK(planes.planes[0].point_m.z() == Approx(0.03 - expected_m).epsilon(1e-12));
-  CHECK(planes.planes[0].normal == Vector3d::UnitZ());
+  // Deeper toward the pushes 3 mm along +x, so the surface there falls away and its normal leans to +x: the slope
+  // of the pending dent, yield_depth · Σ e_k · 2·(x_k − proxy)/a².
+  const double slope = kYieldDepth_mpNs * 5 * 1e-3 * 2.0 * 0.003 / (kPad_m * kPad_m);
+  CHECK((planes.planes[0].normal - Vector3d(slope, 0.0, 1.0).normalized()).norm() < 1e-12);
 
   // A world that applied none of this session's reports has applied none of these pushes.
   frame.report_session_applied = kSession + 1;
@@ -150,7 +153,7 @@ TEST_CASE("a deformable plane is taken again under the proxy from the frame's he
   PlaneFrame frame = test::make_frame({clay_plane()});
   DentPatch& patch = frame.dent_patch;
   patch.object_id = 0;
-  patch.origin_m = {-0.0075, -0.0075, 0.0};
+  patch.origin_m = {-0.0155, -0.0155, 0.0};
   patch.axis_x = {1.0, 0.0, 0.0};
   patch.axis_y = {0.0, 1.0, 0.0};
   patch.spacing_m = 0.001;
@@ -162,9 +165,9 @@ TEST_CASE("a deformable plane is taken again under the proxy from the frame's he
   const Vector3d proxy_m(0.0021, 0.001, 0.03);
   yield.apply(frame, kSession, proxy_m, planes);
   const ContactPlane& plane = planes.planes[0];
-  // Under the proxy: the height at x = 2.1 mm (9.6 samples in), and the wall's normal, tilted toward +x.
+  // Under the proxy: the height at x = 2.1 mm (17.6 samples in), and the wall's normal, tilted toward +x.
   CHECK(plane.point_m.x() == Approx(0.0021));
-  CHECK(plane.point_m.z() == Approx(0.03 - 0.1 * (0.0021 + 0.0075)).epsilon(1e-12));
+  CHECK(plane.point_m.z() == Approx(0.03 - 0.1 * (0.0021 + 0.0155)).epsilon(1e-12));
   CHECK((plane.normal - Vector3d(0.1, 0.0, 1.0).normalized()).norm() < 1e-12);
   // Beyond the patch: the plane the world sent.
   planes = test::make_set({contact_clay()});

@@ -48,6 +48,34 @@ TEST_CASE("a plastic slab dents by the push beyond yield it is given: volume = p
   CHECK(surface.dent_volume_m3() == volume_m3);
 }
 
+TEST_CASE("a plastic slab's patch of heights lies on its cells' centres, and spreads out to reach a fast finger") {
+  PlasticSurface surface = slab();
+  surface.press(at(Vector3d(0.0013, 0.0004, 0.01), 0.01));
+  surface.yield_period();
+  DentPatch patch;
+  const Vector3d about_m(0.0011, 0.0007, 0.01);
+  surface.patch_about(about_m, 4, 0.0, patch);
+  CHECK(patch.object_id == 4);
+  CHECK(patch.spacing_m == Approx(0.001));
+  // Every sample is a cell centre ((i + 0.5) mm from the face's edge at −5 cm) and carries that cell's height.
+  const double u0 = (patch.origin_m[0] + 0.05) / 0.001 - 0.5;
+  const double v0 = (patch.origin_m[1] + 0.05) / 0.001 - 0.5;
+  CHECK(u0 == Approx(std::round(u0)).margin(1e-9));
+  CHECK(v0 == Approx(std::round(v0)).margin(1e-9));
+  const auto column = static_cast<std::size_t>(std::round(u0)) + 16;
+  const auto row = static_cast<std::size_t>(std::round(v0)) + 15;
+  REQUIRE(surface.depth_m(column, row) > 0.0);
+  CHECK(patch.height_m[15 * kDentPatchSide + 16] == Approx(0.01 - surface.depth_m(column, row)).epsilon(1e-12));
+  // It holds the point it was taken about, near its middle.
+  CHECK(std::abs(about_m.x() - (patch.origin_m[0] + 15.5 * patch.spacing_m)) <= 0.5 * patch.spacing_m + 1e-12);
+  // A finger that may travel 5 cm before the next frame: samples further apart, so the patch reaches it.
+  surface.patch_about(about_m, 4, 0.05, patch);
+  CHECK(patch.spacing_m * 0.5 * (kDentPatchSide - 1) == Approx(0.05));
+  // A nonsense reach is no reach.
+  surface.patch_about(about_m, 4, std::numeric_limits<double>::quiet_NaN(), patch);
+  CHECK(patch.spacing_m == Approx(0.001));
+}
+
 TEST_CASE("a plastic slab's threshold is the material's yield force over the contact pad") {
   PlasticMaterial clay;
   clay.yield_stress_Pa = 5000.0;

@@ -193,11 +193,25 @@ void PlasticSurface::tangent_plane(const Eigen::Vector3d& body_m, Eigen::Vector3
   normal = orientation_ * Eigen::Vector3d(-slope_x, -slope_y, 1.0).normalized();
 }
 
-void PlasticSurface::patch_about(const Eigen::Vector3d& body_m, std::int32_t object_id, DentPatch& patch) const {
-  const double spacing_m = std::min(cell_x_m_, cell_y_m_);
-  const double half_span_m = 0.5 * (kDentPatchSide - 1) * spacing_m;
-  const double x0_m = body_m.x() - half_span_m;
-  const double y0_m = body_m.y() - half_span_m;
+void PlasticSurface::patch_about(const Eigen::Vector3d& body_m, std::int32_t object_id, double half_span_m,
+                                 DentPatch& patch) const {
+  constexpr double kHalfSamples = 0.5 * (kDentPatchSide - 1);
+  const double wanted_m = std::isfinite(half_span_m) ? std::max(0.0, half_span_m) : 0.0;
+  // Across the whole face at most: beyond it the heights are the edge's anyway.
+  const double reach_m = std::min(wanted_m, std::max(half_size_m_.x(), half_size_m_.y()) * 2.0);
+  const double spacing_m = std::max(std::min(cell_x_m_, cell_y_m_), reach_m / kHalfSamples);
+  const double span_m = kHalfSamples * spacing_m;
+  double x0_m = body_m.x() - span_m;
+  double y0_m = body_m.y() - span_m;
+  // Samples a cell apart on square cells lie on the cells' centres: the heights are the cells' own, and the haptic
+  // side's bilinear surface between them is this grid's (resampled between centres, it would be smoothed twice).
+  if (spacing_m == cell_x_m_ && spacing_m == cell_y_m_) {
+    const auto centre = [spacing_m](double low_m, double half_m) {
+      return -half_m + (std::round((low_m + half_m) / spacing_m - 0.5) + 0.5) * spacing_m;
+    };
+    x0_m = centre(x0_m, half_size_m_.x());
+    y0_m = centre(y0_m, half_size_m_.y());
+  }
   patch.object_id = object_id;
   patch.origin_m = to_vec3(position_m_ + orientation_ * Eigen::Vector3d(x0_m, y0_m, 0.0));
   patch.axis_x = to_vec3(orientation_ * Eigen::Vector3d::UnitX());

@@ -62,9 +62,11 @@ class PlasticSurface {
   // outward normal (from the bilinear surface's slope), both in the world frame.
   void tangent_plane(const Eigen::Vector3d& body_m, Eigen::Vector3d& point_m, Eigen::Vector3d& normal) const;
   Eigen::Vector3d to_body(const Eigen::Vector3d& world_m) const;
-  // The heights about a body-frame point over the face, a cell apart (common/contract/frames.h DentPatch), for
-  // object `object_id`.
-  void patch_about(const Eigen::Vector3d& body_m, std::int32_t object_id, DentPatch& patch) const;
+  // The heights about a body-frame point over the face (common/contract/frames.h DentPatch), for object `object_id`:
+  // a cell apart, or further apart where that is needed to reach `half_span_m` each way (where the proxy may go
+  // before the next frame: a finger beyond the patch meets only the plane sent).
+  void patch_about(const Eigen::Vector3d& body_m, std::int32_t object_id, double half_span_m,
+                   DentPatch& patch) const;
 
   const PlasticMaterial& material() const { return material_; }
   double max_dent_m() const { return max_dent_m_; }
