@@ -44,6 +44,7 @@ World::World(const Scene& scene, const WorldOptions& options)
   coupling_ = make_coupling(options.coupling, context, stiffness_Npm, damping_Nspm);
 
   surfaces_.resize(states_.size());
+  surface_changes_.assign(states_.size(), 0);
   for (std::size_t id = 0; id < states_.size(); ++id) {
     const SceneObject& object = scene_.objects[id];
     ObjectState& state = states_[id];
@@ -125,8 +126,15 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   engine_->step(scene_.physics.substeps, period_s_ / scene_.physics.substeps, coupling_->needs_contacts(), *coupling_);
   coupling_->after_step();
   port_->settle();
-  for (const auto& surface : surfaces_) {
-    if (surface) surface->yield_period();
+  // Deformable surfaces yield; bodies rest on the dented surface from the next step on.
+  for (std::size_t id = 0; id < surfaces_.size(); ++id) {
+    PlasticSurface* surface = surfaces_[id].get();
+    if (surface == nullptr) continue;
+    surface->yield_period();
+    if (surface->changes() != surface_changes_[id]) {
+      surface_changes_[id] = surface->changes();
+      engine_->dent_top(id, surface->dented_top());
+    }
   }
   ++steps_taken_;
   time_s_ = static_cast<double>(steps_taken_) * period_s_;  // no drift from summing periods

@@ -185,6 +185,7 @@ class World {
   std::unique_ptr<PassivityLayer> port_;
   std::unique_ptr<CouplingStrategy> coupling_;
   std::vector<std::unique_ptr<PlasticSurface>> surfaces_;  // per object; nullptr unless deformable
+  std::vector<std::uint64_t> surface_changes_;              // per object: its surface's changes() the engine has seen
   Eigen::Vector3d total_static_impulse_Ns_ = Eigen::Vector3d::Zero();
   std::map<CounterOwner, std::vector<Eigen::Vector3d>> applied_by_owner_;  // per object (scene ids and the floor)
   std::uint64_t rejected_entries_ = 0;

@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -90,6 +91,29 @@ TEST_CASE("two fingers on one slab each make the dent one finger makes alone") {
   // 8 cm apart, their pads (6 mm) never meet: the mirrored presses dent alike, to rounding.
   CHECK(clay(both)["dent_volume_m3"].get<double>() == Approx(2.0 * one_m3).epsilon(1e-9));
   CHECK(clay(both)["max_dent_m"].get<double>() == Approx(clay(alone)["max_dent_m"].get<double>()).epsilon(1e-9));
+}
+
+TEST_CASE("a ball beside a press rolls into the dent and rests at its bottom") {
+  // scenes/clay.json's slab, and a 4 mm ball of 5 g resting 5 mm from where the finger presses: over the pad's edge.
+  nlohmann::json scene = nlohmann::json::parse(std::ifstream(kClay));
+  scene["objects"].push_back({{"name", "ball"}, {"shape", "sphere"}, {"radius_m", 0.004}, {"dynamic", true},
+                              {"mass_kg", 0.005}, {"position_m", {0.005, 0.0, kSurface_m + 0.004}}});
+  InProcessTrialOptions options;
+  options.scene_text = scene.dump();
+  options.scene_path = kClay;  // names the scene in messages
+  options.trajectory = press(0.0, 0.008, 1.0);
+  options.coupling = Coupling::local;  // a 5 g ball: light for impulse coupling at 20 Hz
+  const std::filesystem::path dir = test::out_dir("clay-ball-rolls-in");
+  options.out_dir = dir;
+  const nlohmann::json summary = run_in_process_trial(options);
+  const double dent_m = clay(summary)["max_dent_m"].get<double>();
+  REQUIRE(dent_m > 0.004);
+  const auto world = test::read_csv_columns(dir / "world.csv");
+  const double x_m = world.at("ball.x_m").back();
+  const double z_m = world.at("ball.z_m").back();
+  // At the dent's bottom: centred on it, lower by its depth (its crest curves less than the ball, 2·d/a² < 1/r).
+  CHECK(std::abs(x_m) < 5e-4);
+  CHECK(z_m == Approx(kSurface_m - dent_m + 0.004).margin(3e-4));
 }
 
 TEST_CASE("clay stroked fast (0.5 m/s, 5 cm a 10 Hz period) is dented along the whole path, finite, nothing lost") {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Every registered engine against physics it must get right, so a comparison of engines compares their models and
 // not their mistakes: Coulomb sliding, resting contact forces, sleeping, and bitwise repeatable runs.
+#include "world_manager/deform/plastic_surface.h"
 #include "world_manager/engine/engine_registry.h"
 #include "world_test_support.h"
 
@@ -186,6 +187,61 @@ TEST_CASE("on every engine a push wakes the body it pushes and what touches it, 
     CHECK_FALSE(engine->asleep(0));
     CHECK_FALSE(engine->asleep(1));
     CHECK(engine->asleep(2));
+  }
+}
+
+TEST_CASE("on every engine bodies rest in the dent of a plastic slab, roll into it, and stay up beside it") {
+  // A 10 × 10 × 2 cm slab on the floor (top face at z = 2 cm), three 3 mm balls of 10 g on it: one over where a dent
+  // will be (x = −2 cm), one where the slope of another will be (4 mm from its centre at x = +2 cm), one 3 cm away.
+  constexpr double kTop_m = 0.02;
+  constexpr double kRadius_m = 0.003;
+  const auto ball = [=](const std::string& name, double x_m, double y_m) {
+    return json{{"name", name}, {"shape", "sphere"}, {"radius_m", kRadius_m}, {"dynamic", true}, {"mass_kg", 0.01},
+                {"position_m", {x_m, y_m, kTop_m + kRadius_m}}};
+  };
+  json objects = json::array();
+  objects.push_back({{"name", "slab"}, {"shape", "box"}, {"size_m", {0.1, 0.1, 0.02}}, {"dynamic", false},
+                     {"position_m", {0.0, 0.0, 0.01}}});
+  objects.push_back(ball("over", -0.02, 0.0));
+  objects.push_back(ball("slope", 0.024, 0.0));
+  objects.push_back(ball("beside", 0.0, 0.03));
+  const json document{{"objects", objects}};
+  for (const EngineEntry& entry : engine_entries()) {
+    INFO(entry.name);
+    const Scene scene = engine_scene(document, entry.name);
+    prepare_engines();
+    auto engine = make_engine(scene);
+    NoForces none;
+    for (int step = 0; step < 30; ++step) engine->step(10, 0.005, false, none);  // 1.5 s: all three at rest, asleep
+    CHECK(engine->asleep(1));
+    // Dents 3.5 mm deep (a push of 0.2 N·s beyond yield each, straight down at x = ∓2 cm).
+    const PlasticMaterial clay;
+    PlasticSurface surface(clay, Eigen::Vector3d(0.05, 0.05, 0.01), Eigen::Vector3d(0.0, 0.0, 0.01),
+                           Eigen::Quaterniond::Identity());
+    for (const double x_m : {-0.02, 0.02}) {
+      surface.press({0.2, Eigen::Vector3d(x_m, 0.0, kTop_m), Eigen::Vector3d(x_m, 0.0, kTop_m)});
+    }
+    surface.yield_period();
+    const double dent_m = 0.01 - surface.height_m(-0.02, 0.0);
+    REQUIRE(dent_m > 0.003);
+    engine->dent_top(0, surface.dented_top());
+    CHECK_FALSE(engine->asleep(1));  // woken: the surface went from under it
+    for (int step = 0; step < 40; ++step) engine->step(10, 0.005, false, none);  // 2 s
+    ObjectState over, slope, beside;
+    engine->read_state(1, over);
+    engine->read_state(2, slope);
+    engine->read_state(3, beside);
+    // The dent's crest curves less than the ball (2·d/a² = 0.2 per mm against 1/r = 0.33), so the ball sits at its
+    // bottom: lower by the dent's depth, to the heightfield's 1 mm facets (a chord's sag under a 3 mm ball).
+    CHECK(over.pose.position_m.z() == Approx(kTop_m - dent_m + kRadius_m).margin(2e-4));
+    CHECK(std::abs(over.pose.position_m.x() + 0.02) < 1e-3);
+    CHECK(std::abs(over.pose.position_m.y()) < 1e-3);
+    // The ball on the other's slope rolled down and rests at its bottom.
+    CHECK(std::abs(slope.pose.position_m.x() - 0.02) < 1e-3);
+    CHECK(slope.pose.position_m.z() == Approx(kTop_m - dent_m + kRadius_m).margin(2e-4));
+    // Beside the dents the slab is as it was.
+    CHECK(beside.pose.position_m.z() == Approx(kTop_m + kRadius_m).margin(1e-4));
+    CHECK((beside.pose.position_m.head<2>() - Eigen::Vector2d(0.0, 0.03)).norm() < 1e-4);
   }
 }
 

@@ -36,6 +36,8 @@ PlasticSurface::PlasticSurface(const PlasticMaterial& material, const Eigen::Vec
   cell_y_m_ = 2.0 * half_size_m.y() / static_cast<double>(rows_);
   max_depth_m_ = (1.0 - PlasticMaterial::kUnyieldingFraction) * 2.0 * half_size_m.z();
   depth_m_.assign(columns_ * rows_, 0.0);
+  top_m_.assign(columns_ * rows_, half_size_m.z());
+  lowest_m_ = half_size_m.z();
   received_Ns_.assign(columns_ * rows_, 0.0);
 }
 
@@ -112,8 +114,23 @@ void PlasticSurface::deepen(std::size_t cell, double by_m) {
   if (wanted_m > max_depth_m_) clamped_m3_ += (wanted_m - max_depth_m_) * area_m2;
   const double new_m = std::min(wanted_m, max_depth_m_);
   volume_m3_ += (new_m - depth_m) * area_m2;
+  if (new_m > depth_m) changed_ = true;
   depth_m = new_m;
+  top_m_[cell] = half_size_m_.z() - new_m;
+  lowest_m_ = std::min(lowest_m_, top_m_[cell]);
   max_dent_m_ = std::max(max_dent_m_, depth_m);
+}
+
+DentedTop PlasticSurface::dented_top() const {
+  DentedTop top;
+  top.columns = columns_;
+  top.rows = rows_;
+  top.cell_x_m = cell_x_m_;
+  top.cell_y_m = cell_y_m_;
+  top.height_m = top_m_.data();
+  top.floor_m = half_size_m_.z() - max_depth_m_;
+  top.lowest_m = lowest_m_;
+  return top;
 }
 
 void PlasticSurface::press_by_penetration(const Eigen::Vector3d& finger_m) {
@@ -139,6 +156,8 @@ void PlasticSurface::press_by_penetration(const Eigen::Vector3d& finger_m) {
       if (weight > 0.0) deepen(r * columns_ + c, centre_m * weight);
     }
   }
+  if (changed_) ++changes_;
+  changed_ = false;
 }
 
 void PlasticSurface::absorb(const Eigen::Vector3d& impulse_Ns) {
@@ -158,6 +177,8 @@ void PlasticSurface::yield_period() {
     }
   }
   touched_ = false;
+  if (changed_) ++changes_;
+  changed_ = false;
 }
 
 double PlasticSurface::height_m(double x_m, double y_m) const {

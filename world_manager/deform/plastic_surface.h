@@ -12,6 +12,7 @@
 // the World.
 
 #include "common/contract/frames.h"
+#include "world_manager/engine/rigid_body_engine.h"
 #include "world_manager/deform/plastic_material.h"
 #include "world_manager/deform/press_path.h"
 
@@ -68,6 +69,12 @@ class PlasticSurface {
   void patch_about(const Eigen::Vector3d& body_m, std::int32_t object_id, double half_span_m,
                    DentPatch& patch) const;
 
+  // The surface for the engine, bodies resting on it (engine/rigid_body_engine.h DentedTop): the cells' heights,
+  // kept in place for this surface's life.
+  DentedTop dented_top() const;
+  // Counts the steps that changed the surface (a cell went deeper): the engine needs the heights again only then.
+  std::uint64_t changes() const { return changes_; }
+
   const PlasticMaterial& material() const { return material_; }
   double max_dent_m() const { return max_dent_m_; }
   double dent_volume_m3() const { return volume_m3_; }  // Σ depth·area over the cells
@@ -104,6 +111,10 @@ class PlasticSurface {
   double cell_y_m_ = 0.0;
   double max_depth_m_ = 0.0;
   std::vector<double> depth_m_;    // per cell, ≥ 0
+  std::vector<double> top_m_;      // per cell, the height above the centre: half height − depth (dented_top)
+  double lowest_m_ = 0.0;          // the lowest of top_m_
+  std::uint64_t changes_ = 0;
+  bool changed_ = false;           // a cell went deeper since the last yield_period or press_by_penetration
   std::vector<double> received_Ns_;  // per cell, this period
   std::vector<double> weights_;      // scratch for spread()
   // The cells received_Ns_ may be nonzero in, if touched_: [column_lo, column_hi] × [row_lo, row_hi].

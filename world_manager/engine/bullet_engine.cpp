@@ -9,6 +9,7 @@
 #include <BulletCollision/CollisionDispatch/btUnionFind.h>
 #include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
 #include <BulletDynamics/MLCPSolvers/btMLCPSolver.h>
+#include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
@@ -158,6 +159,9 @@ struct BulletEngine::World final : EscapeGuard::Engine {
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver = make_solver(scene->physics.bullet, dantzig);
   std::vector<std::unique_ptr<btCollisionShape>> shapes;  // per object, the floor's last
   std::vector<std::unique_ptr<btRigidBody>> bodies;       // per object (static ones have no mass); the floor last
+  // Dented tops (dent_top): per object, the heightfield beside its box (nullptr: none), and its shape.
+  std::vector<std::unique_ptr<btRigidBody>> tops;
+  std::vector<std::unique_ptr<btCollisionShape>> top_shapes;
   ContactIslandWorld world{&dispatcher, &broadphase, solver.get(), &configuration};
 
   std::vector<Eigen::Matrix3d> inverse_inertia_body;  // per object; zero for static ones
@@ -295,6 +299,7 @@ BulletEngine::BulletEngine(const Scene& scene) : bullet_(std::make_unique<World>
   w.contact_damping_Nspm = damping_Nspm;
   const std::size_t count = scene.objects.size();
   w.inverse_inertia_body.assign(count, Eigen::Matrix3d::Zero());
+  w.tops.resize(count);
   w.parked.assign(count, false);
   w.pending_force_N.assign(count, Eigen::Vector3d::Zero());
   w.pending_torque_Nm.assign(count, Eigen::Vector3d::Zero());
@@ -453,6 +458,63 @@ const std::vector<std::size_t>& BulletEngine::moved() const { return bullet_->mo
 ContactGraph& BulletEngine::contacts() { return bullet_->contact_graph; }
 
 const std::vector<std::size_t>& BulletEngine::escaped() const { return bullet_->escape_guard.escaped(); }
+
+void BulletEngine::dent_top(std::size_t id, const DentedTop& top) {
+  World& w = *bullet_;
+  const SceneObject& object = w.scene->objects[id];
+  if (object.dynamic || object.shape.kind != ShapeKind::box || top.columns < 2 || top.rows < 2) return;
+  const auto& size_m = object.shape.box_size_m;
+  const double half_z_m = 0.5 * size_m[2];
+  const auto& q = object.orientation_wxyz;
+  const Eigen::Quaterniond orientation(q[0], q[1], q[2], q[3]);
+  const Eigen::Vector3d centre_m(object.position_m[0], object.position_m[1], object.position_m[2]);
+  const auto placed = [&](double up_m) {
+    btTransform transform;
+    transform.setRotation(btQuaternion(q[1], q[2], q[3], q[0]));
+    transform.setOrigin(to_bt(Eigen::Vector3d(centre_m + orientation * Eigen::Vector3d(0.0, 0.0, up_m))));
+    return transform;
+  };
+  if (!w.tops[id]) {
+    // Bullet's heightfield with z up reads sample (x, y) at y·width + x, as the grid is laid out, centred on its
+    // origin and on the middle of its bounds; one unit between samples, scaled to the cells.
+    auto field = std::make_unique<btHeightfieldTerrainShape>(static_cast<int>(top.columns), static_cast<int>(top.rows),
+                                                             top.height_m, top.floor_m, half_z_m, 2, false);
+    field->setLocalScaling(btVector3(top.cell_x_m, top.cell_y_m, 1.0));
+    btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, field.get());
+    info.m_startWorldTransform = placed(0.5 * (top.floor_m + half_z_m));
+    auto body = std::make_unique<btRigidBody>(info);
+    const btRigidBody& box = w.body(id);
+    body->setFriction(box.getFriction());
+    body->setRestitution(box.getRestitution());
+    body->setContactStiffnessAndDamping(w.contact_stiffness_Npm, w.contact_damping_Nspm);
+    body->setUserIndex(static_cast<int>(id));
+    // Only touching points push: a ball resting on the heights also lies within Bullet's contact threshold of the
+    // neighbouring triangles' edges, whose normals lean; given to the solver, they rolled a 3 mm ball at rest on flat
+    // heights away at 4 cm/s.
+    body->setContactProcessingThreshold(0.0);
+    w.world.addRigidBody(body.get());
+    w.top_shapes.push_back(std::move(field));
+    w.tops[id] = std::move(body);
+  }
+  // The box below the lowest point of the surface, so only the heights are met above it.
+  const double lowest_m = std::clamp(top.lowest_m, top.floor_m, half_z_m);
+  btRigidBody& box = w.body(id);
+  box.getCollisionShape()->setLocalScaling(btVector3(1.0, 1.0, (lowest_m + half_z_m) / size_m[2]));
+  box.setWorldTransform(placed(0.5 * (lowest_m - half_z_m)));
+  w.world.updateSingleAabb(&box);
+  // A body asleep on the box would hang over a dent made under it.
+  btVector3 slab_min, slab_max, top_min, top_max;
+  box.getAabb(slab_min, slab_max);
+  w.tops[id]->getAabb(top_min, top_max);
+  slab_min.setMin(top_min);
+  slab_max.setMax(top_max);
+  for (const std::size_t other : w.dynamic_ids) {
+    if (!asleep(other)) continue;
+    btVector3 body_min, body_max;
+    w.body(other).getAabb(body_min, body_max);
+    if (TestAabbAgainstAabb2(body_min, body_max, slab_min, slab_max)) wake(other);
+  }
+}
 
 std::vector<RigidBodyEngine::Overlap> BulletEngine::overlaps(double min_depth_m) const {
   World& w = *bullet_;

@@ -50,6 +50,7 @@ class BulletEngine final : public RigidBodyEngine {
   const std::vector<std::size_t>& moved() const override;
   ContactGraph& contacts() override;
   std::vector<Overlap> overlaps(double min_depth_m) const override;
+  void dent_top(std::size_t id, const DentedTop& top) override;
   const std::vector<std::size_t>& escaped() const override;
 
  private:

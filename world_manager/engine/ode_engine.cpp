@@ -89,6 +89,11 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
   std::vector<dMass> masses;              // per object, to rebuild a body that wakes
   std::vector<std::size_t> nearby;        // scratch
   std::vector<dTriMeshDataID> mesh_data;  // one per mesh geom; ODE reads the MeshBody's arrays, it copies nothing
+  // Dented tops (dent_top), per object: the heightfield geom beside the object's box (nullptr: none), the grid it
+  // reads (its address is ODE's user data, so the vector is sized once) and ODE's data for it.
+  std::vector<dGeomID> tops;
+  std::vector<DentedTop> top_grids;
+  std::vector<dHeightfieldDataID> top_data;
 
   dGeomID geom_of(std::size_t id) const { return id < geoms.size() ? geoms[id] : floor; }
 
@@ -204,7 +209,10 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
       dGeomID geom = geoms[id];
       if (floor != nullptr) near_callback(this, geom, floor);
       sleeping->fixed_near(geom_bounds(geom), nearby);
-      for (const std::size_t o : nearby) near_callback(this, geom, geoms[o]);
+      for (const std::size_t o : nearby) {
+        near_callback(this, geom, geoms[o]);
+        if (tops[o] != nullptr) near_callback(this, geom, tops[o]);
+      }
     }
   }
 
@@ -247,6 +255,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
     if (space != nullptr) dSpaceDestroy(space);  // destroys the geoms it holds (cleanup mode on)
     if (world != nullptr) dWorldDestroy(world);  // destroys the bodies
     for (dTriMeshDataID data : mesh_data) dGeomTriMeshDataDestroy(data);  // after the geoms that use it
+    for (dHeightfieldDataID data : top_data) dGeomHeightfieldDataDestroy(data);
   }
 
   // The recorded contacts into the graph, each with the normal force the step found: |f·n| of the force the joint put
@@ -357,6 +366,8 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
   ode.bodies.assign(count, nullptr);
   ode.contact_graph.reset(count);
   ode.geoms.assign(count, nullptr);
+  ode.tops.assign(count, nullptr);
+  ode.top_grids.assign(count, DentedTop{});
   ode.escape_guard = EscapeGuard(count);
   ode.inverse_inertia_body.assign(count, Eigen::Matrix3d::Zero());
   for (const SceneObject& object : scene.objects) ode.materials.push_back(object.material);
@@ -510,6 +521,66 @@ void OdeEngine::set_velocity(std::size_t id, const Eigen::Vector3d& velocity_mps
 void OdeEngine::wake(std::size_t id) {
   if (asleep(id)) ode_->sleeping->wake(id, *ode_);
   dBodyEnable(ode_->bodies[id]);  // also restarts ODE's count of the time the body has rested
+}
+
+namespace {
+
+// ODE's heightfield lies in its own x-z plane with y up, centred on its origin, sample (x, z) at
+// (−width/2 + x·Δ, −depth/2 + z·Δ). Turned so its y is the box's z and its x the box's x, its z is the box's −y: sample
+// (x, z) is the grid's column x, row rows − 1 − z.
+dReal top_height(void* grid, int x, int z) {
+  const auto* top = static_cast<const DentedTop*>(grid);
+  const std::size_t row = top->rows - 1 - static_cast<std::size_t>(z);
+  return top->height_m[row * top->columns + static_cast<std::size_t>(x)];
+}
+
+}  // namespace
+
+void OdeEngine::dent_top(std::size_t id, const DentedTop& top) {
+  Handles& ode = *ode_;
+  const SceneObject& object = ode.scene->objects[id];
+  if (object.dynamic || object.shape.kind != ShapeKind::box || top.columns < 2 || top.rows < 2) return;
+  const auto& size_m = object.shape.box_size_m;
+  const double half_z_m = 0.5 * size_m[2];
+  dGeomID box = ode.geoms[id];
+  const auto& q = object.orientation_wxyz;
+  const Eigen::Quaterniond orientation(q[0], q[1], q[2], q[3]);
+  const Eigen::Vector3d centre_m(object.position_m[0], object.position_m[1], object.position_m[2]);
+  if (ode.tops[id] == nullptr) {
+    ode.top_grids[id] = top;
+    dHeightfieldDataID data = dGeomHeightfieldDataCreate();
+    ode.top_data.push_back(data);
+    // Solid below the surface down to the box's bottom, as the slab is.
+    dGeomHeightfieldDataBuildCallback(data, &ode.top_grids[id], &top_height,
+                                      static_cast<double>(top.columns - 1) * top.cell_x_m,
+                                      static_cast<double>(top.rows - 1) * top.cell_y_m, static_cast<int>(top.columns),
+                                      static_cast<int>(top.rows), 1.0, 0.0, top.floor_m + half_z_m, 0);
+    dGeomHeightfieldDataSetBounds(data, top.floor_m, half_z_m);
+    dGeomID field = dCreateHeightfield(dGeomGetSpace(box), data, 1);
+    dGeomSetData(field, id_to_data(id));
+    // Box from heightfield: x → x, y → z, z → −y.
+    Eigen::Matrix3d turn;
+    turn << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+    const Eigen::Matrix3d rotation = orientation.toRotationMatrix() * turn;
+    dMatrix3 r;
+    for (int row = 0; row < 3; ++row) {
+      for (int column = 0; column < 3; ++column) r[4 * row + column] = rotation(row, column);
+      r[4 * row + 3] = 0.0;
+    }
+    dGeomSetPosition(field, centre_m.x(), centre_m.y(), centre_m.z());
+    dGeomSetRotation(field, r);
+    ode.tops[id] = field;
+  }
+  // The box below the lowest point of the surface, so only the heights are met above it.
+  const double lowest_m = std::clamp(top.lowest_m, top.floor_m, half_z_m);
+  dGeomBoxSetLengths(box, size_m[0], size_m[1], lowest_m + half_z_m);
+  const Eigen::Vector3d box_centre_m = centre_m + orientation * Eigen::Vector3d(0.0, 0.0, 0.5 * (lowest_m - half_z_m));
+  dGeomSetPosition(box, box_centre_m.x(), box_centre_m.y(), box_centre_m.z());
+  // A body asleep on the box would hang over a dent made under it.
+  const Eigen::AlignedBox3d slab = geom_bounds(ode.tops[id]).extend(geom_bounds(box));
+  for (const std::size_t other : ode.dynamic_ids) {
+    if (asleep(other) && geom_bounds(ode.geoms[other]).intersects(slab)) wake(other);
+  }
 }
 
 bool OdeEngine::asleep(std::size_t id) const {

@@ -46,6 +46,7 @@ class OdeEngine final : public RigidBodyEngine {
   ContactGraph& contacts() override;
   const std::vector<std::size_t>& escaped() const override;
   std::vector<Overlap> overlaps(double min_depth_m) const override;
+  void dent_top(std::size_t id, const DentedTop& top) override;
 
  private:
   struct Handles;

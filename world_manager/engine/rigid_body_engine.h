@@ -25,6 +25,20 @@ class SubstepHook {
   virtual void after_substep(int /*substep*/) {}
 };
 
+// A static box's top face (its body +z face) as a grid of heights: a plastic slab (world_manager/deform/
+// plastic_surface.h). Sample (c, r), row-major at r·columns + c, is the surface's height above the box's centre along
+// its z at (c + ½, r + ½) cells from the face's −x, −y corner. The engine reads the heights whenever it collides: their
+// owner keeps them alive and in place.
+struct DentedTop {
+  std::size_t columns = 0;
+  std::size_t rows = 0;
+  double cell_x_m = 0.0;
+  double cell_y_m = 0.0;
+  const double* height_m = nullptr;
+  double floor_m = 0.0;   // no height will be below it (the slab's unyielding floor)
+  double lowest_m = 0.0;  // the lowest height now
+};
+
 class RigidBodyEngine {
  public:
   virtual ~RigidBodyEngine() = default;
@@ -68,6 +82,11 @@ class RigidBodyEngine {
   // Every pair with a dynamic body that overlaps by more than `min_depth_m` now, in order of a, then b: what a scene
   // placed inside another, which the solver would push apart on the first step. Changes nothing.
   virtual std::vector<Overlap> overlaps(double min_depth_m) const = 0;
+
+  // Bodies rest on and roll over static box `id`'s dented top from the next step on: the engine collides them with
+  // `top`'s heights above its lowest point and with the box below it. Called again whenever the heights changed (the
+  // engine keeps the first call's pointer); wakes the bodies that may rest on the box.
+  virtual void dent_top(std::size_t id, const DentedTop& top) = 0;
 
   // Objects taken out of the simulation because the solver threw them beyond kEscapeDistance_m (scene.h) or made their
   // state non-finite (engine/escape_guard.h, which every engine asks); they stay where they were taken out, at rest,
