@@ -67,7 +67,14 @@ viewer_serves() {
            "$url$target") || status=$?
     if [ "$status" -ne 0 ] || [ "$code" != 200 ]; then
       cat "$scratch/viewer.out" >&2
-      echo "install_test: the installed viewer does not serve /$target (curl exit $status, HTTP $code)" >&2
+      local alive="still running"
+      if ! kill -0 "$pid" 2> /dev/null; then
+        local exit_status=0
+        wait "$pid" || exit_status=$?
+        alive="exited with status $exit_status"
+      fi
+      echo "install_test: the installed viewer does not serve /$target (curl exit $status, HTTP $code; the viewer" \
+           "$alive)" >&2
       exit 1
     fi
   done
