@@ -77,7 +77,8 @@ void encode_frame(const WorldSnapshot& snapshot, bool playing, double speed, std
                                              static_cast<double>(snapshot.haptic_stats.skipped_periods),
                                              playing ? 1.0 : 0.0,
                                              speed,
-                                             0.0, 0.0, 0.0, 0.0};
+                                             snapshot.dent.object_id >= 0 ? 1.0 : 0.0,
+                                             0.0, 0.0, 0.0};
   for (double value : header) pack.add(value);
   for (std::uint32_t k = 0; k < snapshot.body_count; ++k) {
     const ViewBodyPose& body = snapshot.bodies[k];
@@ -96,6 +97,14 @@ void encode_frame(const WorldSnapshot& snapshot, bool playing, double speed, std
       pack.add(endpoint.planes[p].point_m);
       pack.add(endpoint.planes[p].normal);
     }
+  }
+  const ViewDent& dent = snapshot.dent;
+  if (dent.object_id >= 0) {
+    const double values[kDentValues] = {static_cast<double>(dent.object_id), static_cast<double>(dent.version),
+                                        static_cast<double>(dent.columns),   static_cast<double>(dent.rows),
+                                        dent.x0_m, dent.y0_m, dent.dx_m, dent.dy_m};
+    for (double value : values) pack.add(value);
+    for (std::uint32_t k = 0; k < dent.columns * dent.rows; ++k) pack.add(static_cast<double>(dent.depth_m[k]));
   }
 }
 

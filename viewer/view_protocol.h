@@ -20,11 +20,15 @@
 //        [6] haptic lateness p99, s (NaN: unknown, e.g. lockstep or replay)
 //        [7] haptic faults            [8] world skipped periods  [9] haptic skipped periods
 //        [10] playing (replay: 1 or 0; live: 1)                  [11] replay speed (live: 1)
-//        [12..15] reserved, 0
+//        [12] dent: 1 when a dent follows the endpoints, else 0     [13..15] reserved, 0
 //      then B bodies, kBodyValues each: position x, y, z (m), orientation w, x, y, z (unit quaternion, body → world)
 //      then E endpoints, each kEndpointValues followed by 6·P plane values:
 //        endpoint id, finger valid (1/0), finger x, y, z (m), proxy x, y, z (m), force on the finger x, y, z (N),
 //        plane count P; then per plane: point x, y, z (m), outward unit normal x, y, z
+//      then, if [12] is 1, the dent of a deformable box's top face (common/contract/world_view.h ViewDent),
+//      kDentValues values and C·R depths: body k, version (changes with the dent), columns C, rows R, x0, y0, dx, dy
+//      (m, the box's body frame: point (c, r) at (x0 + c·dx, y0 + r·dy) on the top face), then the depths below the
+//      face (m), row-major (r·C + c)
 //    World frame right-handed, z up, SI units.
 //
 // 3. Page → viewer (replay only; ignored live), text messages of one JSON object:
@@ -51,6 +55,7 @@ inline constexpr std::size_t kFrameHeaderValues = 16;
 inline constexpr std::size_t kBodyValues = 7;
 inline constexpr std::size_t kEndpointValues = 12;
 inline constexpr std::size_t kPlaneValues = 6;
+inline constexpr std::size_t kDentValues = 8;
 inline constexpr std::size_t kMaxClientMessageBytes = 4096;
 inline constexpr double kMinReplaySpeed = 0.1;
 inline constexpr double kMaxReplaySpeed = 10.0;

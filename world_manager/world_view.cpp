@@ -55,6 +55,14 @@ void take_snapshot(const World& world, std::span<const HapticReport* const> repo
                                       pose.orientation.z()};
   }
 
+  // The first deformable object with a dent.
+  out.dent = ViewDent{};
+  for (std::uint32_t k = 0; k < out.body_count && out.dent.object_id < 0; ++k) {
+    if (const PlasticSurface* surface = world.deformable(k); surface != nullptr) {
+      surface->view_dent(static_cast<std::int32_t>(k), out.dent);
+    }
+  }
+
   out.endpoint_count = 0;
   for (std::size_t slot = 0; slot < reports.size() && slot < world.endpoint_slots(); ++slot) {
     const HapticReport* report = reports[slot];

@@ -45,6 +45,22 @@ const char* snapshot_problem(const WorldSnapshot& snapshot) {
       if (!unit(endpoint.planes[p].normal)) return "plane normal not unit";
     }
   }
+  const ViewDent& dent = snapshot.dent;
+  if (dent.object_id >= 0) {
+    if (static_cast<std::uint32_t>(dent.object_id) >= snapshot.body_count) return "dent of a body not in the snapshot";
+    if (dent.columns < 2 || dent.columns > kMaxViewDentSide || dent.rows < 2 || dent.rows > kMaxViewDentSide) {
+      return "dent grid size out of range";
+    }
+    if (!std::isfinite(dent.x0_m) || !std::isfinite(dent.y0_m) || !(dent.dx_m > 0.0) || !(dent.dy_m > 0.0) ||
+        !std::isfinite(dent.dx_m) || !std::isfinite(dent.dy_m)) {
+      return "dent grid not finite and positive";
+    }
+    for (std::uint32_t k = 0; k < dent.columns * dent.rows; ++k) {
+      if (!(dent.depth_m[k] >= 0.0f) || !std::isfinite(dent.depth_m[k])) return "dent depth not finite and >= 0";
+    }
+  } else if (dent.object_id != -1) {
+    return "dent object id negative";
+  }
   return "";
 }
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The viewer in a real browser (headless Chromium driven by Playwright), against the project's own binaries.
-//   node tests/viewer/viewer_test.mjs --build BUILD_DIR --case live|replay|bodies|kill|bad-input [--picture FILE]
+//   node tests/viewer/viewer_test.mjs --build BUILD_DIR --case live|replay|bodies|kill|bad-input|clay [--picture FILE]
 // --picture (replay only): also saves the page at the tap's hardest push as FILE (the README's picture;
 // scripts/make_figures.sh).
 // Each case starts what it needs under a shared-memory name of its own, prints what it checks and measures, and exits
@@ -352,5 +352,62 @@ async function badInput(procs, browser) {
   await procs.stop(world);
 }
 
-const cases = { live, replay, bodies, kill, "bad-input": badInput };
+// A real-time press into the clay watched live: the page draws the dent the world made, as deep as world.csv says,
+// and the face changes on screen where it was pressed.
+async function clay(procs, browser) {
+  const scene = path.join(source, "scenes", "clay.json");
+  const worldCsv = path.join(outDir, "world.csv");
+  const world = procs.start("world", "world_manager", ["--scene", scene, "--clock", "realtime", "--shm", shm,
+    "--log", worldCsv]);
+  const viewer = await procs.viewer(["--shm", shm]);
+  const page = await openPage(browser, viewer.url);
+  await waitFor("the page's first frames", async () => (await view(page))?.framesReceived > 5);
+  // Looking down on the pressed point from above and to the side, close enough to see a few millimetres of dent.
+  await page.evaluate(() => window.impetusView.lookAt([0, 0, 0.03], 0.03));
+  await sleep(500);
+  const before = await capture(page, "clay");
+  const haptic = procs.start("haptic", "haptic_controller", ["--clock", "realtime", "--shm", shm]);
+  const device = procs.start("device", "spidar_sim", ["--clock", "realtime", "--shm", shm, "--trajectory",
+    "press:x=0,y=0,surface_z=0.03,depth=0.008,hold=1.0,speed=0.1"]);
+  // Until the press is over: the device ends its trajectory and exits.
+  await waitFor("the press to end", () => device.exitCode !== null, 20000, 50);
+  await procs.stop(haptic);
+  // The world's last step may still apply the last report: compare with world.csv's newest row each time.
+  let dentM = 0;
+  let seen = null;
+  try {
+    await waitFor("the page's dent", async () => {
+      const { columns, row } = lastRow(worldCsv);
+      dentM = row[columns.indexOf("clay.dent_m")];
+      seen = await view(page);
+      const shown = seen?.dent;
+      return shown && Math.abs(shown.deepest_m - dentM) <= 1e-6 * dentM;
+    }, 5000, 50);
+  } catch (error) {
+    throw new Failure(`${error.message}: world.csv has ${dentM} m, the page ${JSON.stringify(seen?.dent)} ` +
+                      `(${seen?.framesReceived} frames, ${seen?.rejectedFrames} rejected)`);
+  }
+  await sleep(300);
+  const after = await capture(page, "clay");
+  await page.screenshot({ path: path.join(outDir, "clay.png") });
+  const state = await view(page);
+  state.pressedAt = await page.evaluate(() => window.impetusView.projectPoint([0, 0, 0.027]));
+  await procs.stop(viewer);
+  await procs.stop(world);
+
+  check(dentM > 0.002, `the press dented the clay (${(1e3 * dentM).toFixed(2)} mm in world.csv)`);
+  check(state.dent.body === 0 && Math.abs(state.dent.deepest_m - dentM) <= 1e-6 * dentM,
+    `the page's dent is the world's: ${(1e3 * state.dent.deepest_m).toFixed(4)} mm deep on ` +
+    `${state.dent.columns} × ${state.dent.rows} points`);
+  // Where the press went in, the dent's walls face the light at other angles than the face: their pixels changed.
+  // Counted beside the finger's marker (drawn only after), left and right of it: the dent is 12 mm across, 50 px here.
+  const { x, y } = state.pressedAt;
+  const changed = changedPixels(before.image, after.image, [x - 40, y - 20, x - 8, y + 20]) +
+                  changedPixels(before.image, after.image, [x + 8, y - 20, x + 40, y + 20]);
+  // Undented, none of them would change (the marker is left out); dented, about 150 do.
+  check(changed > 50, `the face changed on screen where it was pressed, beside the finger (${changed} of 2560 pixels)`);
+  check(state.rejectedFrames === 0, "no frame rejected by the page");
+}
+
+const cases = { live, replay, bodies, kill, "bad-input": badInput, clay };
 await runCase("viewer_test", cases, which, build, outDir, shm);

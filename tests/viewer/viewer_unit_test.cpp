@@ -135,6 +135,99 @@ TEST_CASE("over DDS a live feed shows a world publishing in its partition, every
   CHECK(feed.rejected() == 0);
 }
 
+TEST_CASE("a pressed clay slab's snapshot carries its dent, and both transports pass it whole") {
+  prepare_engines();
+  const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/clay.json");
+  World world(scene, WorldOptions{});
+  HapticReport report{};
+  report.finger_valid = 1;
+  report.finger_m = {0.01, 0.0, 0.031};
+  report.proxy_m = report.finger_m;
+  world.step(&report);
+  auto snapshot = std::make_unique<WorldSnapshot>();
+  take_snapshot(world, &report, LoopStats{}, nullptr, *snapshot);
+  CHECK(snapshot->dent.object_id == -1);  // nothing dented yet
+  // A push beyond yield straight down at (1 cm, 0), as a report brings it: 0.05 N·s, a dent of about 0.9 mm.
+  report.world_session = world.frame().world_session;
+  report.haptic_session = 7;
+  report.tick = 50;
+  report.haptic_time_s = 0.05;
+  report.entry_count = 1;
+  ObjectImpulse& entry = report.entries[0];
+  entry.object_id = 0;
+  entry.impulse_Ns = {0.0, 0.0, -0.06};
+  entry.press_Ns = 0.05;
+  entry.press_point_Nsm = {0.05 * 0.01, 0.0, 0.05 * 0.03};
+  entry.press_time_Nss = 0.05 * 0.05;
+  entry.press_time2_Nsss = 0.05 * 0.05 * 0.05;
+  entry.press_point_time_Nssm = {0.05 * 0.01 * 0.05, 0.0, 0.05 * 0.03 * 0.05};
+  world.step(&report);
+  const PlasticSurface* clay = world.deformable(0);
+  REQUIRE(clay != nullptr);
+  REQUIRE(clay->max_dent_m() > 1e-4);
+  take_snapshot(world, &report, LoopStats{}, nullptr, *snapshot);
+  const ViewDent& dent = snapshot->dent;
+  REQUIRE(dent.object_id == 0);
+  CHECK(std::string(snapshot_problem(*snapshot)).empty());
+  // Point for point on the cells (1 mm) over the pad (6 mm radius) and a cell of rim: 13 to 15 a side.
+  CHECK(dent.dx_m == Approx(0.001));
+  CHECK(dent.columns >= 13);
+  CHECK(dent.columns <= 15);
+  float deepest_m = 0.0f;
+  for (std::uint32_t k = 0; k < dent.columns * dent.rows; ++k) deepest_m = std::max(deepest_m, dent.depth_m[k]);
+  CHECK(deepest_m == Approx(clay->max_dent_m()).epsilon(1e-6));  // the deepest cell, as a float
+  // The rim is undented.
+  CHECK(dent.depth_m[0] == 0.0f);
+
+  // The page's frame: the flag, then the dent after the endpoints.
+  std::string frame;
+  view::encode_frame(*snapshot, true, 1.0, frame);
+  const std::vector<double> v = values_of(frame);
+  CHECK(v[12] == 1.0);
+  REQUIRE(v.size() > view::kDentValues + dent.columns * dent.rows);
+  const std::size_t at = v.size() - view::kDentValues - dent.columns * dent.rows;
+  CHECK(v[at] == 0.0);                  // body 0
+  CHECK(v[at + 1] == static_cast<double>(dent.version));
+  CHECK(v[at + 2] == dent.columns);
+  CHECK(v[at + 6] == dent.dx_m);
+
+  // Shared memory passes it as written.
+  const std::string shm = "impetus_test_view_dent_" + std::to_string(getpid());
+  ShmWorldViewPublisher shm_publisher(shm);
+  shm_publisher.publish_snapshot(*snapshot);
+  ShmWorldViewReader shm_reader(shm);
+  auto read = std::make_unique<WorldSnapshot>();
+  REQUIRE(shm_reader.read_snapshot(*read));
+  std::string shm_frame;
+  view::encode_frame(*read, true, 1.0, shm_frame);
+  CHECK(shm_frame == frame);
+
+  // DDS too (best effort: published until one arrives).
+  DdsLinkOptions dds;
+  dds.partition = "impetus_test_view_dent_" + std::to_string(getpid());
+  DdsWorldViewPublisher dds_publisher(dds);
+  DdsWorldViewReader dds_reader(dds);
+  bool got = false;
+  for (int attempt = 0; attempt < 400 && !got; ++attempt) {
+    dds_publisher.publish_snapshot(*snapshot);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    got = dds_reader.read_snapshot(*read);
+  }
+  REQUIRE(got);
+  std::string dds_frame;
+  view::encode_frame(*read, true, 1.0, dds_frame);
+  CHECK(dds_frame == frame);
+
+  // A dent that does not fit its grid or has a negative depth is refused by name.
+  snapshot->dent.columns = kMaxViewDentSide + 1;
+  CHECK_THAT(snapshot_problem(*snapshot), Catch::Contains("dent grid size"));
+  snapshot->dent.columns = dent.rows;
+  snapshot->dent.depth_m[1] = -1e-3f;
+  CHECK_THAT(snapshot_problem(*snapshot), Catch::Contains("dent depth"));
+  snapshot->dent.object_id = 5;
+  CHECK_THAT(snapshot_problem(*snapshot), Catch::Contains("dent of a body"));
+}
+
 TEST_CASE("a snapshot with a bad count, a non-finite pose or a non-unit quaternion is named, not used") {
   auto snapshot = std::make_unique<WorldSnapshot>();
   snapshot->world_period_s = 0.05;

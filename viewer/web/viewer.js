@@ -29,6 +29,7 @@ const HEADER_VALUES = 16;
 const BODY_VALUES = 7;
 const ENDPOINT_VALUES = 12;
 const PLANE_VALUES = 6;
+const DENT_VALUES = 8;
 
 // Header offsets.
 const H_KIND = 0;
@@ -43,6 +44,7 @@ const H_WORLD_SKIPPED = 8;
 const H_HAPTIC_SKIPPED = 9;
 const H_PLAYING = 10;
 const H_SPEED = 11;
+const H_DENT = 12;
 
 // Endpoint offsets, from the endpoint's first value.
 const E_ID = 0;
@@ -87,6 +89,7 @@ const view = {
   framesReceived: 0,         // binary messages accepted as frames
   rejectedFrames: 0,         // binary messages ignored as malformed (or arriving before any scene)
   rejectedMessages: 0,       // text messages ignored (not JSON, not a scene, or a malformed scene)
+  dent: null,                // the dent drawn: {body, version, columns, rows, deepest_m}, or null
   fps: 0,
   renderedFrames: 0,
   get latest() { return latest ? describeFrame(latest) : null; },
@@ -94,6 +97,7 @@ const view = {
   get shown() { return { bodies: describePoses(shownPoses, shownCount) }; },
   send(message) { return sendControl(message); },
   project(name) { return projectBody(name); },   // where body `name` was drawn: {x, y} page pixels, or null
+  projectPoint(point) { return projectPoint(point); },  // where world point [x, y, z] (m) is drawn: {x, y} page pixels
   projectPoint(point) { return projectPoint(point); },   // where world point [x, y, z] is drawn: {x, y} page pixels
   // Points the camera at a sphere (centre [x, y, z] m, radius m) and stops it following the bodies, as a user's
   // own camera move does.
@@ -269,8 +273,63 @@ function solidGeometry(shape, detail) {
       return new THREE.CylinderGeometry(shape.radius, shape.radius, shape.length, radial).rotateX(Math.PI / 2);
     case 'capsule':
       return new THREE.CapsuleGeometry(shape.radius, shape.length, [1, 3, 6][detail], radial).rotateX(Math.PI / 2);
-    default: return new THREE.BoxGeometry(shape.size[0], shape.size[1], shape.size[2]);
+    default: return shape.dent ? dentedBoxGeometry(shape) : new THREE.BoxGeometry(...shape.size);
   }
+}
+
+// A box whose top face is dented (shape.dent, from a frame: depths below the face on a grid of the body frame,
+// bilinear between its points, none beyond them): the box's bottom and sides, and a top face through every grid line.
+function dentedBoxGeometry(shape) {
+  const [hx, hy, hz] = shape.size.map((v) => v / 2);
+  const dent = shape.dent;
+  const lines = (first, step, count, half) => {
+    const out = [-half];
+    for (let k = 0; k < count; k++) {
+      const at = first + k * step;
+      if (at > -half && at < half) out.push(at);
+    }
+    out.push(half);
+    return out;
+  };
+  const xs = lines(dent.x0, dent.dx, dent.columns, hx);
+  const ys = lines(dent.y0, dent.dy, dent.rows, hy);
+  const depthAt = (x, y) => {
+    const u = (x - dent.x0) / dent.dx;
+    const v = (y - dent.y0) / dent.dy;
+    if (!(u >= 0 && v >= 0 && u <= dent.columns - 1 && v <= dent.rows - 1)) return 0;
+    const c = Math.min(Math.floor(u), dent.columns - 2);
+    const r = Math.min(Math.floor(v), dent.rows - 2);
+    const tu = u - c;
+    const tv = v - r;
+    const at = (i, j) => dent.depths[j * dent.columns + i];
+    return (1 - tv) * ((1 - tu) * at(c, r) + tu * at(c + 1, r)) + tv * ((1 - tu) * at(c, r + 1) + tu * at(c + 1, r + 1));
+  };
+  const top = new THREE.BufferGeometry();
+  const position = new Float32Array(xs.length * ys.length * 3);
+  ys.forEach((y, j) => xs.forEach((x, i) => position.set([x, y, hz - depthAt(x, y)], (j * xs.length + i) * 3)));
+  const index = [];
+  for (let j = 0; j + 1 < ys.length; j++) {
+    for (let i = 0; i + 1 < xs.length; i++) {
+      const a = j * xs.length + i;  // counter-clockwise seen from above
+      index.push(a, a + 1, a + 1 + xs.length, a, a + 1 + xs.length, a + xs.length);
+    }
+  }
+  top.setAttribute('position', new THREE.BufferAttribute(position, 3));
+  top.setIndex(index);
+  top.computeVertexNormals();
+  // BoxGeometry's faces in order +x, −x, +y, −y, +z, −z, six indices each: all but +z.
+  const box = new THREE.BoxGeometry(2 * hx, 2 * hy, 2 * hz);
+  const boxIndex = Array.from(box.index.array).filter((_, n) => n < 24 || n >= 30);
+  const boxCount = box.attributes.position.count;
+  const out = new THREE.BufferGeometry();
+  const merged = (a, b) => { const m = new Float32Array(a.length + b.length); m.set(a); m.set(b, a.length); return m; };
+  out.setAttribute('position', new THREE.BufferAttribute(merged(box.attributes.position.array, position), 3));
+  out.setAttribute('normal', new THREE.BufferAttribute(merged(box.attributes.normal.array,
+                                                               top.attributes.normal.array), 3));
+  out.setIndex([...boxIndex, ...index.map((n) => n + boxCount)]);
+  box.dispose();
+  top.dispose();
+  return out;
 }
 
 // The tessellation detail for a scene of `count` bodies.
@@ -437,12 +496,22 @@ function mergeBodies(bodies, shapes, detail) {
   return { mesh, lines };
 }
 
+// What the bodies' mesh was built from, so a dent can rebuild it (showDent).
+let sceneShapes = [];
+let sceneDetail = 2;
+let dentBuiltAt = -Infinity;
+const DENT_REDRAW_MS = 200;  // clay being pressed changes every world step: its face is rebuilt 5 times a second
+
 function buildScene(message) {
   disposeTree(sceneRoot);
   if (poseTexture) poseTexture.dispose();
   const bodies = message.bodies;
   const count = bodies.length;
   const shapes = bodies.map(shapeOf);
+  sceneShapes = shapes;
+  sceneDetail = detailFor(count);
+  view.dent = null;
+  dentBuiltAt = -Infinity;
   bodyRadii = Float64Array.from(shapes, (shape) => shape.boundingRadius);
   shownPoses = new Float64Array(count * BODY_VALUES);
   shownCount = 0;
@@ -458,7 +527,7 @@ function buildScene(message) {
   bodiesPlaced = false;
   drawnFrame = null;
   if (count > 0) {
-    const merged = mergeBodies(bodies, shapes, detailFor(count));
+    const merged = mergeBodies(bodies, shapes, sceneDetail);
     bodiesMesh = new THREE.Mesh(merged.mesh, bodyMaterial);
     bodiesOutline = new THREE.LineSegments(merged.lines, edgeMaterial);
     for (const object of [bodiesMesh, bodiesOutline]) {
@@ -595,8 +664,17 @@ function parseFrame(buffer) {
     endpoints[e] = offset;
     offset += ENDPOINT_VALUES + planes * PLANE_VALUES;
   }
+  let dent = null;
+  if (d[H_DENT] === 1) {
+    if (offset + DENT_VALUES > d.length) return null;
+    const [body, version, columns, rows] = d.subarray(offset, offset + 4);
+    if (!Number.isInteger(body) || body < 0 || body >= scene.bodies.length) return null;
+    if (!Number.isInteger(columns) || !Number.isInteger(rows) || columns < 2 || rows < 2) return null;
+    dent = { offset, body, version, columns, rows };
+    offset += DENT_VALUES + columns * rows;
+  }
   if (offset !== d.length) return null;
-  return { data: d, recv: performance.now(), endpoints };
+  return { data: d, recv: performance.now(), endpoints, dent };
 }
 
 // Until the user moves the camera, it follows the bodies: when a dynamic body leaves the view (a tapped cube sliding
@@ -641,6 +719,32 @@ function onFrame(frame) {
   recordCharts(frame);
   hudDirty = true;
   syncReplayBar(frame);
+  showDent(frame);
+}
+
+// A frame's dent, drawn into its box's top face: the bodies' mesh rebuilt with that box's face through the dent's
+// points, when the dent changed (at most every DENT_REDRAW_MS; a later frame brings the newest).
+function showDent(frame) {
+  const dent = frame.dent;
+  if (!dent || !bodiesMesh || sceneShapes[dent.body].kind !== 'box') return;
+  if (view.dent && view.dent.body === dent.body && view.dent.version === dent.version) return;
+  const now = performance.now();
+  if (now - dentBuiltAt < DENT_REDRAW_MS) return;
+  dentBuiltAt = now;
+  const d = frame.data;
+  const o = dent.offset;
+  const depths = d.slice(o + DENT_VALUES, o + DENT_VALUES + dent.columns * dent.rows);
+  const shapes = sceneShapes.slice();
+  shapes[dent.body] = { ...sceneShapes[dent.body], key: `dent:${dent.body}:${dent.version}`,
+                        dent: { x0: d[o + 4], y0: d[o + 5], dx: d[o + 6], dy: d[o + 7], columns: dent.columns,
+                                rows: dent.rows, depths } };
+  const merged = mergeBodies(scene.bodies, shapes, sceneDetail);
+  bodiesMesh.geometry.dispose();
+  bodiesMesh.geometry = merged.mesh;
+  bodiesOutline.geometry.dispose();
+  bodiesOutline.geometry = merged.lines;
+  view.dent = { body: dent.body, version: dent.version, columns: dent.columns, rows: dent.rows,
+                deepest_m: depths.reduce((a, b) => Math.max(a, b), 0) };
 }
 
 function worldPeriod(frame) {

@@ -114,11 +114,60 @@ void PlasticSurface::deepen(std::size_t cell, double by_m) {
   if (wanted_m > max_depth_m_) clamped_m3_ += (wanted_m - max_depth_m_) * area_m2;
   const double new_m = std::min(wanted_m, max_depth_m_);
   volume_m3_ += (new_m - depth_m) * area_m2;
-  if (new_m > depth_m) changed_ = true;
+  if (new_m > depth_m) {
+    changed_ = true;
+    const std::size_t column = cell % columns_;
+    const std::size_t row = cell / columns_;
+    dented_column_lo_ = dented_ ? std::min(dented_column_lo_, column) : column;
+    dented_column_hi_ = dented_ ? std::max(dented_column_hi_, column) : column;
+    dented_row_lo_ = dented_ ? std::min(dented_row_lo_, row) : row;
+    dented_row_hi_ = dented_ ? std::max(dented_row_hi_, row) : row;
+    dented_ = true;
+  }
   depth_m = new_m;
   top_m_[cell] = half_size_m_.z() - new_m;
   lowest_m_ = std::min(lowest_m_, top_m_[cell]);
   max_dent_m_ = std::max(max_dent_m_, depth_m);
+}
+
+void PlasticSurface::view_dent(std::int32_t object_id, ViewDent& out) const {
+  out.object_id = -1;
+  if (!dented_) return;
+  // A cell of undented face on each side, so the drawn dent meets the face at its rim; at least two points a side.
+  const std::size_t column_lo = dented_column_lo_ > 0 ? dented_column_lo_ - 1 : 0;
+  const std::size_t column_hi = std::min(dented_column_hi_ + 1, columns_ - 1);
+  const std::size_t row_lo = dented_row_lo_ > 0 ? dented_row_lo_ - 1 : 0;
+  const std::size_t row_hi = std::min(dented_row_hi_ + 1, rows_ - 1);
+  const std::size_t span_columns = column_hi - column_lo + 1;
+  const std::size_t span_rows = row_hi - row_lo + 1;
+  if (span_columns < 2 || span_rows < 2) return;  // a slab one cell wide: nothing to draw between points
+  // Cells per point, each way: 1 while the span fits.
+  const std::size_t block_x = (span_columns + kMaxViewDentSide - 1) / kMaxViewDentSide;
+  const std::size_t block_y = (span_rows + kMaxViewDentSide - 1) / kMaxViewDentSide;
+  const std::size_t columns = std::max<std::size_t>(2, (span_columns + block_x - 1) / block_x);
+  const std::size_t rows = std::max<std::size_t>(2, (span_rows + block_y - 1) / block_y);
+  out.object_id = object_id;
+  out.columns = static_cast<std::uint32_t>(columns);
+  out.rows = static_cast<std::uint32_t>(rows);
+  out.version = changes_;
+  out.dx_m = static_cast<double>(block_x) * cell_x_m_;
+  out.dy_m = static_cast<double>(block_y) * cell_y_m_;
+  // Each point at its block's middle.
+  out.x0_m = -half_size_m_.x() + (static_cast<double>(column_lo) + 0.5 * static_cast<double>(block_x)) * cell_x_m_;
+  out.y0_m = -half_size_m_.y() + (static_cast<double>(row_lo) + 0.5 * static_cast<double>(block_y)) * cell_y_m_;
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t c = 0; c < columns; ++c) {
+      double deepest_m = 0.0;
+      for (std::size_t br = 0; br < block_y; ++br) {
+        const std::size_t row = std::min(row_lo + r * block_y + br, row_hi);
+        for (std::size_t bc = 0; bc < block_x; ++bc) {
+          const std::size_t column = std::min(column_lo + c * block_x + bc, column_hi);
+          deepest_m = std::max(deepest_m, depth_m_[row * columns_ + column]);
+        }
+      }
+      out.depth_m[r * columns + c] = static_cast<float>(deepest_m);
+    }
+  }
 }
 
 DentedTop PlasticSurface::dented_top() const {

@@ -12,6 +12,7 @@
 // the World.
 
 #include "common/contract/frames.h"
+#include "common/contract/world_view.h"
 #include "world_manager/engine/rigid_body_engine.h"
 #include "world_manager/deform/plastic_material.h"
 #include "world_manager/deform/press_path.h"
@@ -72,6 +73,10 @@ class PlasticSurface {
   // The surface for the engine, bodies resting on it (engine/rigid_body_engine.h DentedTop): the cells' heights,
   // kept in place for this surface's life.
   DentedTop dented_top() const;
+  // The dent to draw (common/contract/world_view.h ViewDent) for object `object_id`: the dented cells' rectangle,
+  // a cell a point while it fits in kMaxViewDentSide, the deepest cell of each block beyond (a groove narrower than a
+  // block still shows). Leaves `out` without an object (object_id −1) while nothing is dented.
+  void view_dent(std::int32_t object_id, ViewDent& out) const;
   // Counts the steps that changed the surface (a cell went deeper): the engine needs the heights again only then.
   std::uint64_t changes() const { return changes_; }
 
@@ -113,6 +118,9 @@ class PlasticSurface {
   std::vector<double> depth_m_;    // per cell, ≥ 0
   std::vector<double> top_m_;      // per cell, the height above the centre: half height − depth (dented_top)
   double lowest_m_ = 0.0;          // the lowest of top_m_
+  // The dented cells lie within [dented_column_lo_, dented_column_hi_] × [dented_row_lo_, dented_row_hi_] (if any).
+  bool dented_ = false;
+  std::size_t dented_column_lo_ = 0, dented_column_hi_ = 0, dented_row_lo_ = 0, dented_row_hi_ = 0;
   std::uint64_t changes_ = 0;
   bool changed_ = false;           // a cell went deeper since the last yield_period or press_by_penetration
   std::vector<double> received_Ns_;  // per cell, this period

@@ -32,6 +32,7 @@ struct DdsWorldViewPublisher::State {
     allocate_sequence(scene.bodies, kMaxViewBodies);
     allocate_sequence(snapshot.endpoints, kMaxViewEndpoints);
     allocate_sequence(snapshot.bodies, kMaxViewBodies);
+    allocate_sequence(snapshot.dent_depth_m, kMaxViewDentSide * kMaxViewDentSide);
   }
   ~State() {
     dds_sample_free(&scene, &impetus_dds_ViewScene_desc, DDS_FREE_CONTENTS);
@@ -106,6 +107,19 @@ void DdsWorldViewPublisher::publish_snapshot(const WorldSnapshot& snapshot) {
               out.bodies._buffer[k].orientation_wxyz);
   }
   out.bodies._length = bodies;
+  const ViewDent& dent = snapshot.dent;
+  out.dent_object = dent.object_id;
+  out.dent_columns = dent.columns;
+  out.dent_rows = dent.rows;
+  out.dent_version = dent.version;
+  out.dent_x0_m = dent.x0_m;
+  out.dent_y0_m = dent.y0_m;
+  out.dent_dx_m = dent.dx_m;
+  out.dent_dy_m = dent.dy_m;
+  const std::uint32_t samples =
+      dent.object_id >= 0 ? std::min(dent.columns * dent.rows, kMaxViewDentSide * kMaxViewDentSide) : 0;
+  std::copy(dent.depth_m.begin(), dent.depth_m.begin() + samples, out.dent_depth_m._buffer);
+  out.dent_depth_m._length = samples;
   dds_write(state_->snapshot_writer, &out);
 }
 
@@ -197,7 +211,8 @@ bool DdsWorldViewReader::read_snapshot(WorldSnapshot& out) {
   State& state = *state_;
   if (!take_newest(state.snapshot_reader, state.snapshot, state.have_snapshot_sample)) return false;
   const impetus_dds_WorldSnapshot& in = state.snapshot;
-  if (in.bodies._length > kMaxViewBodies || in.endpoints._length > kMaxViewEndpoints) {
+  if (in.bodies._length > kMaxViewBodies || in.endpoints._length > kMaxViewEndpoints ||
+      in.dent_depth_m._length > kMaxViewDentSide * kMaxViewDentSide) {
     ++state.rejected;
     return false;
   }
@@ -228,6 +243,23 @@ bool DdsWorldViewReader::read_snapshot(WorldSnapshot& out) {
     out.bodies[k].position_m = from_dds(in.bodies._buffer[k].position_m);
     std::copy(in.bodies._buffer[k].orientation_wxyz, in.bodies._buffer[k].orientation_wxyz + 4,
               out.bodies[k].orientation_wxyz.begin());
+  }
+  out.dent = ViewDent{};
+  out.dent.object_id = in.dent_object;  // snapshot_problem refuses a bad one
+  if (in.dent_object >= 0) {
+    // The depths must fill the grid the header names (snapshot_problem checks the rest).
+    if (static_cast<std::uint64_t>(in.dent_columns) * in.dent_rows != in.dent_depth_m._length) {
+      ++state.rejected;
+      return false;
+    }
+    out.dent.columns = in.dent_columns;
+    out.dent.rows = in.dent_rows;
+    out.dent.version = in.dent_version;
+    out.dent.x0_m = in.dent_x0_m;
+    out.dent.y0_m = in.dent_y0_m;
+    out.dent.dx_m = in.dent_dx_m;
+    out.dent.dy_m = in.dent_dy_m;
+    std::copy(in.dent_depth_m._buffer, in.dent_depth_m._buffer + in.dent_depth_m._length, out.dent.depth_m.begin());
   }
   if (*snapshot_problem(out) != '\0') {
     ++state.rejected;
