@@ -147,7 +147,7 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     const Eigen::Vector3d impulse_Ns = normal_parts[static_cast<std::size_t>(j)] + load_share(contact, j) * remainder_Ns;
     const ContactPlane& plane = planes.planes[contact.active[j].plane];
     const Eigen::Vector3d angular_Nms = plane.angular_impulse_Nms(contact.proxy_m, impulse_Ns);
-    // Where and when the surface was pressed (frames.h ObjectImpulse::press_*): the push into it at the proxy beyond
+    // Where the surface was pressed (frames.h ObjectImpulse::press_*): the push into it at the proxy beyond
     // what the surface holds without yielding (a deformable plane's yield force over the tick; the law's threshold
     // taken here, at the haptic rate, so the dent does not depend on how the world's period cut the push).
     const double press_Ns =
@@ -171,12 +171,16 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     add_to(entry->angular_impulse_moment_Nmss, angular_Nms * report_.haptic_time_s);
     entry->hand_input_J += std::max(0.0, impulse_Ns.dot(finger_velocity_mps));
     if (press_Ns > 0.0) {
-      const double t_s = report_.haptic_time_s;
+      const Eigen::Vector3d& x_m = contact.proxy_m;
       entry->press_Ns += press_Ns;
-      add_to(entry->press_point_Nsm, press_Ns * contact.proxy_m);
-      entry->press_time_Nss += press_Ns * t_s;
-      entry->press_time2_Nsss += press_Ns * t_s * t_s;
-      add_to(entry->press_point_time_Nssm, press_Ns * t_s * contact.proxy_m);
+      add_to(entry->press_point_Nsm, press_Ns * x_m);
+      std::array<double, 6>& point2 = entry->press_point2_Nsm2;  // xx, xy, xz, yy, yz, zz
+      point2[0] += press_Ns * x_m.x() * x_m.x();
+      point2[1] += press_Ns * x_m.x() * x_m.y();
+      point2[2] += press_Ns * x_m.x() * x_m.z();
+      point2[3] += press_Ns * x_m.y() * x_m.y();
+      point2[4] += press_Ns * x_m.y() * x_m.z();
+      point2[5] += press_Ns * x_m.z() * x_m.z();
     }
     entry->last_tick = tick;
   }

@@ -6,22 +6,22 @@
 namespace impetus {
 
 PressMoments PressMoments::of(const ObjectImpulse& entry) {
-  return {entry.press_Ns, to_eigen(entry.press_point_Nsm), entry.press_time_Nss, entry.press_time2_Nsss,
-          to_eigen(entry.press_point_time_Nssm)};
+  const std::array<double, 6>& m = entry.press_point2_Nsm2;  // xx, xy, xz, yy, yz, zz
+  Eigen::Matrix3d point2_Nsm2;
+  point2_Nsm2 << m[0], m[1], m[2], m[1], m[3], m[4], m[2], m[4], m[5];
+  return {entry.press_Ns, to_eigen(entry.press_point_Nsm), point2_Nsm2};
 }
 
 PressMoments PressMoments::operator-(const PressMoments& other) const {
-  return {push_Ns - other.push_Ns, point_Nsm - other.point_Nsm, time_Nss - other.time_Nss,
-          time2_Nsss - other.time2_Nsss, point_time_Nssm - other.point_time_Nssm};
+  return {push_Ns - other.push_Ns, point_Nsm - other.point_Nsm, point2_Nsm2 - other.point2_Nsm2};
 }
 
 PressMoments PressMoments::scaled(double factor) const {
-  return {factor * push_Ns, factor * point_Nsm, factor * time_Nss, factor * time2_Nsss, factor * point_time_Nssm};
+  return {factor * push_Ns, factor * point_Nsm, factor * point2_Nsm2};
 }
 
 bool PressMoments::all_finite() const {
-  return std::isfinite(push_Ns) && point_Nsm.allFinite() && std::isfinite(time_Nss) && std::isfinite(time2_Nsss) &&
-         point_time_Nssm.allFinite();
+  return std::isfinite(push_Ns) && point_Nsm.allFinite() && point2_Nsm2.allFinite();
 }
 
 ImpulseLedger::ImpulseLedger(std::size_t id_count) : id_count_(id_count) {}

@@ -24,9 +24,7 @@ namespace impetus {
 struct PressMoments {
   double push_Ns = 0.0;                                        // Σ p_k
   Eigen::Vector3d point_Nsm = Eigen::Vector3d::Zero();         // Σ p_k·x_k, world frame
-  double time_Nss = 0.0;                                       // Σ p_k·t_k
-  double time2_Nsss = 0.0;                                     // Σ p_k·t_k²
-  Eigen::Vector3d point_time_Nssm = Eigen::Vector3d::Zero();   // Σ p_k·x_k·t_k
+  Eigen::Matrix3d point2_Nsm2 = Eigen::Matrix3d::Zero();       // Σ p_k·x_k·x_kᵀ, symmetric
 
   static PressMoments of(const ObjectImpulse& entry);
   PressMoments operator-(const PressMoments& other) const;
@@ -38,7 +36,7 @@ struct ImpulseDelta {
   Eigen::Vector3d impulse_Ns = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_impulse_Nms = Eigen::Vector3d::Zero();  // about the centre of mass, world frame
   double hand_input_J = 0.0;  // the energy the hand put in behind it (ObjectImpulse::hand_input_J)
-  PressMoments press;         // where and when the surface was pressed (ObjectImpulse::press_*)
+  PressMoments press;         // where the surface was pressed (ObjectImpulse::press_*)
 };
 
 // Whose counters: one endpoint of one haptic session.

@@ -166,16 +166,15 @@ struct ObjectImpulse {
   // rule), where it pushed. The world holds what its couplings give the object to it
   // (world_manager/couplings/passivity_layer.h).
   double hand_input_J = 0.0;
-  // Where and when the object's surface was pressed (the push into it, p_k = max(0, −J_k·n_k), at the proxy x_k, at
-  // session time t_k): Σ p_k (N·s), Σ p_k·x_k (N·s·m, world frame), Σ p_k·t_k (N·s²), Σ p_k·t_k² (N·s³) and
-  // Σ p_k·x_k·t_k (N·s²·m). The differences over a world period give the push, where it was centred, and how the
-  // contact moved while pressing (a straight stroke is recovered exactly), so a deformable object dents along the
-  // finger's path (world_manager/deform/press_path.h). Zero for any object but a deformable one (kPlaneDeformable).
+  // Where the object's surface was pressed (the push into it beyond yield, p_k, at the proxy x_k): Σ p_k (N·s),
+  // Σ p_k·x_k (N·s·m, world frame) and Σ p_k·x_k·x_kᵀ (N·s·m², the symmetric matrix's xx, xy, xz, yy, yz, zz). The
+  // differences over a world period give the push, where it was centred, and how it spread along the surface (a
+  // steady straight stroke is recovered exactly), so a deformable object dents along the finger's path
+  // (world_manager/deform/press_path.h). Moments in space, not in time: they stay as precise after hours as at the
+  // start. Zero for any object but a deformable one (kPlaneDeformable).
   double press_Ns = 0.0;
   Vec3 press_point_Nsm{};
-  double press_time_Nss = 0.0;
-  double press_time2_Nsss = 0.0;
-  Vec3 press_point_time_Nssm{};
+  std::array<double, 6> press_point2_Nsm2{};
   std::uint64_t last_tick = 0;    // last haptic tick that added to this entry
 };
 

@@ -93,9 +93,7 @@ void visit_entry(A& a, B& b, F&& f) {
   f(a.hand_input_J, b.hand_input_J);
   f(a.press_Ns, b.press_Ns);
   f(a.press_point_Nsm, b.press_point_Nsm);
-  f(a.press_time_Nss, b.press_time_Nss);
-  f(a.press_time2_Nsss, b.press_time2_Nsss);
-  f(a.press_point_time_Nssm, b.press_point_time_Nssm);
+  f(a.press_point2_Nsm2, b.press_point2_Nsm2);
   f(a.last_tick, b.last_tick);
 }
 

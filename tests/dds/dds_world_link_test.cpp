@@ -180,6 +180,40 @@ TEST_CASE("a frame and a report keep every bit through the DDS types, and a coun
   CHECK_FALSE(from_dds(*report_sample, received_report));
 }
 
+TEST_CASE("a frame's dent patch travels over DDS only when it has one, and keeps every bit") {
+  static wire::PlaneFrame sent, received;
+  static PlaneFrame frame, decoded;
+  frame = box_frame(5);
+  sent = {};
+  encode(frame, sent);
+  DdsFrameSample sample;
+  to_dds(sent, 42, 3, 7, *sample);
+  CHECK((*sample).dent_patch.height_m._length == 0);  // no patch: none of its 8 KB sent
+  REQUIRE(from_dds(*sample, received));
+  CHECK(std::memcmp(&sent, &received, used_bytes(sent)) == 0);
+
+  // A patch: every height, bit for bit, and the frame's seal holds.
+  frame.dent_patch.object_id = 0;
+  frame.dent_patch.origin_m = {-0.0155, -0.0155, 0.03};
+  frame.dent_patch.axis_x = {1.0, 0.0, 0.0};
+  frame.dent_patch.axis_y = {0.0, 1.0, 0.0};
+  frame.dent_patch.spacing_m = 0.001;
+  for (std::size_t k = 0; k < frame.dent_patch.height_m.size(); ++k) {
+    frame.dent_patch.height_m[k] = 0.015 - 1e-6 * static_cast<double>(k % 97);
+  }
+  sent = {};
+  encode(frame, sent);
+  to_dds(sent, 42, 3, 7, *sample);
+  CHECK((*sample).dent_patch.height_m._length == kDentPatchSide * kDentPatchSide);
+  REQUIRE(from_dds(*sample, received));
+  CHECK(std::memcmp(&sent, &received, used_bytes(sent)) == 0);
+  REQUIRE(decode(received, decoded) == FrameError::ok);
+  CHECK(decoded.dent_patch.height_m == frame.dent_patch.height_m);
+  // Heights for a frame without a patch, or a patch cut short, are refused.
+  (*sample).dent_patch.height_m._length = 10;
+  CHECK_FALSE(from_dds(*sample, received));
+}
+
 TEST_CASE("over DDS a controller is given a slot, its frames arrive whole and the world reads its newest report") {
   const DdsLinkOptions options = partition("cross");
   DdsWorldLinkServer server(options, realtime_info());

@@ -56,8 +56,10 @@ TEST_CASE("a deformable surface gets an entry with the push beyond its yield for
   CHECK(entry.impulse_Ns[2] == Approx(-2e-3));
   CHECK(entry.press_Ns == Approx((2.0 - kYieldForce_N) * 1e-3));  // the threshold taken tick by tick
   CHECK(to_eigen(entry.press_point_Nsm).isApprox(entry.press_Ns * contact.contact.proxy_m));
-  CHECK(entry.press_time_Nss == Approx(entry.press_Ns * 2.0));
-  CHECK(entry.press_time2_Nsss == Approx(entry.press_Ns * 4.0));
+  const Vector3d x_m = contact.contact.proxy_m;
+  CHECK(entry.press_point2_Nsm2[0] == Approx(entry.press_Ns * x_m.x() * x_m.x()));
+  CHECK(entry.press_point2_Nsm2[2] == Approx(entry.press_Ns * x_m.x() * x_m.z()));
+  CHECK(entry.press_point2_Nsm2[5] == Approx(entry.press_Ns * x_m.z() * x_m.z()));
   REQUIRE(accumulator.last_share_count() == 1);
   CHECK(accumulator.last_shares()[0].yielding_Ns == Approx(entry.press_Ns));
 

@@ -222,12 +222,9 @@ TEST_CASE("the surface the haptic side yields between frames is the one the worl
         share.object_id = 0;
         share.yielding_Ns = kPush_Ns;
         yield.record(tick, at_m, &share, 1);
-        const double t_s = kTick_s * static_cast<double>(tick);
         moments.push_Ns += kPush_Ns;
         moments.point_Nsm += kPush_Ns * at_m;
-        moments.time_Nss += kPush_Ns * t_s;
-        moments.time2_Nsss += kPush_Ns * t_s * t_s;
-        moments.point_time_Nssm += kPush_Ns * t_s * at_m;
+        moments.point2_Nsm2 += kPush_Ns * at_m * at_m.transpose();
       }
       const Eigen::Vector3d proxy_m = proxy_at(tick);
       Eigen::Vector3d before_normal, after_normal, stale_normal;

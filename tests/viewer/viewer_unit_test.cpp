@@ -158,9 +158,7 @@ TEST_CASE("a pressed clay slab's snapshot carries its dent, and both transports 
   entry.impulse_Ns = {0.0, 0.0, -0.06};
   entry.press_Ns = 0.05;
   entry.press_point_Nsm = {0.05 * 0.01, 0.0, 0.05 * 0.03};
-  entry.press_time_Nss = 0.05 * 0.05;
-  entry.press_time2_Nsss = 0.05 * 0.05 * 0.05;
-  entry.press_point_time_Nssm = {0.05 * 0.01 * 0.05, 0.0, 0.05 * 0.03 * 0.05};
+  entry.press_point2_Nsm2 = {0.05 * 0.01 * 0.01, 0.0, 0.05 * 0.01 * 0.03, 0.0, 0.0, 0.05 * 0.03 * 0.03};
   world.step(&report);
   const PlasticSurface* clay = world.deformable(0);
   REQUIRE(clay != nullptr);

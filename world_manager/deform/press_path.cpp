@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/deform/press_path.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 
 namespace impetus {
@@ -10,17 +12,18 @@ PressStroke stroke_of(const PressMoments& moments) {
   if (!moments.all_finite() || !(moments.push_Ns > 0.0)) return stroke;
   const double push_Ns = moments.push_Ns;
   const Eigen::Vector3d centre_m = moments.point_Nsm / push_Ns;
-  const double mean_time_s = moments.time_Nss / push_Ns;
-  // σ² by its definition; rounding can leave it slightly negative for a push within one tick.
-  const double variance_s2 = moments.time2_Nsss / push_Ns - mean_time_s * mean_time_s;
   stroke.push_Ns = push_Ns;
   stroke.from_m = centre_m;
   stroke.to_m = centre_m;
-  // Below a microsecond of spread, rounding of t̄² (session times of minutes) dominates σ²: a press at one instant.
-  constexpr double kMinSpread_s = 1e-6;
-  if (!(variance_s2 > kMinSpread_s * kMinSpread_s)) return stroke;
-  const Eigen::Vector3d velocity_mps = (moments.point_time_Nssm / push_Ns - centre_m * mean_time_s) / variance_s2;
-  const Eigen::Vector3d half_m = velocity_mps * std::sqrt(3.0 * variance_s2);
+  // C by its definition; rounding can leave it slightly indefinite for a push at one point.
+  const Eigen::Matrix3d covariance_m2 = moments.point2_Nsm2 / push_Ns - centre_m * centre_m.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance_m2);
+  if (solver.info() != Eigen::Success) return stroke;
+  const double largest_m2 = solver.eigenvalues()(2);  // ascending
+  // Below a micrometre of spread, a press at one point (a proxy at rest still wanders by rounding).
+  constexpr double kMinSpread_m = 1e-6;
+  if (!(largest_m2 > kMinSpread_m * kMinSpread_m)) return stroke;
+  const Eigen::Vector3d half_m = std::sqrt(3.0 * largest_m2) * solver.eigenvectors().col(2);
   if (!half_m.allFinite()) return stroke;
   stroke.from_m = centre_m - half_m;
   stroke.to_m = centre_m + half_m;

@@ -3,12 +3,12 @@
 // Where a world period's push was given (docs/deformation.md): from the moments of the push into a surface over the
 // period (impulse_ledger.h PressMoments), the straight stroke that has them. Exact for a contact that moved in a
 // straight line at constant speed while pushing steadily (a press, a tap, a stroke); otherwise the stroke with the
-// same centre, the same spread in time, and the same drift.
+// same centre and the same spread along its main direction.
 //
-//     P = Σp,  x̄ = Σp·x / P,  t̄ = Σp·t / P,  σ² = Σp·t² / P − t̄²,  v = (Σp·x·t / P − x̄·t̄) / σ²
+//     P = Σp,  x̄ = Σp·x / P,  C = Σp·x·xᵀ / P − x̄·x̄ᵀ  (the push's covariance in space),  C u = λ u, λ the largest
 //
-// A steady push over a time window has its times spread uniformly, over ±√3·σ about t̄: the stroke runs from
-// x̄ − v·√3·σ to x̄ + v·√3·σ, and the push is shared evenly along it.
+// A push spread evenly along a segment of length L has variance L²/12 along it: the stroke runs from
+// x̄ − √(3λ)·u to x̄ + √(3λ)·u, and the push is shared evenly along it.
 
 #include "world_manager/impulse_ledger.h"
 

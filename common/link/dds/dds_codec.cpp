@@ -19,6 +19,12 @@ struct ToDds {
   void operator()(const std::array<double, N>& from, double (&to)[N]) const {
     std::copy(from.begin(), from.end(), to);
   }
+  // A bounded sequence (allocated to N): all of it; the caller shortens what it need not send.
+  template <std::size_t N>
+  void operator()(const std::array<double, N>& from, dds_sequence_double& to) const {
+    std::copy(from.begin(), from.end(), to._buffer);
+    to._length = static_cast<std::uint32_t>(N);
+  }
   void operator()(const Coupling& from, std::uint32_t& to) const { to = static_cast<std::uint32_t>(from); }
   void operator()(const ShapeKind& from, std::uint32_t& to) const { to = static_cast<std::uint32_t>(from); }
   template <class T>
@@ -32,6 +38,13 @@ struct FromDds {
   template <std::size_t N>
   void operator()(std::array<double, N>& to, const double (&from)[N]) const {
     std::copy(from, from + N, to.begin());
+  }
+  // What was sent (its length checked by the caller), zeros after.
+  template <std::size_t N>
+  void operator()(std::array<double, N>& to, const dds_sequence_double& from) const {
+    const std::size_t sent = std::min<std::size_t>(from._length, N);
+    std::copy(from._buffer, from._buffer + sent, to.begin());
+    std::fill(to.begin() + static_cast<std::ptrdiff_t>(sent), to.end(), 0.0);
   }
   void operator()(Coupling& to, const std::uint32_t& from) const { to = static_cast<Coupling>(from); }
   void operator()(ShapeKind& to, const std::uint32_t& from) const { to = static_cast<ShapeKind>(from); }
@@ -59,6 +72,7 @@ struct DdsToWire {
 
 DdsFrameSample::DdsFrameSample() {
   allocate_sequence(sample_.planes, kMaxPlanes);
+  allocate_sequence(sample_.dent_patch.height_m, kDentPatchSide * kDentPatchSide);
 }
 DdsFrameSample::~DdsFrameSample() { dds_sample_free(&sample_, &impetus_dds_PlaneFrame_desc, DDS_FREE_CONTENTS); }
 
@@ -76,6 +90,8 @@ void to_dds(const wire::PlaneFrame& frame, std::uint64_t client_id, std::uint32_
   out.world_id = world_id;
   out.checksum = frame.checksum;
   fields::visit_frame_header(frame, out, WireToDds{});
+  // The heights only with a patch: a frame without one (every scene without clay) sends 8 KB less.
+  if (frame.dent_patch.object_id < 0) out.dent_patch.height_m._length = 0;
   const std::uint32_t count = std::min(frame.plane_count, kMaxPlanes);
   for (std::uint32_t k = 0; k < count; ++k) fields::visit_plane(frame.planes[k], out.planes._buffer[k], WireToDds{});
   out.planes._length = count;
@@ -95,6 +111,9 @@ void to_dds(const wire::HapticReport& report, std::uint64_t client_id, std::uint
 
 bool from_dds(const impetus_dds_PlaneFrame& in, wire::PlaneFrame& out) {
   if (in.plane_count != in.planes._length || in.plane_count > kMaxPlanes) return false;
+  if (in.dent_patch.height_m._length != (in.dent_patch.object_id >= 0 ? kDentPatchSide * kDentPatchSide : 0u)) {
+    return false;
+  }
   out.checksum = in.checksum;
   fields::visit_frame_header(out, in, DdsToWire{});
   for (std::uint32_t k = 0; k < in.plane_count; ++k) fields::visit_plane(out.planes[k], in.planes._buffer[k], DdsToWire{});

@@ -195,7 +195,7 @@ FrameError validate(const wire::HapticReport& report) {
     if (!all_finite(entry.impulse_Ns) || !all_finite(entry.angular_impulse_Nms) ||
         !all_finite(entry.impulse_moment_Nss) || !all_finite(entry.angular_impulse_moment_Nmss) ||
         !finite(entry.hand_input_J) || !finite(entry.press_Ns) || !all_finite(entry.press_point_Nsm) ||
-        !finite(entry.press_time_Nss) || !finite(entry.press_time2_Nsss) || !all_finite(entry.press_point_time_Nssm)) {
+        !std::all_of(entry.press_point2_Nsm2.begin(), entry.press_point2_Nsm2.end(), finite)) {
       return FrameError::not_finite;
     }
   }

@@ -97,9 +97,7 @@ struct ObjectImpulse {
   double hand_input_J = 0.0;
   double press_Ns = 0.0;
   Vec3 press_point_Nsm{};
-  double press_time_Nss = 0.0;
-  double press_time2_Nsss = 0.0;
-  Vec3 press_point_time_Nssm{};
+  std::array<double, 6> press_point2_Nsm2{};
   std::uint64_t last_tick = 0;
 };
 
