@@ -26,6 +26,15 @@ Scene engine_scene(json document, std::string_view engine) {
   return parse_scene(document, "engines.json");
 }
 
+// An engine of `scene` (its physics.engine), its bodies left 1.5 s without forces to come to rest (and fall asleep).
+std::unique_ptr<RigidBodyEngine> rested_engine(const Scene& scene) {
+  prepare_engines();
+  auto engine = make_engine(scene);
+  NoForces none;
+  for (int step = 0; step < 30; ++step) engine->step(10, 0.005, false, none);
+  return engine;
+}
+
 // A 1 kg, 5 cm cube on a floor, both with dynamic friction `mu` (so the pair's is `mu`: scene.h combine_friction).
 json sliding_cube(double mu, double speed_mps) {
   return json{{"floor", {{"static_friction", mu}, {"dynamic_friction", mu}}},
@@ -176,10 +185,8 @@ TEST_CASE("on every engine a push wakes the body it pushes and what touches it, 
   for (const EngineEntry& entry : engine_entries()) {
     INFO(entry.name);
     const Scene scene = engine_scene(document, entry.name);
-    prepare_engines();
-    auto engine = make_engine(scene);
+    auto engine = rested_engine(scene);
     NoForces none;
-    for (int step = 0; step < 30; ++step) engine->step(10, 0.005, false, none);  // 1.5 s at rest
     for (std::size_t id = 0; id < 3; ++id) CHECK(engine->asleep(id));
     // Towards b, for one substep: 0.3 mN·s on 30 g, 1 cm/s.
     engine->add_force(0, Eigen::Vector3d(0.06, 0.0, 0.0), Eigen::Vector3d::Zero());
@@ -209,10 +216,8 @@ TEST_CASE("on every engine bodies rest in the dent of a plastic slab, roll into 
   for (const EngineEntry& entry : engine_entries()) {
     INFO(entry.name);
     const Scene scene = engine_scene(document, entry.name);
-    prepare_engines();
-    auto engine = make_engine(scene);
+    auto engine = rested_engine(scene);
     NoForces none;
-    for (int step = 0; step < 30; ++step) engine->step(10, 0.005, false, none);  // 1.5 s: all three at rest, asleep
     CHECK(engine->asleep(1));
     // Dents 3.5 mm deep (a push of 0.2 N·s beyond yield each, straight down at x = ∓2 cm).
     const PlasticMaterial clay;

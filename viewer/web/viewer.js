@@ -302,7 +302,8 @@ function dentedBoxGeometry(shape) {
     const tu = u - c;
     const tv = v - r;
     const at = (i, j) => dent.depths[j * dent.columns + i];
-    return (1 - tv) * ((1 - tu) * at(c, r) + tu * at(c + 1, r)) + tv * ((1 - tu) * at(c, r + 1) + tu * at(c + 1, r + 1));
+    return (1 - tv) * ((1 - tu) * at(c, r) + tu * at(c + 1, r)) +
+           tv * ((1 - tu) * at(c, r + 1) + tu * at(c + 1, r + 1));
   };
   const top = new THREE.BufferGeometry();
   const position = new Float32Array(xs.length * ys.length * 3);

@@ -13,9 +13,9 @@
 
 #include "common/contract/frames.h"
 #include "common/contract/world_view.h"
-#include "world_manager/engine/rigid_body_engine.h"
 #include "world_manager/deform/plastic_material.h"
 #include "world_manager/deform/press_path.h"
+#include "world_manager/engine/rigid_body_engine.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
