@@ -49,7 +49,7 @@ void check_accepted(const PlaneFrame& frame) {
     FUZZ_CHECK(std::isfinite(plane.inverse_mass_per_kg));
     FUZZ_CHECK(std::isfinite(plane.extent_m) && plane.extent_m >= 0.0);
     FUZZ_CHECK(plane.yield_force_N >= 0.0 && plane.yield_depth_mpNs >= 0.0 && plane.yield_radius_m >= 0.0 &&
-               plane.yield_room_m >= 0.0);
+               plane.yield_room_m >= 0.0 && plane.yield_compliance_mpN >= 0.0);
     for (double value : plane.inverse_inertia_world) FUZZ_CHECK(std::isfinite(value));
     const double norm = std::hypot(plane.normal[0], plane.normal[1], plane.normal[2]);
     FUZZ_CHECK(std::fabs(norm - 1.0) < kUnitSlack);

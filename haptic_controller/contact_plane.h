@@ -28,11 +28,13 @@ struct ContactPlane : ShapePlane {
   double static_friction = 0.0;
   double dynamic_friction = 0.0;
   double extent_m = 0.0;  // how far from point_m the plane describes its object; 0: unbounded (Plane::extent_m)
-  // A deformable surface's yield (Plane::yield_force_N, yield_depth_mpNs, yield_radius_m); zero for the rigid.
+  // A deformable surface's yield (Plane::yield_force_N, yield_depth_mpNs, yield_radius_m, yield_room_m,
+  // yield_compliance_mpN); zero for the rigid.
   double yield_force_N = 0.0;
   double yield_depth_mpNs = 0.0;
   double yield_radius_m = 0.0;
   double yield_room_m = 0.0;
+  double yield_compliance_mpN = 0.0;
 
   // Whether the plane carries its body's shape (the floor's does not).
   bool shaped() const { return shape.kind != ShapeKind::none; }

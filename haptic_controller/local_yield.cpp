@@ -59,14 +59,37 @@ void LocalYield::record(std::uint64_t tick, const Eigen::Vector3d& proxy_m, cons
   }
 }
 
+void LocalYield::yield_elastic(const PlaneFrame& frame, const Plane& sent, const Eigen::Vector3d& proxy_m,
+                               const Eigen::Vector3d& finger_m, double stiffness_Npm, ContactPlane& plane) {
+  plane.normal = to_eigen(sent.normal);
+  plane.point_m = to_eigen(sent.point_m);
+  if (frame.dent_patch.object_id == plane.object_id) {
+    patch_plane(frame.dent_patch, proxy_m, plane.point_m, plane.normal);
+  }
+  // The finger's spring k and the surface's compliance c in series: with the surface in by D under a push F,
+  // F = k·(p − D) and D = c·F, so D = c·k·p / (1 + c·k), p how far the finger is below the frame's surface. Solved
+  // within the tick, not from the last tick's force: with c·k above 1 (a soft gel under a stiff spring) that lag
+  // would ring.
+  const double below_m = (plane.point_m - finger_m).dot(plane.normal);
+  if (!(below_m > 0.0) || !(stiffness_Npm > 0.0)) return;
+  const double ck = sent.yield_compliance_mpN * stiffness_Npm;
+  const double in_m = std::min(below_m * ck / (1.0 + ck), sent.yield_room_m);
+  plane.point_m -= in_m * plane.normal;
+}
+
 void LocalYield::apply(const PlaneFrame& frame, std::uint64_t haptic_session, const Eigen::Vector3d& proxy_m,
-                       PlaneSet& planes) const {
+                       const Eigen::Vector3d& finger_m, double stiffness_Npm, PlaneSet& planes) const {
   const std::uint64_t applied_tick = frame.report_session_applied == haptic_session ? frame.report_tick_applied : 0;
   for (std::uint32_t k = 0; k < planes.count; ++k) {
     ContactPlane& plane = planes.planes[k];
-    if (!plane.deformable() || !(plane.yield_depth_mpNs > 0.0) || !(plane.yield_radius_m > 0.0)) continue;
+    if (!plane.deformable()) continue;
     const Plane* sent = frame_plane(frame, plane.object_id);
     if (sent == nullptr) continue;
+    if (sent->yield_compliance_mpN > 0.0) {
+      yield_elastic(frame, *sent, proxy_m, finger_m, stiffness_Npm, plane);
+      continue;
+    }
+    if (!(plane.yield_depth_mpNs > 0.0) || !(plane.yield_radius_m > 0.0)) continue;
     const double radius2_m2 = plane.yield_radius_m * plane.yield_radius_m;
     // Σ e_k·w(|x_k − proxy|) and its gradient in the proxy, Σ e_k·(−2/a²)·(proxy − x_k) over the pad, newest first,
     // down to the applied report.

@@ -44,6 +44,7 @@ ContactPlane to_contact_plane(const Plane& plane) {
   out.yield_depth_mpNs = plane.yield_depth_mpNs;
   out.yield_radius_m = plane.yield_radius_m;
   out.yield_room_m = plane.yield_room_m;
+  out.yield_compliance_mpN = plane.yield_compliance_mpN;
   out.shape = plane.shape;
   if (traits(plane.shape.kind).carries_axes) {
     const Eigen::Vector3d x = to_eigen(plane.body_axis_x);

@@ -161,8 +161,15 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   // Planes that carry their shape taken again at the last proxy, or at the finger past a body the way to it does not
   // enter (shape_planes.h).
   retake_shape_planes(planes_, to_eigen(result_.proxy_m), finger_m);
-  // Deformable surfaces yield by the push beyond yield the world has not yet dented them by (local_yield.h).
-  if (have_frame_) local_yield_.apply(current_frame_, report.haptic_session, to_eigen(result_.proxy_m), planes_);
+  // Deformable surfaces yield by the push beyond yield the world has not yet dented them by, elastic ones by this
+  // tick's push (local_yield.h).
+  const double stiffness_Npm =
+      std::isnan(options_.stiffness_Npm) ? positive_or(current_frame_.stiffness_Npm, kFallbackStiffness_Npm)
+                                         : options_.stiffness_Npm;
+  if (have_frame_) {
+    local_yield_.apply(current_frame_, report.haptic_session, to_eigen(result_.proxy_m), finger_m, stiffness_Npm,
+                       planes_);
+  }
 
   // 3. Proxy D_j (god-object with friction).
   planes_.valid_within_m =
@@ -183,9 +190,6 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
 
   // 4. Force f_j on the finger (§3.3). Out of contact nothing is touched, so nothing pushes: the damper acts only
   //    while a plane holds the proxy (its history still advances, so the first contact tick is continuous).
-  const double stiffness_Npm =
-      std::isnan(options_.stiffness_Npm) ? positive_or(current_frame_.stiffness_Npm, kFallbackStiffness_Npm)
-                                         : options_.stiffness_Npm;
   const double damping_Nspm =
       std::isnan(options_.damping_Nspm)
           ? positive_or(current_frame_.damping_Nspm, passivity_damping_Nspm(stiffness_Npm, options_.tick_period_s))

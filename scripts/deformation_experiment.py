@@ -10,6 +10,10 @@ rule also runs once with the world at the haptic rate (1 kHz), its reference. Re
 depth and volume (and for the stroke the groove's depth along its middle): mean, spread over the phases (max − min)
 and bias against the reference, and checks the law itself (dent volume × flow resistance = push above yield).
 
+With an elastic slab (--scene scenes/gel.json: "law": "elastic") the surface springs back, so the measures are the
+deepest it went and the work the pushes did on it, and the law's check is its energy books (work + the integrator's
+share = dissipated + held, world_manager/deform/elastic_membrane.h).
+
 Writes OUT/deformation.md, OUT/deformation.json and OUT/deformation.png (dent against time for every phase, the two
 rules side by side), and prints the table. With --check it exits 1 unless the law holds to 1e-9 in every trial and,
 for every case of --check-cases at every rate, the impulse rule's spread is at most --max-spread of its dent and at
@@ -61,8 +65,13 @@ def trajectories(surface_z, x0, y0):
                                                                              stroke_z),
                    (0.1, start_x, y0, stroke_z), ((end_x - start_x) / 0.05, end_x, y0, stroke_z),
                    (0.1, end_x, y0, stroke_z), ((above - stroke_z) / 0.1, end_x, y0, above), (0.4, end_x, y0, above)])
-    # The groove is measured along the stroke's middle, a pad's width in from where it went in and came out.
-    return {"press": (press, None), "tap": (tap, None), "stroke": (stroke, (start_x + 0.015, end_x - 0.015))}
+    # The groove is measured along the stroke's middle, a pad's width in from where it went in and came out. An elastic
+    # slab's depth while held is averaged over the middle of the press's hold and of the stroke's cruise.
+    press_held = (0.2 + down_s + 0.2, 0.2 + down_s + 0.5)
+    cruise_start = 0.2 + (above - stroke_z) / 0.1 + 0.1
+    stroke_held = (cruise_start + 0.3, cruise_start + (end_x - start_x) / 0.05 - 0.3)
+    return {"press": (press, None, press_held), "tap": (tap, None, None),
+            "stroke": (stroke, (start_x + 0.015, end_x - 0.015), stroke_held)}
 
 
 def write_csv(path, waypoints):
@@ -70,12 +79,19 @@ def write_csv(path, waypoints):
     return path
 
 
-def measure(trial_dir, scene_path, rule, case, groove_span):
-    """What one trial left in the clay, from its summary."""
+def measure(trial_dir, scene_path, rule, case, groove_span, held):
+    """What one trial left in the clay, from its summary (and, for an elastic slab held down, world.csv)."""
     summary = json.loads((trial_dir / "summary.json").read_text())
     clay = next(iter(summary["world"]["deformable"].values()))
     result = {"dent_m": clay["max_dent_m"], "volume_m3": clay["dent_volume_m3"], "absorbed_Ns": clay["absorbed_Ns"],
               "yielding_Ns": clay["yielding_Ns"], "clamped_m3": clay["clamped_m3"], "rule": clay["rule"]}
+    if clay.get("law") == "elastic":
+        result.update({key: clay[key] for key in ("work_J", "scheme_J", "dissipated_J", "stored_J")})
+        if held is not None:
+            world = logs.read_log(trial_dir / logs.WORLD, keep_time_s=lambda t: held[0] <= t <= held[1])
+            name = next(k for k in world.columns if k.endswith(".dent_m"))
+            result["held_m"] = statistics.mean(world[name])
+        return result
     if groove_span is not None:
         row = clay["deepest_row"]
         centre_x = json.loads(scene_path.read_text())["objects"][0]["position_m"][0]
@@ -87,9 +103,9 @@ def measure(trial_dir, scene_path, rule, case, groove_span):
     return result
 
 
-def one_trial(trial_dir, scene_path, trajectory, rate_hz, phase, rule, case, groove_span):
+def one_trial(trial_dir, scene_path, trajectory, rate_hz, phase, rule, case, groove_span, held):
     run_trial(trial_dir, scene_path, trajectory, "impulse", rate_hz, phase)
-    return measure(trial_dir, scene_path, rule, case, groove_span)
+    return measure(trial_dir, scene_path, rule, case, groove_span, held)
 
 
 def stats_of(values, reference):
@@ -114,6 +130,10 @@ def main():
     parser.add_argument("--check", action="store_true", help="exit 1 unless the goals below hold")
     parser.add_argument("--check-cases", default="press,tap,stroke",
                         help="--check: the cases held to the goals below (the others are reported)")
+    parser.add_argument("--check-measures", default=None,
+                        help="--check: the measures held to the goals (default: all for a plastic slab; for an "
+                             "elastic one held_m, the depth while held: its deepest and the energy it took depend on "
+                             "when within a period the push was given, which the world is not told)")
     parser.add_argument("--max-spread", type=float, default=1.0,
                         help="--check: largest impulse-rule spread over phases, %% of the dent (the goal: 1 %%)")
     parser.add_argument("--max-ratio", type=float, default=0.2,
@@ -126,6 +146,9 @@ def main():
     clay = scene["objects"][0]
     if "deformable" not in clay or clay["shape"] != "box":
         sys.exit(f"{args.scene}: the first object must be a deformable box")
+    elastic = clay["deformable"].get("law", "plastic") == "elastic"
+    check_measures = (args.check_measures.split(",") if args.check_measures else
+                      ["held_m"] if elastic else ["dent_m", "volume_m3", "groove_m"])
     centre = clay["position_m"]
     surface_z = centre[2] + 0.5 * clay["size_m"][2]
     args.out.mkdir(parents=True, exist_ok=True)
@@ -137,11 +160,11 @@ def main():
         scenes[rule].write_text(json.dumps(variant, indent=1))
     paths = trajectories(surface_z, centre[0], centre[1])
     cases = args.cases.split(",")
-    files, spans = {}, {}
+    files, spans, helds = {}, {}, {}
     for case in cases:
         if case not in paths:
             sys.exit(f"--cases: unknown case {case!r}, expected press, tap, stroke")
-        waypoints, spans[case] = paths[case]
+        waypoints, spans[case], helds[case] = paths[case]
         files[case] = write_csv(args.out / f"{case}.csv", waypoints)
 
     rates = [float(r) for r in args.rates.split(",")]
@@ -150,29 +173,37 @@ def main():
         for rule in RULES:
             key = (case, rule, "reference", 0)
             tasks.append((key, one_trial, (args.out / f"{case}-{rule}-reference", scenes[rule], files[case],
-                                           args.haptic_rate, 0, rule, case, spans[case])))
+                                           args.haptic_rate, 0, rule, case, spans[case], helds[case])))
             for rate in rates:
                 ticks = round(args.haptic_rate / rate)
                 for phase in sorted({round(k * ticks / args.phases) for k in range(args.phases)}):
                     key = (case, rule, rate, phase)
                     tasks.append((key, one_trial, (args.out / f"{case}-{rule}-{rate:g}hz-phase{phase:03d}",
                                                    scenes[rule], files[case], rate, phase, rule, case,
-                                                   spans[case])))
+                                                   spans[case], helds[case])))
     results = dict(track(run_parallel(tasks, args.jobs), [key for key, _, _ in tasks], "deformation", args.quiet))
 
     table, report, failures = [], {}, []
-    flow = clay["deformable"].get("flow_resistance_Paspm", 1e6)
-    law_error = max(abs(r["volume_m3"] * flow - r["yielding_Ns"]) / r["yielding_Ns"] for r in results.values()
-                    if r["rule"] == "impulse" and r["clamped_m3"] == 0.0 and r["yielding_Ns"] > 0)
+    if elastic:
+        law_error = max(abs(r["work_J"] + r["scheme_J"] - r["dissipated_J"] - r["stored_J"]) / r["work_J"]
+                        for r in results.values() if r["work_J"] > 0)
+        law_text = "energy books: |work + scheme − dissipated − held| / work"
+    else:
+        flow = clay["deformable"].get("flow_resistance_Paspm", 1e6)
+        law_error = max(abs(r["volume_m3"] * flow - r["yielding_Ns"]) / r["yielding_Ns"] for r in results.values()
+                        if r["rule"] == "impulse" and r["clamped_m3"] == 0.0 and r["yielding_Ns"] > 0)
+        law_text = "|volume × η − push above yield| / push above yield"
     if law_error > 1e-9:
-        failures.append(f"the law: dent volume × flow resistance differs from the push above yield by "
-                        f"{law_error:.2e} (relative)")
+        failures.append(f"the law's check ({law_text}) is off by {law_error:.2e} (relative)")
     header = ("| case | rule | world | measure | reference (1 kHz) | mean | spread over phases | spread (% of mean) | "
               "bias vs reference |")
     table += [header, "|---|---|---|---|---|---|---|---|---|"]
     for case in cases:
         measures = [("dent depth", "dent_m", 1e3, "mm"), ("dent volume", "volume_m3", 1e9, "mm³")]
-        if case == "stroke":
+        if elastic:
+            measures = ([("depth held", "held_m", 1e3, "mm")] if helds[case] is not None else []) + \
+                [("deepest", "dent_m", 1e3, "mm"), ("energy it took", "work_J", 1e3, "mJ")]
+        elif case == "stroke":
             measures.append(("groove depth", "groove_m", 1e3, "mm"))
         for rule in RULES:
             reference = results[(case, rule, "reference", 0)]
@@ -194,7 +225,7 @@ def main():
                 ratio = imp["spread"] / pen["spread"] if pen["spread"] > 0 else float("inf")
                 report[case]["impulse"][f"{rate:g}"][field]["spread_ratio_to_penetration"] = ratio
                 ratio_lines.append(f"| {case} | {rate:g} Hz | {field} | {ratio:.3f} |")
-                if case not in args.check_cases.split(","):
+                if case not in args.check_cases.split(",") or field not in check_measures:
                     continue
                 if imp["spread_pct"] > args.max_spread:
                     failures.append(f"{case} at {rate:g} Hz: impulse-rule {field} spread {imp['spread_pct']:.2f} % "
@@ -208,8 +239,7 @@ def main():
     title = ["# Deformation experiment: the full table", "",
              "Generated by `scripts/deformation_experiment.py` (`scripts/make_figures.sh`); read "
              "[deformation.md](deformation.md) first.", ""]
-    law = (f"law check: |volume × η − push above yield| / push above yield ≤ {law_error:.1e} over all "
-           f"{len(results)} trials")
+    law = f"law check: {law_text} ≤ {law_error:.1e} over all {len(results)} trials"
     text = "\n".join(title + table + ratio_lines + ["", law])
     (args.out / "deformation.md").write_text(text + "\n")
     (args.out / "deformation.json").write_text(json.dumps({"cases": report, "law_relative_error": law_error,

@@ -37,6 +37,9 @@ cp out/figures/latency/latency.md docs/latency_table.md
 /usr/bin/python3 scripts/deformation_experiment.py --out out/figures/deformation
 cp out/figures/deformation/deformation.png docs/deformation.png
 cp out/figures/deformation/deformation.md docs/deformation_table.md
+/usr/bin/python3 scripts/deformation_experiment.py --scene scenes/gel.json --out out/figures/deformation-gel
+cp out/figures/deformation-gel/deformation.png docs/deformation_gel.png
+cp out/figures/deformation-gel/deformation.md docs/deformation_gel_table.md
 # The phase experiment and the hard cases on every engine (docs/engines.md).
 /usr/bin/python3 scripts/engines.py --quiet --out out/figures/engines --doc docs/engines.md
 # The viewer replaying a lockstep tap trial at its hardest push, in headless Chromium (the browser test's replay case

@@ -5,7 +5,7 @@
 #include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
 #include "common/mesh/mesh_object.h"
-#include "world_manager/deform/plastic_surface.h"
+#include "world_manager/deform/deformable_surface.h"
 #include "world_manager/engine/engine_registry.h"
 
 #include <nlohmann/json.hpp>
@@ -149,21 +149,50 @@ constexpr std::string_view kObjectKeys[] = {
     "name", "shape", "dynamic", "mass_kg", "density_kgpm3", "position_m", "orientation_wxyz", "linear_velocity_mps",
     "angular_velocity_radps", "static_friction", "dynamic_friction", "restitution", "deformable"};
 
-// A "deformable" block (docs/scene-format.md): a plastic top face for a static box. The ranges span the materials a
-// finger can dent (wet clay at ~1 kPa to stiff wax at ~1 MPa) with room either side, and grids a step can yield in
-// milliseconds (PlasticSurface::kMaxCells).
-PlasticMaterial parse_deformable(const Node& node, const SceneObject& object) {
+// A "deformable" block (docs/scene-format.md): a plastic or elastic top face for a static box. The plastic ranges
+// span the materials a finger can dent (wet clay at ~1 kPa to stiff wax at ~1 MPa) with room either side, the elastic
+// ones foams to hard rubbers; grids a step can yield in milliseconds (DeformableSurface::kMaxCells) and elastic
+// grids whose integration keeps up with real time (DeformableSurface::kMaxCellStepsPerSecond).
+DeformableMaterial parse_deformable(const Node& node, const SceneObject& object) {
   node.expect_object();
-  node.expect_keys({"rule", "yield_stress_Pa", "flow_resistance_Paspm", "contact_radius_m", "cell_m", "plasticity"});
+  node.expect_keys({"law", "rule", "yield_stress_Pa", "flow_resistance_Paspm", "contact_radius_m", "cell_m",
+                    "plasticity", "stiffness_Papm", "tension_Npm", "areal_density_kgpm2", "damping_Paspm"});
   if (object.dynamic) node.fail("only a static object can be deformable (\"dynamic\": false)");
   if (object.shape.kind != ShapeKind::box) node.fail("only a box can be deformable (its top face yields)");
-  PlasticMaterial material;
+  DeformableMaterial material;
+  if (node.has("law")) {
+    const std::string law = node.child("law").string();
+    if (law == "plastic") {
+      material.law = DeformableMaterial::Law::plastic;
+    } else if (law == "elastic") {
+      material.law = DeformableMaterial::Law::elastic;
+    } else {
+      node.child("law").fail("unknown law, expected plastic or elastic");
+    }
+  }
+  const bool elastic = material.law == DeformableMaterial::Law::elastic;
+  for (const char* key : {"yield_stress_Pa", "flow_resistance_Paspm", "plasticity"}) {
+    if (elastic && node.has(key)) node.child(key).fail("a key of the plastic law, and this slab's law is elastic");
+  }
+  for (const char* key : {"stiffness_Papm", "tension_Npm", "areal_density_kgpm2", "damping_Paspm"}) {
+    if (!elastic && node.has(key)) {
+      node.child(key).fail("a key of the elastic law, and this slab's law is plastic (add \"law\": \"elastic\")");
+    }
+  }
+  if (node.has("stiffness_Papm")) {
+    material.stiffness_Papm = node.child("stiffness_Papm").in_range(1e3, 1e10, " Pa/m");
+  }
+  if (node.has("tension_Npm")) material.tension_Npm = node.child("tension_Npm").in_range(0.0, 1e4, " N/m");
+  if (node.has("areal_density_kgpm2")) {
+    material.areal_density_kgpm2 = node.child("areal_density_kgpm2").in_range(1e-2, 1e4, " kg/m²");
+  }
+  if (node.has("damping_Paspm")) material.damping_Paspm = node.child("damping_Paspm").in_range(0.0, 1e9, " Pa·s/m");
   if (node.has("rule")) {
     const std::string rule = node.child("rule").string();
     if (rule == "impulse") {
-      material.rule = PlasticMaterial::Rule::impulse;
+      material.rule = DeformableMaterial::Rule::impulse;
     } else if (rule == "penetration") {
-      material.rule = PlasticMaterial::Rule::penetration;
+      material.rule = DeformableMaterial::Rule::penetration;
     } else {
       node.child("rule").fail("unknown rule, expected impulse or penetration");
     }
@@ -187,10 +216,19 @@ PlasticMaterial parse_deformable(const Node& node, const SceneObject& object) {
   }
   const Eigen::Vector3d half_m = 0.5 * Eigen::Vector3d(object.shape.box_size_m[0], object.shape.box_size_m[1],
                                                        object.shape.box_size_m[2]);
-  if (PlasticSurface::cells_for(material, half_m) > PlasticSurface::kMaxCells) {
+  if (DeformableSurface::cells_for(material, half_m) > DeformableSurface::kMaxCells) {
     const Node at = node.has("cell_m") ? node.child("cell_m") : node;
-    at.fail("the top face would have more than " + std::to_string(PlasticSurface::kMaxCells) +
+    at.fail("the top face would have more than " + std::to_string(DeformableSurface::kMaxCells) +
             " cells; use larger cells or a smaller box");
+  }
+  if (elastic) {
+    const double cell_steps = DeformableSurface::cell_steps_per_second(material, half_m);
+    if (cell_steps > DeformableSurface::kMaxCellStepsPerSecond) {
+      node.fail("an elastic slab this stiff, light and fine (" + readable(cell_steps) +
+                " cell updates per simulated second, above " + readable(DeformableSurface::kMaxCellStepsPerSecond) +
+                ") would not keep up with real time; use larger cells, a smaller box, a softer skin or foundation, or "
+                "a heavier layer");
+    }
   }
   return material;
 }

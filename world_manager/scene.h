@@ -12,7 +12,7 @@
 #include "common/contract/vec3.h"
 #include "common/runtime/input_error.h"
 #include "common/shape/shape.h"
-#include "world_manager/deform/plastic_material.h"
+#include "world_manager/deform/deformable_material.h"
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -83,9 +83,9 @@ struct SceneObject {
   Vec3 linear_velocity_mps{};
   Vec3 angular_velocity_radps{};  // world frame
   Material material;
-  // A static box whose top face yields where it is pressed (world_manager/deform/plastic_surface.h); the scene's
+  // A static box whose top face yields where it is pressed (world_manager/deform/deformable_surface.h); the scene's
   // "deformable" block.
-  std::optional<PlasticMaterial> deformable;
+  std::optional<DeformableMaterial> deformable;
 };
 
 struct Floor {

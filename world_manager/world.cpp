@@ -54,8 +54,8 @@ World::World(const Scene& scene, const WorldOptions& options)
       state.pose.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
     }
     if (object.deformable) {
-      surfaces_[id] = std::make_unique<PlasticSurface>(*object.deformable, 0.5 * to_eigen(object.shape.box_size_m),
-                                                       state.pose.position_m, state.pose.orientation);
+      surfaces_[id] = std::make_unique<DeformableSurface>(*object.deformable, 0.5 * to_eigen(object.shape.box_size_m),
+                                                          state.pose.position_m, state.pose.orientation);
     }
   }
   refresh_states(engine_->moved());
@@ -112,11 +112,15 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   for (std::size_t slot = 0; slot < kMaxEndpoints; ++slot) {
     fingers_[slot] = slot < reports.size() ? endpoints_[slot].finger : FingerState{};
   }
-  // The penetration rule dents by the finger as sampled now (the previous method of paper §6.4).
+  // The penetration rule moves the surface by the finger as sampled now (the previous method of paper §6.4); an
+  // elastic one follows the proxy, where the haptic side holds the finger's contact.
   for (const auto& surface : surfaces_) {
-    if (!surface || surface->material().rule != PlasticMaterial::Rule::penetration) continue;
+    if (!surface || surface->material().rule != DeformableMaterial::Rule::penetration) continue;
+    const bool elastic = surface->material().law == DeformableMaterial::Law::elastic;
     for (std::size_t slot = 0; slot < reports.size(); ++slot) {
-      if (fingers_[slot].valid) surface->press_by_penetration(fingers_[slot].finger.position_m);
+      if (!fingers_[slot].valid) continue;
+      surface->press_by_penetration(
+          elastic ? endpoints_[slot].plane_query.position_m : fingers_[slot].finger.position_m, slot);
     }
   }
   coupling_->before_step(std::span<const FingerState>(fingers_.data(), reports.size()), features_);
@@ -128,9 +132,9 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   port_->settle();
   // Deformable surfaces yield; bodies rest on the dented surface from the next step on.
   for (std::size_t id = 0; id < surfaces_.size(); ++id) {
-    PlasticSurface* surface = surfaces_[id].get();
+    DeformableSurface* surface = surfaces_[id].get();
     if (surface == nullptr) continue;
-    surface->yield_period();
+    surface->yield_period(period_s_);
     if (surface->changes() != surface_changes_[id]) {
       surface_changes_[id] = surface->changes();
       engine_->dent_top(id, surface->dented_top());
@@ -281,8 +285,8 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
     if (id < floor_id && surfaces_[id]) {
       surfaces_[id]->absorb(t.delta.impulse_Ns);
       // The push beyond yield, where and when it was given (deform/press_path.h).
-      if (surfaces_[id]->material().rule == PlasticMaterial::Rule::impulse) {
-        surfaces_[id]->press(stroke_of(t.delta.press));
+      if (surfaces_[id]->material().rule == DeformableMaterial::Rule::impulse) {
+        surfaces_[id]->press(stroke_of(t.delta.press), static_cast<std::size_t>(&endpoint - endpoints_.data()));
       }
     }
     if (id < floor_id && scene_.objects[id].dynamic) {
@@ -349,18 +353,19 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
   for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
     Plane& plane = frame.planes[k];
     if (plane.object_id < 0 || static_cast<std::size_t>(plane.object_id) >= surfaces_.size()) continue;
-    const PlasticSurface* surface = surfaces_[static_cast<std::size_t>(plane.object_id)].get();
+    const DeformableSurface* surface = surfaces_[static_cast<std::size_t>(plane.object_id)].get();
     if (surface == nullptr) continue;
     const Eigen::Vector3d query_body_m = surface->to_body(endpoint.plane_query.position_m);
     if (!surface->over_face(query_body_m)) continue;
     plane.flags |= kPlaneDeformable;
-    const PlasticMaterial& material = surface->material();
+    const DeformableMaterial& material = surface->material();
     plane.yield_force_N = material.yield_force_N();
     plane.yield_depth_mpNs = material.yield_depth_mpNs();
     plane.yield_radius_m = material.contact_radius_m;
     Eigen::Vector3d point_m, normal;
     surface->tangent_plane(query_body_m, point_m, normal);
     plane.yield_room_m = surface->room_m(query_body_m.x(), query_body_m.y());
+    plane.yield_compliance_mpN = surface->compliance_mpN();
     plane.point_m = to_vec3(point_m);
     plane.normal = to_vec3(normal);
     plane.shape = Shape{};
@@ -372,7 +377,9 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
     const Eigen::Vector3d up = to_eigen(plane.normal);
     const Eigen::Vector3d velocity_mps = endpoint.plane_query.velocity_mps;
     const double travel_m = 2.0 * period_s_ * (velocity_mps - velocity_mps.dot(up) * up).norm();
-    if (frame.dent_patch.object_id < 0) surface->patch_about(query_body_m, plane.object_id, travel_m, frame.dent_patch);
+    if (frame.dent_patch.object_id < 0) {
+      surface->patch_about(query_body_m, plane.object_id, travel_m, frame.dent_patch, slot);
+    }
   }
   // Planes past the count stay value-initialised (frames.h copy_used): only those the last frame used need it.
   for (std::uint32_t k = frame.plane_count; k < used_before; ++k) frame.planes[k] = Plane{};

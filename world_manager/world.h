@@ -14,7 +14,7 @@
 #include "common/spidar/geometry.h"
 #include "world_manager/scene.h"
 #include "world_manager/couplings/coupling.h"
-#include "world_manager/deform/plastic_surface.h"
+#include "world_manager/deform/deformable_surface.h"
 #include "world_manager/engine/rigid_body_engine.h"
 #include "world_manager/features/feature_extractor.h"
 #include "world_manager/impulse_ledger.h"
@@ -137,7 +137,7 @@ class World {
   // The yielding top face of deformable object `id` (scene "deformable"), or nullptr for any other object. Pressed by
   // the reports' press moments (impulse rule) or the sampled fingers (penetration rule) and yielded once per step,
   // after the engine; the frames carry its surface under each proxy (kPlaneDeformable).
-  const PlasticSurface* deformable(std::size_t id) const {
+  const DeformableSurface* deformable(std::size_t id) const {
     return id < surfaces_.size() ? surfaces_[id].get() : nullptr;
   }
 
@@ -184,7 +184,7 @@ class World {
   AppliedImpulses applied_;
   std::unique_ptr<PassivityLayer> port_;
   std::unique_ptr<CouplingStrategy> coupling_;
-  std::vector<std::unique_ptr<PlasticSurface>> surfaces_;  // per object; nullptr unless deformable
+  std::vector<std::unique_ptr<DeformableSurface>> surfaces_;  // per object; nullptr unless deformable
   std::vector<std::uint64_t> surface_changes_;              // per object: its surface's changes() the engine has seen
   Eigen::Vector3d total_static_impulse_Ns_ = Eigen::Vector3d::Zero();
   std::map<CounterOwner, std::vector<Eigen::Vector3d>> applied_by_owner_;  // per object (scene ids and the floor)

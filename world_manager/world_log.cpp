@@ -90,11 +90,11 @@ void WorldLog::record() {
     put(record.values, 16, world_.total_impulse_Ns(id));
   }
   for (std::size_t id = 0; id < objects.size(); ++id) {
-    const PlasticSurface* surface = world_.deformable(id);
+    const DeformableSurface* surface = world_.deformable(id);
     if (surface == nullptr) continue;
     WorldLogRecord& record = row_[next++];
     record.part = WorldLogRecord::Part::deformable;
-    record.values[0] = surface->max_dent_m();
+    record.values[0] = surface->dent_m();
     record.values[1] = surface->dent_volume_m3();
     record.values[2] = surface->yielding_Ns();
   }

@@ -281,10 +281,10 @@ nlohmann::json WorldNode::summary() const {
       port_objects[scene_.objects[id].name] = port_json(books);
     }
   }
-  // Each deformable object's dent (deform/plastic_surface.h) and the push it absorbed.
+  // Each deformable object's dent (deform/deformable_surface.h) and the push it absorbed.
   nlohmann::json deformable = nlohmann::json::object();
   for (std::size_t id = 0; id < scene_.objects.size(); ++id) {
-    const PlasticSurface* surface = world_.deformable(id);
+    const DeformableSurface* surface = world_.deformable(id);
     if (surface == nullptr) continue;
     deformable[scene_.objects[id].name] = {{"rule", to_string(surface->material().rule)},
                                            {"max_dent_m", surface->max_dent_m()},
@@ -293,8 +293,21 @@ nlohmann::json WorldNode::summary() const {
                                            {"yielding_Ns", surface->yielding_Ns()},
                                            {"lost_Ns", surface->lost_Ns()},
                                            {"clamped_m3", surface->clamped_m3()}};
-    const PlasticSurface::Profile row = surface->deepest_row();
-    deformable[scene_.objects[id].name]["deepest_row"] = {
+    nlohmann::json& entry = deformable[scene_.objects[id].name];
+    entry["law"] = to_string(surface->material().law);
+    if (surface->material().law == DeformableMaterial::Law::elastic) {
+      // The elastic law's books (deform/elastic_membrane.h): the surface springs back, so its depth now, the
+      // pushes' work, and where the work went.
+      entry["dent_m"] = surface->dent_m();
+      entry["compliance_mpN"] = surface->compliance_mpN();
+      entry["work_J"] = surface->work_J();
+      entry["dissipated_J"] = surface->dissipated_J();
+      entry["stored_J"] = surface->stored_J();
+      entry["scheme_J"] = surface->scheme_J();
+      entry["given_back_J"] = surface->given_back_J();
+    }
+    const DeformableSurface::Profile row = surface->deepest_row();
+    entry["deepest_row"] = {
         {"y_m", row.y_m}, {"x0_m", row.x0_m}, {"dx_m", row.dx_m}, {"depth_m", row.depth_m}};
   }
   nlohmann::json port = port_json(world_.port().total());

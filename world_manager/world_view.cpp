@@ -58,7 +58,7 @@ void take_snapshot(const World& world, std::span<const HapticReport* const> repo
   // The first deformable object with a dent.
   out.dent = ViewDent{};
   for (std::uint32_t k = 0; k < out.body_count && out.dent.object_id < 0; ++k) {
-    if (const PlasticSurface* surface = world.deformable(k); surface != nullptr) {
+    if (const DeformableSurface* surface = world.deformable(k); surface != nullptr) {
       surface->view_dent(static_cast<std::int32_t>(k), out.dent);
     }
   }

@@ -39,8 +39,9 @@ inline constexpr std::uint32_t kMaxLocalContacts = 4;
 
 // Plane flags.
 inline constexpr std::uint32_t kPlaneDynamic = 1u << 0;  // the object moves; impulses on it are applied by the world
-// The object is fixed but yields where it is pressed (a plastic slab, world_manager/deform/plastic_surface.h): its
-// share of the reaction gets an entry (with where it pressed, ObjectImpulse::press_*) instead of the static total.
+// The object is fixed but yields where it is pressed (a plastic or elastic slab, world_manager/deform/
+// deformable_surface.h): its share of the reaction gets an entry (with where it pressed, ObjectImpulse::press_*)
+// instead of the static total.
 inline constexpr std::uint32_t kPlaneDeformable = 1u << 1;
 // A plane's shape travels in Plane::shape (a tagged descriptor, common/shape/shape_descriptor.h), not in flags.
 
@@ -77,7 +78,7 @@ struct Plane {
   // How far from point_m the plane still describes the object (common/shape/shape.h plane_extent_m): a
   // sphere's radius, a box's diagonal. 0: unbounded (the floor).
   double extent_m = 0.0;
-  // A deformable object's surface under the finger (kPlaneDeformable; world_manager/deform/plastic_material.h): the
+  // A deformable object's surface under the finger (kPlaneDeformable; world_manager/deform/deformable_material.h): the
   // push it holds without yielding (N; 0: it yields to any push, or is rigid), how far the surface under the pad's
   // centre goes in per N·s of push beyond that (m/(N·s); 0: it does not yield between frames), the radius of the
   // pad the push is spread over (m), and how much further in the surface can go at point_m (m; the slab's unyielding
@@ -86,6 +87,10 @@ struct Plane {
   double yield_depth_mpNs = 0.0;
   double yield_radius_m = 0.0;
   double yield_room_m = 0.0;
+  // An elastic surface (world_manager/deform/elastic_membrane.h): how far the surface under the pad's centre goes in
+  // per newton of steady push (m/N; 0: not elastic), so the haptic side yields it under the finger at 1 kHz as the
+  // world's surface will settle, the patch of heights carrying the rest (haptic_controller/local_yield.h).
+  double yield_compliance_mpN = 0.0;
   // The body's shape (kind none for the floor), so the haptic side takes the plane again from it every tick
   // (common/shape/shape.h retake_plane). For a kind whose traits carry axes, the body's x and y axes in the world frame
   // (unit, orthogonal; z = x × y) about its centre com_m; zero otherwise (a sphere's plane carries its centre as
@@ -104,13 +109,13 @@ struct Plane {
   std::array<LocalContact, kMaxLocalContacts> local_contacts{};
 };
 
-// A deformable surface around the proxy as heights (world_manager/deform/plastic_surface.h): a square of
+// A deformable surface around the proxy as heights (world_manager/deform/deformable_surface.h): a square of
 // kDentPatchSide × kDentPatchSide samples `spacing_m` apart, sample (i, j) at origin_m + i·spacing·axis_x +
 // j·spacing·axis_y + height_m[j·kDentPatchSide + i]·(axis_x × axis_y), the surface bilinear between them. The haptic
 // side takes the object's plane again from it under the proxy every tick (haptic_controller/local_yield.h), as a
 // shape's plane is taken again: a plane alone goes stale as the finger moves over a dent. 32 × 32 samples (8 KB):
 // a cell apart (1 mm by default), ±15.5 mm about the proxy, the travel of a 15 cm/s stroke over two 10 Hz periods;
-// a faster finger gets samples further apart rather than a patch it leaves (plastic_surface.h patch_about).
+// a faster finger gets samples further apart rather than a patch it leaves (deformable_surface.h patch_about).
 inline constexpr std::uint32_t kDentPatchSide = 32;
 struct DentPatch {
   std::int32_t object_id = -1;  // the deformable object; -1: no patch

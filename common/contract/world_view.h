@@ -63,7 +63,7 @@ struct ViewEndpoint {
   std::array<ViewPlane, kMaxViewPlanes> planes{};
 };
 
-// The dent in a deformable object's top face (world_manager/deform/plastic_surface.h), to draw it: depths below the
+// The dent in a deformable object's top face (world_manager/deform/deformable_surface.h), to draw it: depths below the
 // face at columns × rows points of the object's body frame, point (c, r) at (x0 + c·dx, y0 + r·dy) on the face,
 // row-major (r·columns + c), the face bilinear between them. The points cover the dented cells, one per cell while
 // they fit, further apart beyond; outside them the face is undented. 32 × 32 (4 KB, sent with every snapshot): a

@@ -49,6 +49,7 @@ void visit_plane(A& a, B& b, F&& f) {
   f(a.yield_depth_mpNs, b.yield_depth_mpNs);
   f(a.yield_radius_m, b.yield_radius_m);
   f(a.yield_room_m, b.yield_room_m);
+  f(a.yield_compliance_mpN, b.yield_compliance_mpN);
   visit_shape(a.shape, b.shape, f);
   f(a.body_axis_x, b.body_axis_x);
   f(a.body_axis_y, b.body_axis_y);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// A plastic slab's cost (docs/deformation.md), on both sides of the link:
+// A deformable slab's cost (docs/deformation.md), on both sides of the link:
 //   world:  one world step's denting of a 128 × 128-cell slab (12.8 cm at 1 mm): a 5 mm stroke of push laid along
 //           its path and over the pad, then the law over the touched cells; and the penetration rule's step;
 //   haptic: the servo's tick with a finger pressing 3 mm into the slab's face and circling (2 cm radius, 6 cm/s), the
@@ -8,10 +8,11 @@
 //           world's frame comes every 50 ticks (20 Hz) and has applied the reports up to the tick before it; and the
 //           worst case of a world that never applies any (every push since the start pending, up to the record's
 //           capacity).
+//   gel:    the elastic slab of scenes/gel.json over the same cells: a world step's substeps, and its frame's patch.
 // p50, p99 and max in ns. Prints only; asserts nothing.
 
 #include "haptic_controller/servo.h"
-#include "world_manager/deform/plastic_surface.h"
+#include "world_manager/deform/deformable_surface.h"
 
 #include <algorithm>
 #include <chrono>
@@ -35,9 +36,9 @@ void print(const std::string& name, std::vector<double> ns) {
 }
 
 void world_steps() {
-  PlasticMaterial clay;
+  DeformableMaterial clay;
   const Eigen::Vector3d half_m(0.064, 0.064, 0.015);
-  PlasticSurface surface(clay, half_m, Eigen::Vector3d(0, 0, 0.015), Eigen::Quaterniond::Identity());
+  DeformableSurface surface(clay, half_m, Eigen::Vector3d(0, 0, 0.015), Eigen::Quaterniond::Identity());
   std::printf("slab: %zu × %zu cells\n", surface.columns(), surface.rows());
   std::vector<double> ns;
   for (int step = 0; step < 2000; ++step) {
@@ -51,8 +52,8 @@ void world_steps() {
     ns.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count());
   }
   print("world step, impulse rule (a 5 mm stroke laid and yielded)", ns);
-  clay.rule = PlasticMaterial::Rule::penetration;
-  PlasticSurface penetrated(clay, half_m, Eigen::Vector3d(0, 0, 0.015), Eigen::Quaterniond::Identity());
+  clay.rule = DeformableMaterial::Rule::penetration;
+  DeformableSurface penetrated(clay, half_m, Eigen::Vector3d(0, 0, 0.015), Eigen::Quaterniond::Identity());
   ns.clear();
   for (int step = 0; step < 2000; ++step) {
     const double angle = 0.125 * step;
@@ -65,6 +66,35 @@ void world_steps() {
     ns.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count());
   }
   print("world step, penetration rule (one sampled finger)", ns);
+}
+
+// The gel of scenes/gel.json over the same 128 × 128 cells: a world step (its substeps of the membrane) under a press
+// circling as above, at 20 and 10 Hz, and the frame's patch (the heights less the finger's own static response).
+void elastic_steps() {
+  DeformableMaterial gel;
+  gel.law = DeformableMaterial::Law::elastic;
+  const Eigen::Vector3d half_m(0.064, 0.064, 0.015);
+  for (const double rate_hz : {20.0, 10.0}) {
+    DeformableSurface surface(gel, half_m, Eigen::Vector3d(0, 0, 0.015), Eigen::Quaterniond::Identity());
+    const double period_s = 1.0 / rate_hz;
+    std::vector<double> ns, patch_ns;
+    DentPatch patch;
+    for (int step = 0; step < 200; ++step) {
+      const double angle = 0.125 * step;
+      const Eigen::Vector3d from_m(0.04 * std::cos(angle), 0.04 * std::sin(angle), kTop_m);
+      const Eigen::Vector3d to_m(0.04 * std::cos(angle + 0.125), 0.04 * std::sin(angle + 0.125), kTop_m);
+      const auto start = std::chrono::steady_clock::now();
+      surface.press({1.0 * period_s, from_m, to_m});  // 1 N
+      surface.yield_period(period_s);
+      const auto stepped = std::chrono::steady_clock::now();
+      surface.patch_about(surface.to_body(to_m), 0, 0.0, patch, 0);
+      ns.push_back(std::chrono::duration<double, std::nano>(stepped - start).count());
+      patch_ns.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - stepped).count());
+    }
+    const std::string rate = std::to_string(static_cast<int>(rate_hz)) + " Hz";
+    print("world step, gel at " + rate + " (1 N circling, all substeps)", ns);
+    print("frame patch, gel at " + rate + " (less the finger's response)", patch_ns);
+  }
 }
 
 Eigen::Vector3d finger_at(int tick) {
@@ -89,7 +119,7 @@ PlaneFrame frame_at(const Eigen::Vector3d& proxy_m, std::uint64_t index, std::ui
   plane.static_friction = 0.6;
   plane.dynamic_friction = 0.5;
   if (deformable) {
-    const PlasticMaterial clay;
+    const DeformableMaterial clay;
     plane.flags = kPlaneDeformable;
     plane.extent_m = clay.contact_radius_m;
     plane.yield_force_N = clay.yield_force_N();
@@ -142,6 +172,7 @@ void haptic_ticks(const std::string& name, bool deformable, bool world_applies) 
 
 int main() {
   world_steps();
+  elastic_steps();
   haptic_ticks("haptic tick, the face as a rigid box's plane", false, true);
   haptic_ticks("haptic tick, the face as clay, yielding between frames", true, true);
   haptic_ticks("haptic tick, clay, a world that applies nothing (worst)", true, false);

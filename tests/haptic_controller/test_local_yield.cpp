@@ -98,7 +98,7 @@ TEST_CASE("a deformable plane yields between frames by the pushes the world has 
   // the proxy (weight 1) and 16–20 3 mm away (weight 1 − 0.25 = 0.75).
   PlaneSet planes = test::make_set({contact_clay()});
   planes.planes[0].point_m = Vector3d(0, 0, 0.031);
-  yield.apply(frame, kSession, proxy_m, planes);
+  yield.apply(frame, kSession, proxy_m, proxy_m, 0.0, planes);
   const double expected_m = kYieldDepth_mpNs * (5 * 1e-3 + 5 * 0.75e-3);
   CHECK(planes.planes[0].point_m.z() == Approx(0.03 - expected_m).epsilon(1e-12));
   // Deeper toward the pushes 3 mm along +x, so the surface there falls away and its normal leans to +x: the slope
@@ -109,18 +109,18 @@ TEST_CASE("a deformable plane yields between frames by the pushes the world has 
   // A world that applied none of this session's reports has applied none of these pushes.
   frame.report_session_applied = kSession + 1;
   planes = test::make_set({contact_clay()});
-  yield.apply(frame, kSession, proxy_m, planes);
+  yield.apply(frame, kSession, proxy_m, proxy_m, 0.0, planes);
   CHECK(planes.planes[0].point_m.z() == Approx(0.03 - kYieldDepth_mpNs * (15 * 1e-3 + 5 * 0.75e-3)).epsilon(1e-12));
 
   // Applied up to the newest: the frame's surface as sent. Far from the pushes: nothing pending there either.
   frame.report_session_applied = kSession;
   frame.report_tick_applied = 20;
   planes = test::make_set({contact_clay()});
-  yield.apply(frame, kSession, proxy_m, planes);
+  yield.apply(frame, kSession, proxy_m, proxy_m, 0.0, planes);
   CHECK(planes.planes[0].point_m.z() == 0.03);
   frame.report_tick_applied = 0;
   planes = test::make_set({contact_clay()});
-  yield.apply(frame, kSession, proxy_m + Vector3d(0.02, 0, 0), planes);
+  yield.apply(frame, kSession, proxy_m + Vector3d(0.02, 0, 0), proxy_m + Vector3d(0.02, 0, 0), 0.0, planes);
   CHECK(planes.planes[0].point_m.z() == 0.03);
 
   // A rigid plane is left alone; a cleared record holds nothing.
@@ -128,11 +128,11 @@ TEST_CASE("a deformable plane yields between frames by the pushes the world has 
   rigid.flags = 0;
   planes = test::make_set({rigid});
   planes.planes[0].point_m.z() = 0.031;
-  yield.apply(frame, kSession, proxy_m, planes);
+  yield.apply(frame, kSession, proxy_m, proxy_m, 0.0, planes);
   CHECK(planes.planes[0].point_m.z() == 0.031);
   yield.clear();
   planes = test::make_set({contact_clay()});
-  yield.apply(frame, kSession, proxy_m, planes);
+  yield.apply(frame, kSession, proxy_m, proxy_m, 0.0, planes);
   CHECK(planes.planes[0].point_m.z() == 0.03);
 }
 
@@ -145,7 +145,7 @@ TEST_CASE("local yield keeps its newest pushes when more come than it holds, and
   CHECK(yield.forgotten() == extra);
   PlaneFrame frame = test::make_frame({clay_plane()});
   PlaneSet planes = test::make_set({contact_clay()});
-  yield.apply(frame, kSession, at_m, planes);
+  yield.apply(frame, kSession, at_m, at_m, 0.0, planes);
   CHECK(planes.planes[0].point_m.z() ==
         Approx(0.03 - kYieldDepth_mpNs * 1e-4 * static_cast<double>(LocalYield::kMaxSamples)).epsilon(1e-12));
 }
@@ -165,7 +165,7 @@ TEST_CASE("a deformable plane is taken again under the proxy from the frame's he
   LocalYield yield;
   PlaneSet planes = test::make_set({contact_clay()});
   const Vector3d proxy_m(0.0021, 0.001, 0.03);
-  yield.apply(frame, kSession, proxy_m, planes);
+  yield.apply(frame, kSession, proxy_m, proxy_m, 0.0, planes);
   const ContactPlane& plane = planes.planes[0];
   // Under the proxy: the height at x = 2.1 mm (17.6 samples in), and the wall's normal, tilted toward +x.
   CHECK(plane.point_m.x() == Approx(0.0021));
@@ -173,7 +173,7 @@ TEST_CASE("a deformable plane is taken again under the proxy from the frame's he
   CHECK((plane.normal - Vector3d(0.1, 0.0, 1.0).normalized()).norm() < 1e-12);
   // Beyond the patch: the plane the world sent.
   planes = test::make_set({contact_clay()});
-  yield.apply(frame, kSession, Vector3d(0.02, 0.0, 0.03), planes);
+  yield.apply(frame, kSession, Vector3d(0.02, 0.0, 0.03), Vector3d(0.02, 0.0, 0.03), 0.0, planes);
   CHECK(planes.planes[0].point_m == Vector3d(0, 0, 0.03));
   CHECK(planes.planes[0].normal == Vector3d::UnitZ());
 }

@@ -7,7 +7,7 @@
 #include "loop/in_process_trial.h"
 #include "tests/integration/csv_columns.h"
 #include "tests/integration/trial_support.h"
-#include "world_manager/deform/plastic_surface.h"
+#include "world_manager/deform/deformable_surface.h"
 #include "world_manager/deform/press_path.h"
 
 #include <catch2/catch.hpp>
@@ -162,7 +162,7 @@ TEST_CASE("clay stroked fast (0.5 m/s, 5 cm a 10 Hz period) is dented along the 
 // The haptic side between frames and the world at the next frame, from the same pushes: a finger stroking the clay
 // at 5 cm/s with a steady push beyond yield, the world at 20 Hz and at 10 Hz. Just before each frame, the surface
 // under the proxy is the last frame's yielded by the pushes the world has not yet applied
-// (haptic_controller/local_yield.h); just after, the world's own (world_manager/deform/plastic_surface.h), with
+// (haptic_controller/local_yield.h); just after, the world's own (world_manager/deform/deformable_surface.h), with
 // nothing pending. They must agree: a finger whose surface jumps at every frame pushes differently from one on clay
 // that yields as it is pressed.
 TEST_CASE("the surface the haptic side yields between frames is the one the world's next frame shows") {
@@ -170,11 +170,11 @@ TEST_CASE("the surface the haptic side yields between frames is the one the worl
   constexpr double kTick_s = 1e-3;
   constexpr double kSpeed_mps = 0.05;
   constexpr double kPush_Ns = 0.5e-3;  // beyond yield, every tick: 0.5 N over the yield force
-  const PlasticMaterial material;
+  const DeformableMaterial material;
   for (const int period_ticks : {50, 100}) {
     CAPTURE(period_ticks);
-    PlasticSurface surface(material, Eigen::Vector3d(0.1, 0.1, 0.015), Eigen::Vector3d(0, 0, 0.015),
-                           Eigen::Quaterniond::Identity());
+    DeformableSurface surface(material, Eigen::Vector3d(0.1, 0.1, 0.015), Eigen::Vector3d(0, 0, 0.015),
+                              Eigen::Quaterniond::Identity());
     LocalYield yield;
     PlaneFrame frame;
     frame.report_session_applied = kSession;
@@ -209,7 +209,7 @@ TEST_CASE("the surface the haptic side yields between frames is the one the worl
       PlaneSet planes;
       planes.planes[0] = to_contact_plane(frame.planes[0]);
       planes.count = 1;
-      yield.apply(frame, kSession, proxy_m, planes);
+      yield.apply(frame, kSession, proxy_m, proxy_m, 0.0, planes);
       normal = planes.planes[0].normal;
       return (proxy_m - planes.planes[0].point_m).dot(normal);
     };

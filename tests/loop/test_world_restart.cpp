@@ -124,7 +124,7 @@ TEST_CASE("a restarted world dents clay only by the push given against its own f
     servo.on_plane_frame(world->step(&servo.report()), now_s);
   }
   REQUIRE(first_world_yielding_Ns > 0.01);  // the first world was dented
-  const PlasticSurface& clay = *world->deformable(0);
+  const DeformableSurface& clay = *world->deformable(0);
   const HapticReport& report = servo.report();
   REQUIRE(report.world_session == 22);
   REQUIRE(report.entry_count == 1);

@@ -160,7 +160,7 @@ TEST_CASE("a pressed clay slab's snapshot carries its dent, and both transports 
   entry.press_point_Nsm = {0.05 * 0.01, 0.0, 0.05 * 0.03};
   entry.press_point2_Nsm2 = {0.05 * 0.01 * 0.01, 0.0, 0.05 * 0.01 * 0.03, 0.0, 0.0, 0.05 * 0.03 * 0.03};
   world.step(&report);
-  const PlasticSurface* clay = world.deformable(0);
+  const DeformableSurface* clay = world.deformable(0);
   REQUIRE(clay != nullptr);
   REQUIRE(clay->max_dent_m() > 1e-4);
   take_snapshot(world, &report, LoopStats{}, nullptr, *snapshot);

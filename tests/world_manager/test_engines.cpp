@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Every registered engine against physics it must get right, so a comparison of engines compares their models and
 // not their mistakes: Coulomb sliding, resting contact forces, sleeping, and bitwise repeatable runs.
-#include "world_manager/deform/plastic_surface.h"
+#include "world_manager/deform/deformable_surface.h"
 #include "world_manager/engine/engine_registry.h"
 #include "world_test_support.h"
 
@@ -220,9 +220,9 @@ TEST_CASE("on every engine bodies rest in the dent of a plastic slab, roll into 
     NoForces none;
     CHECK(engine->asleep(1));
     // Dents 3.5 mm deep (a push of 0.2 N·s beyond yield each, straight down at x = ∓2 cm).
-    const PlasticMaterial clay;
-    PlasticSurface surface(clay, Eigen::Vector3d(0.05, 0.05, 0.01), Eigen::Vector3d(0.0, 0.0, 0.01),
-                           Eigen::Quaterniond::Identity());
+    const DeformableMaterial clay;
+    DeformableSurface surface(clay, Eigen::Vector3d(0.05, 0.05, 0.01), Eigen::Vector3d(0.0, 0.0, 0.01),
+                              Eigen::Quaterniond::Identity());
     for (const double x_m : {-0.02, 0.02}) {
       surface.press({0.2, Eigen::Vector3d(x_m, 0.0, kTop_m), Eigen::Vector3d(x_m, 0.0, kTop_m)});
     }

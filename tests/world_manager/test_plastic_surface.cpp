@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The plastic slab (world_manager/deform/): its law, where a push lands, its limits, and its scene keys.
 
-#include "world_manager/deform/plastic_surface.h"
+#include "world_manager/deform/deformable_surface.h"
 #include "world_manager/deform/press_path.h"
 #include "world_manager/scene.h"
 
@@ -19,22 +19,22 @@ namespace {
 using Eigen::Vector3d;
 
 // A 10 × 10 × 2 cm slab centred at the origin, top face at z = 0.01, with the scene's default clay.
-PlasticSurface slab(PlasticMaterial material = {}) {
-  return PlasticSurface(material, Vector3d(0.05, 0.05, 0.01), Vector3d::Zero(), Eigen::Quaterniond::Identity());
+DeformableSurface slab(DeformableMaterial material = {}) {
+  return DeformableSurface(material, Vector3d(0.05, 0.05, 0.01), Vector3d::Zero(), Eigen::Quaterniond::Identity());
 }
 
 PressStroke at(const Vector3d& point_m, double push_Ns) { return {push_Ns, point_m, point_m}; }
 
 TEST_CASE("a plastic slab dents by the push beyond yield it is given: volume = push / flow resistance") {
-  const PlasticMaterial clay;
-  PlasticSurface surface = slab(clay);
+  const DeformableMaterial clay;
+  DeformableSurface surface = slab(clay);
   const double push_Ns = 0.01;
   surface.press(at(Vector3d(0.003, -0.002, 0.01), push_Ns));
   CHECK(surface.max_dent_m() == 0.0);  // nothing yields before the period ends
   surface.yield_period();
   CHECK(surface.yielding_Ns() == Approx(push_Ns).epsilon(1e-12));
   CHECK(surface.dent_volume_m3() * clay.flow_resistance_Paspm == Approx(push_Ns).epsilon(1e-12));
-  // The pad's centre goes in by about 2·e/(π·a²·η) (plastic_material.h), what the haptic side yields it by between
+  // The pad's centre goes in by about 2·e/(π·a²·η) (deformable_material.h), what the haptic side yields it by between
   // frames: the grid's paraboloid sampled at 1 mm cells under a 6 mm pad differs from the continuous one by a few
   // percent of the dent (the step a finger meets at the next frame).
   const double centre_m = clay.yield_depth_mpNs() * push_Ns;
@@ -49,7 +49,7 @@ TEST_CASE("a plastic slab dents by the push beyond yield it is given: volume = p
 }
 
 TEST_CASE("a plastic slab's patch of heights lies on its cells' centres, and spreads out to reach a fast finger") {
-  PlasticSurface surface = slab();
+  DeformableSurface surface = slab();
   surface.press(at(Vector3d(0.0013, 0.0004, 0.01), 0.01));
   surface.yield_period();
   DentPatch patch;
@@ -77,13 +77,13 @@ TEST_CASE("a plastic slab's patch of heights lies on its cells' centres, and spr
 }
 
 TEST_CASE("a plastic slab's threshold is the material's yield force over the contact pad") {
-  PlasticMaterial clay;
+  DeformableMaterial clay;
   clay.yield_stress_Pa = 5000.0;
   clay.contact_radius_m = 0.006;
   clay.flow_resistance_Paspm = 1e6;
   CHECK(clay.yield_force_N() == Approx(5000.0 * M_PI * 0.006 * 0.006));
   CHECK(clay.yield_depth_mpNs() == Approx(2.0 / (M_PI * 0.006 * 0.006 * 1e6)));
-  clay.rule = PlasticMaterial::Rule::penetration;  // the previous method: the push does not dent it
+  clay.rule = DeformableMaterial::Rule::penetration;  // the previous method: the push does not dent it
   CHECK(clay.yield_force_N() == 0.0);
   CHECK(clay.yield_depth_mpNs() == 0.0);
 }
@@ -150,8 +150,8 @@ TEST_CASE("a stroke is laid as precisely after an hour of pressing as at the sta
 }
 
 TEST_CASE("a plastic slab conserves a stroke's push and keeps what lands off its face as lost") {
-  const PlasticMaterial clay;
-  PlasticSurface surface = slab(clay);
+  const DeformableMaterial clay;
+  DeformableSurface surface = slab(clay);
   surface.press({0.02, Vector3d(-0.02, 0.0, 0.01), Vector3d(0.02, 0.0, 0.01)});
   surface.press(at(Vector3d(0.3, 0.0, 0.01), 0.005));  // 30 cm off the slab
   surface.yield_period();
@@ -164,8 +164,8 @@ TEST_CASE("a plastic slab conserves a stroke's push and keeps what lands off its
 }
 
 TEST_CASE("no push goes through a plastic slab: its last tenth does not yield") {
-  const PlasticMaterial clay;
-  PlasticSurface surface = slab(clay);
+  const DeformableMaterial clay;
+  DeformableSurface surface = slab(clay);
   for (int period = 0; period < 100; ++period) {
     surface.press(at(Vector3d::Zero(), 10.0));  // 200 N for 50 ms, a hundred times over
     surface.yield_period();
@@ -182,10 +182,10 @@ TEST_CASE("no push goes through a plastic slab: its last tenth does not yield") 
 }
 
 TEST_CASE("the penetration rule moves the surface by plasticity times the sampled penetration") {
-  PlasticMaterial clay;
-  clay.rule = PlasticMaterial::Rule::penetration;
+  DeformableMaterial clay;
+  clay.rule = DeformableMaterial::Rule::penetration;
   clay.plasticity = 0.5;
-  PlasticSurface surface = slab(clay);
+  DeformableSurface surface = slab(clay);
   surface.press_by_penetration(Vector3d(0.0005, 0.0005, 0.01 + 0.002));  // above: nothing
   CHECK(surface.max_dent_m() == 0.0);
   surface.press_by_penetration(Vector3d(0.0005, 0.0005, 0.01 - 0.002));  // 2 mm in, over a cell centre
@@ -196,10 +196,10 @@ TEST_CASE("the penetration rule moves the surface by plasticity times the sample
 }
 
 TEST_CASE("a tilted plastic slab takes pushes and gives planes in its own frame") {
-  const PlasticMaterial clay;
+  const DeformableMaterial clay;
   const Eigen::Quaterniond tilt(Eigen::AngleAxisd(0.3, Vector3d::UnitX()));
   const Vector3d centre_m(0.1, 0.0, 0.05);
-  PlasticSurface surface(clay, Vector3d(0.05, 0.05, 0.01), centre_m, tilt);
+  DeformableSurface surface(clay, Vector3d(0.05, 0.05, 0.01), centre_m, tilt);
   const Vector3d on_top_m = centre_m + tilt * Vector3d(0.0, 0.0, 0.01);
   Vector3d point_m, normal;
   surface.tangent_plane(surface.to_body(on_top_m + tilt * Vector3d(0, 0, 0.003)), point_m, normal);
@@ -230,8 +230,8 @@ TEST_CASE("a scene's deformable block: defaults, and errors that name the file, 
   nlohmann::json scene = clay_scene();
   const Scene parsed = parse_scene(scene, "clay.json");
   REQUIRE(parsed.objects[0].deformable.has_value());
-  CHECK(parsed.objects[0].deformable->rule == PlasticMaterial::Rule::impulse);
-  CHECK(parsed.objects[0].deformable->yield_stress_Pa == PlasticMaterial{}.yield_stress_Pa);
+  CHECK(parsed.objects[0].deformable->rule == DeformableMaterial::Rule::impulse);
+  CHECK(parsed.objects[0].deformable->yield_stress_Pa == DeformableMaterial{}.yield_stress_Pa);
 
   scene["objects"][0]["deformable"] = {{"rule", "melt"}};
   CHECK_THAT(error_of(scene), Catch::Contains("clay.json: /objects/0/deformable/rule") &&

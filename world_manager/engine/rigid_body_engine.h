@@ -25,10 +25,10 @@ class SubstepHook {
   virtual void after_substep(int /*substep*/) {}
 };
 
-// A static box's top face (its body +z face) as a grid of heights: a plastic slab (world_manager/deform/
-// plastic_surface.h). Sample (c, r), row-major at r·columns + c, is the surface's height above the box's centre along
-// its z at (c + ½, r + ½) cells from the face's −x, −y corner. The engine reads the heights whenever it collides: their
-// owner keeps them alive and in place.
+// A static box's top face (its body +z face) as a grid of heights: a deformable slab (world_manager/deform/
+// deformable_surface.h). Sample (c, r), row-major at r·columns + c, is the surface's height above the box's centre
+// along its z at (c + ½, r + ½) cells from the face's −x, −y corner. The engine reads the heights whenever it
+// collides: their owner keeps them alive and in place.
 struct DentedTop {
   std::size_t columns = 0;
   std::size_t rows = 0;

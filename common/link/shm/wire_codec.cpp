@@ -134,12 +134,12 @@ FrameError validate(const wire::PlaneFrame& frame) {
         !all_finite(plane.velocity_mps) || !all_finite(plane.angular_velocity_radps) ||
         !finite(plane.static_friction) || !finite(plane.dynamic_friction) || !finite(plane.inverse_mass_per_kg) ||
         !finite(plane.extent_m) || !finite(plane.yield_force_N) || !finite(plane.yield_depth_mpNs) ||
-        !finite(plane.yield_radius_m) || !finite(plane.yield_room_m)) {
+        !finite(plane.yield_radius_m) || !finite(plane.yield_room_m) || !finite(plane.yield_compliance_mpN)) {
       return FrameError::not_finite;
     }
     if (plane.extent_m < 0.0) return FrameError::bad_reach;
     if (plane.yield_force_N < 0.0 || plane.yield_depth_mpNs < 0.0 || plane.yield_radius_m < 0.0 ||
-        plane.yield_room_m < 0.0) {
+        plane.yield_room_m < 0.0 || plane.yield_compliance_mpN < 0.0) {
       return FrameError::bad_yield;
     }
     if (!all_finite(plane.body_axis_x) || !all_finite(plane.body_axis_y) || !all_finite(plane.shape.box_size_m) ||

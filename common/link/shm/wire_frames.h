@@ -46,6 +46,7 @@ struct Plane {
   double yield_depth_mpNs = 0.0;
   double yield_radius_m = 0.0;
   double yield_room_m = 0.0;
+  double yield_compliance_mpN = 0.0;
   Shape shape;
   Vec3 body_axis_x{};
   Vec3 body_axis_y{};
