@@ -25,10 +25,12 @@ const std::string kGel = std::string(IMPETUS_SOURCE_DIR) + "/scenes/gel.json";
 constexpr double kSurface_m = 0.03;  // the gel's top face
 constexpr double kStiffness_Npm = 2000.0;  // the scene's haptic spring
 
-nlohmann::json trial(const std::filesystem::path& dir, const std::string& trajectory, double rate_hz) {
+nlohmann::json trial(const std::filesystem::path& dir, const std::string& trajectory, double rate_hz,
+                     const std::vector<std::string>& fingers = {}) {
   InProcessTrialOptions options;
   options.scene_path = kGel;
   options.trajectory = trajectory;
+  options.fingers = fingers;
   options.world_rate_hz = rate_hz;
   options.out_dir = dir;
   return run_in_process_trial(options);
@@ -43,9 +45,9 @@ struct Held {
   double world_dent_m = 0.0;  // the world's deepest cell at the window's end
 };
 
-// The last 0.3 s of a 1.2 s hold but its final 50 ms.
-Held held(const std::filesystem::path& dir) {
-  const auto haptic = test::read_csv_columns(dir / "haptic.csv");
+// The last 0.3 s of a 1.2 s hold but its final 50 ms, of the finger that logs to `haptic_log`.
+Held held(const std::filesystem::path& dir, const std::string& haptic_log = "haptic.csv") {
+  const auto haptic = test::read_csv_columns(dir / haptic_log);
   const auto world = test::read_csv_columns(dir / "world.csv");
   const std::vector<double>& time_s = haptic.at("time_s");
   REQUIRE(time_s.size() > 100);
@@ -102,6 +104,28 @@ TEST_CASE("a finger pressing the gel feels the spring and the gel in series, the
       CHECK(h.force_N == Approx(reference_N).epsilon(0.01));
     }
   }
+}
+
+TEST_CASE("two fingers on the gel each feel and make what one finger alone does, at 10 Hz") {
+  // 6 cm apart (30 of the gel's decay lengths): neither dent reaches the other finger. Each finger's frame leaves out
+  // its own share and shows the other's, so each feels the same as alone: were its own share shown, it would feel
+  // its own dent a period late on top of the one the haptic side renders.
+  const auto press = [](double x_m) {
+    return "press:x=" + std::to_string(x_m) + ",y=0,surface_z=" + std::to_string(kSurface_m) + ",depth=0.006,hold=1.2";
+  };
+  const std::filesystem::path alone_dir = test::out_dir("gel-one-finger");
+  const std::filesystem::path both_dir = test::out_dir("gel-two-fingers");
+  const nlohmann::json alone = trial(alone_dir, press(-0.03), 10.0);
+  const nlohmann::json both = trial(both_dir, "", 10.0, {"a=" + press(-0.03), "b=" + press(0.03)});
+  const Held one = held(alone_dir);
+  const Held first = held(both_dir, "haptic.csv");
+  const Held second = held(both_dir, "haptic.endpoint1.csv");
+  REQUIRE(one.force_N > 0.3);
+  CHECK(first.force_N == Approx(one.force_N).epsilon(1e-6));
+  CHECK(second.force_N == Approx(one.force_N).epsilon(1e-6));
+  // The world's gel holds both dents, each as deep as the one alone.
+  CHECK(first.world_dent_m == Approx(one.world_dent_m).epsilon(1e-6));
+  CHECK(gel(both)["max_dent_m"].get<double>() == Approx(gel(alone)["max_dent_m"].get<double>()).epsilon(1e-6));
 }
 
 TEST_CASE("the gel springs back flat once the finger leaves, and its energy books balance") {

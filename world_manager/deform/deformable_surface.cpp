@@ -181,19 +181,21 @@ void DeformableSurface::deepen(std::size_t cell, double by_m) {
   volume_m3_ += (new_m - depth_m) * area_m2;
   if (new_m > depth_m) {
     changed_ = true;
-    const std::size_t column = cell % columns_;
-    const std::size_t row = cell / columns_;
-    dented_column_lo_ = dented_ ? std::min(dented_column_lo_, column) : column;
-    dented_column_hi_ = dented_ ? std::max(dented_column_hi_, column) : column;
-    dented_row_lo_ = dented_ ? std::min(dented_row_lo_, row) : row;
-    dented_row_hi_ = dented_ ? std::max(dented_row_hi_, row) : row;
-    dented_ = true;
+    mark_dented(cell % columns_, cell / columns_);
   }
   depth_m = new_m;
   top_m_[cell] = half_size_m_.z() - new_m;
   lowest_m_ = std::min(lowest_m_, top_m_[cell]);
   max_dent_m_ = std::max(max_dent_m_, depth_m);
   dent_m_ = max_dent_m_;
+}
+
+void DeformableSurface::mark_dented(std::size_t column, std::size_t row) {
+  dented_column_lo_ = dented_ ? std::min(dented_column_lo_, column) : column;
+  dented_column_hi_ = dented_ ? std::max(dented_column_hi_, column) : column;
+  dented_row_lo_ = dented_ ? std::min(dented_row_lo_, row) : row;
+  dented_row_hi_ = dented_ ? std::max(dented_row_hi_, row) : row;
+  dented_ = true;
 }
 
 void DeformableSurface::remeasure() {
@@ -210,13 +212,7 @@ void DeformableSurface::remeasure() {
       lowest_m = std::min(lowest_m, top_m_[cell]);
       deepest_m = std::max(deepest_m, depth_m);
       volume_m3 += depth_m * area_m2;
-      if (std::abs(depth_m) > kMoved_m) {
-        dented_column_lo_ = dented_ ? std::min(dented_column_lo_, c) : c;
-        dented_column_hi_ = dented_ ? std::max(dented_column_hi_, c) : c;
-        dented_row_lo_ = dented_ ? std::min(dented_row_lo_, r) : r;
-        dented_row_hi_ = dented_ ? std::max(dented_row_hi_, r) : r;
-        dented_ = true;
-      }
+      if (std::abs(depth_m) > kMoved_m) mark_dented(c, r);
     }
   }
   lowest_m_ = lowest_m;

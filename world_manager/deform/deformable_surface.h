@@ -132,6 +132,8 @@ class DeformableSurface {
   // the cells it meets; returns false if it meets none.
   bool spread(double x_m, double y_m, double amount, std::vector<double>& grid, bool touch);
   void deepen(std::size_t cell, double by_m);
+  // Widens the dented rectangle to take in a cell.
+  void mark_dented(std::size_t column, std::size_t row);
   // Elastic: after the membrane moved, the tops, the deepest, the volume and the moved rectangle again.
   void remeasure();
   // Bilinear in `grid`'s cell values between their centres, constant beyond the outer centres.
