@@ -110,20 +110,5 @@ TEST_CASE("scene error: a mesh file missing, unreadable, open for a dynamic body
   CHECK(error_of(dir, unknown).find("size_m") != std::string::npos);
 }
 
-TEST_CASE("a mesh on an engine that cannot collide meshes is refused, naming the object and the engine to use") {
-  const std::filesystem::path dir = fresh_dir("engine");
-  test::write_obj(test::box_mesh(Vector3d(0.02, 0.02, 0.02)), (dir / "parts/box.obj").string());
-  Scene scene = load(dir, mesh_object("parts/box.obj", true));
-  scene.physics.engine = "bullet";
-  try {
-    test::make_world(scene);
-    FAIL("expected the bullet engine to refuse a mesh");
-  } catch (const SceneError& error) {
-    const std::string message = error.what();
-    CHECK(message.find("'part'") != std::string::npos);
-    CHECK(message.find("\"engine\": \"ode\"") != std::string::npos);
-  }
-}
-
 }  // namespace
 }  // namespace impetus

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/engine/bullet_engine.h"
 
+#include "common/mesh/mesh_body.h"
+#include "common/shape/mesh_geometry.h"
 #include "world_manager/engine/escape_guard.h"
 #include "world_manager/engine/sleeping_bodies.h"
 #include "world_manager/engine/speculative_contacts.h"
@@ -10,7 +12,11 @@
 #include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
 #include <BulletDynamics/MLCPSolvers/btMLCPSolver.h>
 #include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
+#include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
+#include <BulletCollision/Gimpact/btGImpactShape.h>
 #include <btBulletDynamicsCommon.h>
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -54,7 +60,55 @@ btScalar combined_damping(const btCollisionObject* a, const btCollisionObject* b
   return std::min(a->getContactDamping(), b->getContactDamping());
 }
 
-std::unique_ptr<btCollisionShape> make_shape(const SceneObject& object) {
+// What a mesh's shape needs kept as long as it: Bullet's view of the triangles, and the vertices turned to the body's
+// principal axes where they are not the file's.
+struct MeshArrays {
+  std::vector<std::unique_ptr<btTriangleIndexVertexArray>> views;
+  std::vector<std::unique_ptr<std::vector<Eigen::Vector3d>>> turned_vertices_m;
+};
+
+// A mesh's triangles for Bullet (docs/meshes.md), read in place from the loaded MeshBody (which lives as long as the
+// process): a static mesh as a BVH of its triangles, a dynamic one as a GImpact shape (a BVH of triangles that
+// moves), its vertices turned by `to_principal` (Bullet's body frame is the principal axes of inertia).
+std::unique_ptr<btCollisionShape> make_mesh_shape(const SceneObject& object, const Eigen::Matrix3d& to_principal,
+                                                  MeshArrays& arrays) {
+  const auto* body = dynamic_cast<const MeshBody*>(find_mesh_geometry(object.shape.mesh_hash));
+  if (body == nullptr) throw SceneError("object '" + object.name + "': its mesh was not loaded");
+  const TriangleMesh& mesh = body->bvh().mesh();
+  const std::vector<Eigen::Vector3d>* vertices_m = &mesh.vertices_m;
+  if (!to_principal.isIdentity(0.0)) {
+    auto turned = std::make_unique<std::vector<Eigen::Vector3d>>(mesh.vertices_m.size());
+    for (std::size_t k = 0; k < mesh.vertices_m.size(); ++k) (*turned)[k] = to_principal * mesh.vertices_m[k];
+    vertices_m = turned.get();
+    arrays.turned_vertices_m.push_back(std::move(turned));
+  }
+  btIndexedMesh part;
+  part.m_numTriangles = static_cast<int>(mesh.triangles.size());
+  part.m_triangleIndexBase = reinterpret_cast<const unsigned char*>(mesh.triangles.data());
+  part.m_triangleIndexStride = static_cast<int>(sizeof(mesh.triangles[0]));
+  part.m_numVertices = static_cast<int>(vertices_m->size());
+  part.m_vertexBase = reinterpret_cast<const unsigned char*>(vertices_m->data());
+  part.m_vertexStride = static_cast<int>(sizeof(Eigen::Vector3d));
+  part.m_indexType = PHY_INTEGER;
+  part.m_vertexType = PHY_DOUBLE;
+  auto array = std::make_unique<btTriangleIndexVertexArray>();
+  array->addIndexedMesh(part, PHY_INTEGER);
+  std::unique_ptr<btCollisionShape> out;
+  if (object.dynamic) {
+    auto moving = std::make_unique<btGImpactMeshShape>(array.get());
+    moving->setMargin(0.0);  // a triangle's margin lies outside it: the mesh would stand off by it
+    moving->updateBound();
+    out = std::move(moving);
+  } else {
+    out = std::make_unique<btBvhTriangleMeshShape>(array.get(), true);
+    out->setMargin(0.0);
+  }
+  arrays.views.push_back(std::move(array));
+  return out;
+}
+
+std::unique_ptr<btCollisionShape> make_shape(const SceneObject& object, const Eigen::Matrix3d& to_principal,
+                                             MeshArrays& arrays) {
   const Shape& shape = object.shape;
   std::unique_ptr<btCollisionShape> out;
   switch (shape.kind) {
@@ -69,9 +123,8 @@ std::unique_ptr<btCollisionShape> make_shape(const SceneObject& object) {
     case ShapeKind::cylinder:
       out = std::make_unique<btCylinderShapeZ>(btVector3(shape.radius_m, shape.radius_m, shape.length_m / 2.0));
       break;
-    case ShapeKind::mesh:  // docs/meshes.md: ODE collides meshes; this adapter does not yet
-      throw SceneError("object '" + object.name + "': the bullet engine does not collide meshes yet; use " +
-                       "\"engine\": \"ode\" (the default)");
+    case ShapeKind::mesh:
+      return make_mesh_shape(object, to_principal, arrays);
     case ShapeKind::none:
       throw SceneError("object '" + object.name + "' has no shape");
   }
@@ -148,7 +201,8 @@ std::unique_ptr<btSequentialImpulseConstraintSolver> make_solver(const BulletPar
 }  // namespace
 
 struct BulletEngine::World final : EscapeGuard::Engine {
-  explicit World(const Scene& s) : scene(&s) {}
+  // GImpact's algorithms (a moving mesh against anything) join the dispatcher's.
+  explicit World(const Scene& s) : scene(&s) { btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher); }
 
   const Scene* scene;
   // Declared before the world, so the world (which holds them) goes first.
@@ -157,6 +211,14 @@ struct BulletEngine::World final : EscapeGuard::Engine {
   btDbvtBroadphase broadphase;
   btDantzigSolver dantzig;
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver = make_solver(scene->physics.bullet, dantzig);
+  MeshArrays mesh_arrays;  // the meshes' triangles, for their shapes
+  // Per object, Bullet's body frame in ours: its principal axes of inertia (Bullet takes a diagonal inertia), the
+  // identity but for a mesh whose principal axes are not its file's. Bullet's orientation is ours times this.
+  std::vector<btQuaternion> principal;
+  Eigen::Quaterniond ours(std::size_t id, const btQuaternion& q) const {
+    const btQuaternion o = q * principal[id].inverse();
+    return Eigen::Quaterniond(o.w(), o.x(), o.y(), o.z());
+  }
   std::vector<std::unique_ptr<btCollisionShape>> shapes;  // per object, the floor's last
   std::vector<std::unique_ptr<btRigidBody>> bodies;       // per object (static ones have no mass); the floor last
   // Dented tops (dent_top): per object, the heightfield beside its box (nullptr: none), and its shape.
@@ -209,7 +271,7 @@ struct BulletEngine::World final : EscapeGuard::Engine {
   std::optional<EscapeGuard::BodyState> escape_state(std::size_t id) const override {
     if (!is_dynamic(id) || parked[id]) return std::nullopt;
     const btRigidBody& b = body(id);
-    const btQuaternion q = b.getWorldTransform().getRotation();
+    const Eigen::Quaterniond q = ours(id, b.getWorldTransform().getRotation());
     return EscapeGuard::BodyState{to_eigen(b.getWorldTransform().getOrigin()), to_eigen(b.getLinearVelocity()),
                                   to_eigen(b.getAngularVelocity()), Eigen::Vector4d(q.w(), q.x(), q.y(), q.z())};
   }
@@ -217,7 +279,7 @@ struct BulletEngine::World final : EscapeGuard::Engine {
     btRigidBody& b = body(id);
     world.removeRigidBody(&b);  // out of the solver, gravity and collisions
     btTransform transform = b.getWorldTransform();
-    if (reset_orientation) transform.setRotation(btQuaternion::getIdentity());
+    if (reset_orientation) transform.setRotation(principal[id]);
     transform.setOrigin(to_bt(position_m));
     b.setWorldTransform(transform);
     b.setLinearVelocity(btVector3(0, 0, 0));
@@ -299,6 +361,7 @@ BulletEngine::BulletEngine(const Scene& scene) : bullet_(std::make_unique<World>
   w.contact_damping_Nspm = damping_Nspm;
   const std::size_t count = scene.objects.size();
   w.inverse_inertia_body.assign(count, Eigen::Matrix3d::Zero());
+  w.principal.assign(count, btQuaternion::getIdentity());
   w.tops.resize(count);
   w.parked.assign(count, false);
   w.pending_force_N.assign(count, Eigen::Vector3d::Zero());
@@ -313,19 +376,31 @@ BulletEngine::BulletEngine(const Scene& scene) : bullet_(std::make_unique<World>
   };
   for (std::size_t id = 0; id < count; ++id) {
     const SceneObject& object = scene.objects[id];
-    w.shapes.push_back(make_shape(object));
-    btTransform transform;
-    const auto& q = object.orientation_wxyz;
-    transform.setRotation(btQuaternion(q[1], q[2], q[3], q[0]));
-    transform.setOrigin(to_bt(object.position_m));
     const double mass_kg = object.dynamic ? object.mass_kg : 0.0;
     btVector3 inertia(0, 0, 0);
+    Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  // the principal axes, columns in our body frame
     if (object.dynamic) {
-      // The primitives' inertia is diagonal in the body frame (shape.h).
+      // The primitives' inertia is diagonal in the body frame (shape.h); a mesh's may not be, and Bullet takes a
+      // diagonal one: its body frame is then the principal axes, I = R·diag(λ)·Rᵀ, R a rotation.
       const Eigen::Matrix3d exact = inertia_kgm2(object.shape, object.mass_kg);
-      inertia = btVector3(exact(0, 0), exact(1, 1), exact(2, 2));
+      Eigen::Vector3d principal_kgm2 = exact.diagonal();
+      const double off_diagonal = (exact - Eigen::Matrix3d(exact.diagonal().asDiagonal())).cwiseAbs().maxCoeff();
+      if (off_diagonal > 1e-12 * exact.trace()) {
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(exact);
+        axes = solver.eigenvectors();
+        if (axes.determinant() < 0.0) axes.col(2) = -axes.col(2);
+        principal_kgm2 = solver.eigenvalues();
+      }
+      inertia = to_bt(principal_kgm2);
       w.inverse_inertia_body[id] = exact.inverse();
     }
+    const Eigen::Quaterniond turn(axes);
+    w.principal[id] = btQuaternion(turn.x(), turn.y(), turn.z(), turn.w());
+    w.shapes.push_back(make_shape(object, axes.transpose(), w.mesh_arrays));
+    btTransform transform;
+    const auto& q = object.orientation_wxyz;
+    transform.setRotation(btQuaternion(q[1], q[2], q[3], q[0]) * w.principal[id]);
+    transform.setOrigin(to_bt(object.position_m));
     btRigidBody::btRigidBodyConstructionInfo info(mass_kg, nullptr, w.shapes.back().get(), inertia);
     info.m_startWorldTransform = transform;
     w.bodies.push_back(std::make_unique<btRigidBody>(info));
@@ -370,9 +445,8 @@ BulletEngine::~BulletEngine() = default;
 
 void BulletEngine::read_state(std::size_t id, ObjectState& out) const {
   const btRigidBody& b = bullet_->body(id);
-  const btQuaternion q = b.getWorldTransform().getRotation();
   out.pose.position_m = to_eigen(b.getWorldTransform().getOrigin());
-  out.pose.orientation = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z());
+  out.pose.orientation = bullet_->ours(id, b.getWorldTransform().getRotation());
   out.velocity_mps = to_eigen(b.getLinearVelocity());
   out.angular_velocity_radps = to_eigen(b.getAngularVelocity());
 }
