@@ -424,18 +424,17 @@ void DeformableSurface::patch_about(const Eigen::Vector3d& body_m, std::int32_t 
   patch.axis_x = to_vec3(orientation_ * Eigen::Vector3d::UnitX());
   patch.axis_y = to_vec3(orientation_ * Eigen::Vector3d::UnitY());
   patch.spacing_m = spacing_m;
+  if (membrane_ && !shared_ && solo_ == slot) {
+    // Elastic, the only endpoint that pushed: its share is the whole surface, and the surface without it the face.
+    std::fill(patch.height_m.begin(), patch.height_m.end(), half_size_m_.z());
+    return;
+  }
   for (std::uint32_t j = 0; j < kDentPatchSide; ++j) {
     for (std::uint32_t i = 0; i < kDentPatchSide; ++i) {
       patch.height_m[j * kDentPatchSide + i] = height_m(x0_m + i * spacing_m, y0_m + j * spacing_m);
     }
   }
-  if (!membrane_) return;
-  if (!shared_ && solo_ == slot) {
-    // The only endpoint that pushed: its share is the whole surface, and the surface without it the face.
-    std::fill(patch.height_m.begin(), patch.height_m.end(), half_size_m_.z());
-    return;
-  }
-  if (slot >= own_.size() || !own_[slot].membrane) return;
+  if (!membrane_ || slot >= own_.size() || !own_[slot].membrane) return;
   const std::vector<double>& own_m = own_[slot].depth_m;
   for (std::uint32_t j = 0; j < kDentPatchSide; ++j) {
     for (std::uint32_t i = 0; i < kDentPatchSide; ++i) {
