@@ -199,6 +199,30 @@ TEST_CASE("the penetration rule holds an elastic slab where the sampled contact 
   CHECK(material.yield_depth_mpNs() == 0.0);
 }
 
+TEST_CASE("under the penetration rule a second finger's first pin is its own share, not the first finger's") {
+  DeformableMaterial material = gel();
+  material.rule = DeformableMaterial::Rule::penetration;
+  DeformableSurface surface = slab(material);
+  const double period_s = 0.05;
+  const Vector3d first_m(-0.0195, 0.0005, 0.008);  // 2 mm in
+  const Vector3d second_m(0.0205, 0.0005, 0.008);  // 4 cm away
+  surface.press_by_penetration(first_m, 0);
+  surface.yield_period(period_s);
+  surface.press_by_penetration(first_m, 0);
+  surface.press_by_penetration(second_m, 1);  // its first: the shares split here
+  surface.yield_period(period_s);
+  DentPatch patch;
+  // The first finger's wide patch about the middle: the second's pinned dent shows whole in it.
+  surface.patch_about(Vector3d(0.0005, 0.0005, 0.01), 0, 0.03, patch, 0);
+  const long u = std::lround((second_m.x() - patch.origin_m[0]) / patch.spacing_m);
+  const long v = std::lround((second_m.y() - patch.origin_m[1]) / patch.spacing_m);
+  const double sample_x_m = patch.origin_m[0] + static_cast<double>(u) * patch.spacing_m;
+  const double sample_y_m = patch.origin_m[1] + static_cast<double>(v) * patch.spacing_m;
+  const double height_m = patch.height_m[static_cast<std::size_t>(v) * kDentPatchSide + static_cast<std::size_t>(u)];
+  CHECK(height_m < 0.01 - 1e-4);
+  CHECK(height_m == Approx(surface.height_m(sample_x_m, sample_y_m)).margin(1e-9));
+}
+
 TEST_CASE("an elastic slab's scene keys: defaults, and errors that name the file, the key and the value") {
   nlohmann::json scene = nlohmann::json::parse(R"({
     "objects": [{"name": "gel", "shape": "box", "size_m": [0.1, 0.1, 0.03], "dynamic": false,

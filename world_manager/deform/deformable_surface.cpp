@@ -277,8 +277,10 @@ void DeformableSurface::press_by_penetration(const Eigen::Vector3d& finger_m, st
   const Eigen::Vector3d body_m = to_body(finger_m);
   if (!over_face(body_m)) return;
   if (membrane_) {
+    // The share first: a second endpoint's first pin splits the shares, and the first endpoint's takes the pins so far.
+    OwnShare* share = own(slot);
     pin_under(body_m, pin_m_);
-    if (OwnShare* share = own(slot)) pin_under(body_m, share->pin_m);
+    if (share != nullptr) pin_under(body_m, share->pin_m);
     pinned_ = true;
     return;
   }
