@@ -40,6 +40,7 @@ void check_accepted(const PlaneFrame& frame) {
              std::isfinite(frame.damping_Nspm) && all_finite(frame.gravity_mps2));
   FUZZ_CHECK(std::isfinite(frame.world_period_s) && frame.world_period_s > 0.0);
   FUZZ_CHECK(std::isfinite(frame.reach_radius_m) && frame.reach_radius_m >= 0.0);
+  FUZZ_CHECK(frame.port_layer <= 1 && std::isfinite(frame.port_returned_J) && frame.port_returned_J >= 0.0);
   FUZZ_CHECK(frame.coupling == Coupling::impulse || frame.coupling == Coupling::position ||
              frame.coupling == Coupling::local);
   for (std::uint32_t k = 0; k < frame.plane_count; ++k) {

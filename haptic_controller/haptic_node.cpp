@@ -300,6 +300,12 @@ nlohmann::json HapticNode::endpoint_summary(const Endpoint& endpoint) const {
     impulses[std::to_string(entry.object_id)] = {entry.impulse_Ns[0], entry.impulse_Ns[1], entry.impulse_Ns[2]};
   }
   const Eigen::Vector3d& abandoned = endpoint.servo.accumulator().abandoned_impulse_Ns();
+  // The passivity layer's half at the hand (hand_port.h): zeros with the layer off.
+  const HandPortBooks& hand = endpoint.servo.hand_port().books();
+  const nlohmann::json hand_port = {{"input_J", hand.input_J},       {"output_J", hand.output_J},
+                                    {"credited_J", hand.credited_J}, {"returned_J", hand.returned_J},
+                                    {"damped_J", hand.damped_J},     {"reservoir_J", hand.reservoir_J()},
+                                    {"interventions", hand.interventions}};
   return {{"endpoint", report.endpoint},
           {"haptic_session", options_.haptic_session},
           {"faults", counters.faults},
@@ -316,6 +322,7 @@ nlohmann::json HapticNode::endpoint_summary(const Endpoint& endpoint) const {
           {"local_replayed_ticks_max", counters.local_replayed_ticks_max},
           {"local_replay_gaps", counters.local_replay_gaps},
           {"local_unlogged_shares", counters.local_unlogged_shares},
+          {"hand_port", hand_port},
           {"log_rows_dropped", endpoint.log ? endpoint.log->dropped() : 0},
           {"max_force_N", endpoint.max_force_N},
           {"stiffness_Npm", endpoint.stiffness_Npm},

@@ -152,8 +152,8 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     // taken here, at the haptic rate, so the dent does not depend on how the world's period cut the push).
     const double press_Ns =
         plane.deformable() ? std::max(0.0, -impulse_Ns.dot(plane.normal) - plane.yield_force_N * dt_s) : 0.0;
-    last_shares_[static_cast<std::size_t>(last_share_count_++)] = {plane.object_id, plane.dynamic(), impulse_Ns,
-                                                                   angular_Nms, press_Ns};
+    ImpulseShare& share = last_shares_[static_cast<std::size_t>(last_share_count_++)];
+    share = {plane.object_id, plane.dynamic(), impulse_Ns, angular_Nms, press_Ns};
     if (!plane.dynamic() && !plane.deformable()) {
       add_to(report_.static_impulse_Ns, impulse_Ns);
       continue;
@@ -169,7 +169,9 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     // First moments in time (common/contract/frames.h ObjectImpulse): where in the world period this impulse belongs.
     add_to(entry->impulse_moment_Nss, impulse_Ns * report_.haptic_time_s);
     add_to(entry->angular_impulse_moment_Nmss, angular_Nms * report_.haptic_time_s);
-    entry->hand_input_J += std::max(0.0, impulse_Ns.dot(finger_velocity_mps));
+    share.credit_J = std::max(0.0, impulse_Ns.dot(finger_velocity_mps));
+    share.entry = entry;
+    entry->hand_input_J += share.credit_J;
     if (press_Ns > 0.0) {
       const Eigen::Vector3d& x_m = contact.proxy_m;
       entry->press_Ns += press_Ns;
@@ -184,6 +186,33 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
     }
     entry->last_tick = tick;
   }
+}
+
+bool ImpulseAccumulator::pushed_dynamic() const {
+  for (int j = 0; j < last_share_count_; ++j) {
+    const ImpulseShare& share = last_shares_[static_cast<std::size_t>(j)];
+    if (share.dynamic && share.entry != nullptr && share.impulse_Ns.norm() > 0.0) return true;
+  }
+  return false;
+}
+
+double ImpulseAccumulator::set_last_credit(double energy_J) {
+  double weight_Ns = 0.0;
+  for (int j = 0; j < last_share_count_; ++j) {
+    const ImpulseShare& share = last_shares_[static_cast<std::size_t>(j)];
+    if (share.dynamic && share.entry != nullptr) weight_Ns += share.impulse_Ns.norm();
+  }
+  const double total_J = energy_J > 0.0 && std::isfinite(energy_J) && weight_Ns > 0.0 ? energy_J : 0.0;
+  double credited_J = 0.0;
+  for (int j = 0; j < last_share_count_; ++j) {
+    ImpulseShare& share = last_shares_[static_cast<std::size_t>(j)];
+    if (share.entry == nullptr) continue;
+    const double part_J = share.dynamic && weight_Ns > 0.0 ? total_J * share.impulse_Ns.norm() / weight_Ns : 0.0;
+    share.entry->hand_input_J += part_J - share.credit_J;
+    share.credit_J = part_J;
+    credited_J += part_J;
+  }
+  return credited_J;
 }
 
 }  // namespace impetus

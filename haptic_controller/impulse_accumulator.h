@@ -57,6 +57,8 @@ struct ImpulseShare {
   Eigen::Vector3d impulse_Ns = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_impulse_Nms = Eigen::Vector3d::Zero();  // about the plane's com_m
   double yielding_Ns = 0.0;  // a deformable plane's push beyond yield (ObjectImpulse::press_Ns's part), else 0
+  double credit_J = 0.0;     // the energy this share credited to its entry's hand_input_J
+  ObjectImpulse* entry = nullptr;  // its entry in the report (nullptr: static, or dropped)
 };
 
 class ImpulseAccumulator {
@@ -82,6 +84,13 @@ class ImpulseAccumulator {
   // Rendered against a world session that ended before applying it (objects and static geometry).
   const Eigen::Vector3d& abandoned_impulse_Ns() const { return abandoned_Ns_; }
   std::uint64_t dropped_shares() const { return dropped_shares_; }
+
+  // Whether the last add() pushed a dynamic object that has an entry (a push the world can credit energy to).
+  bool pushed_dynamic() const;
+  // Makes the energy the last add() credited to the world behind its pushes on dynamic objects `energy_J` in all, in
+  // place of Σ max(0, J_k·v_k), shared in proportion to |J_k| (the passivity layer's hand, hand_port.h, decides how
+  // much). Returns what it credited: 0 when the last add() pushed no dynamic object with an entry.
+  double set_last_credit(double energy_J);
 
   // The shares of the last add(), one per active constraint (empty when nothing was pushed).
   const ImpulseShare* last_shares() const { return last_shares_.data(); }

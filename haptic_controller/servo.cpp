@@ -47,6 +47,7 @@ void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   have_frame_ = true;
   frame_arrival_s_ = now_s;
   accumulator_.on_plane_frame(frame);
+  hand_port_.on_plane_frame(frame);
 }
 
 void HapticServo::measure_frame_boundary(const ProxySolution& contact) {
@@ -94,6 +95,7 @@ void HapticServo::measure_frame_boundary(const ProxySolution& contact) {
 
 void HapticServo::idle_tick(bool fault) {
   watched_count_ = 0;
+  hand_port_.idle();
   renderer_.reset();
   result_.force_N = {};
   accumulator_.report().force_N = {};
@@ -134,8 +136,9 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   }
   const double hold_s = std::min(dt_s, kCommandStale_s);
   const Eigen::Vector3d finger_m = finger->position_m;
+  const bool paired_finger = finger_known_ && dt_s > 0.0 && std::isfinite(dt_s);  // a displacement since the last tick
   const Eigen::Vector3d finger_velocity_mps =
-      finger_known_ && dt_s > 0.0 ? Eigen::Vector3d((finger_m - finger_m_) / dt_s) : Eigen::Vector3d::Zero();
+      paired_finger ? Eigen::Vector3d((finger_m - finger_m_) / dt_s) : Eigen::Vector3d::Zero();
   if (!finger_known_) god_object_.begin_finger_session(finger_m);  // a finger that appears inside an object is not kicked
   finger_m_ = finger_m;
   finger_known_ = true;
@@ -217,6 +220,23 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
                       accumulator_.last_share_count());
   // The objects give way at the haptic rate (local coupling, paper §6.3): this tick's shares move the model.
   if (have_frame_) motion_->take_shares(accumulator_.last_shares(), accumulator_.last_share_count());
+
+  // 5b. With the passivity layer on, the finger gets no more energy than it put in and the world handed back, and
+  //     the world gets what the proxy's spring would not give back (hand_port.h); the objects keep the reaction of
+  //     the contact force.
+  if (hand_port_.active()) {
+    const double stored_J = contact.contact.active_count > 0
+                                ? 0.5 * stiffness_Npm * (contact.contact.proxy_m - finger_m).squaredNorm()
+                                : 0.0;
+    const Eigen::Vector3d displacement_m = finger_velocity_mps * dt_s;
+    const HandPortTick port = hand_port_.tick(force_N, paired_finger ? &displacement_m : nullptr,
+                                              accumulator_.pushed_dynamic(), stored_J);
+    hand_port_.credit(accumulator_.set_last_credit(port.credit_J));
+    result_.force_N = to_vec3(port.force_N);
+    report.force_N = result_.force_N;
+  } else {
+    hand_port_.idle();
+  }
 
   // 6. The device renders it (docs/architecture.md §1.2 step 6: the haptic node commands the device).
   result_.render = true;

@@ -12,6 +12,7 @@
 #include "haptic_controller/device/haptic_device.h"
 #include "haptic_controller/force_renderer.h"
 #include "haptic_controller/god_object.h"
+#include "haptic_controller/hand_port.h"
 #include "haptic_controller/impulse_accumulator.h"
 #include "haptic_controller/local_dynamics.h"
 #include "haptic_controller/local_yield.h"
@@ -107,6 +108,7 @@ class HapticServo {
   const ImpulseAccumulator& accumulator() const { return accumulator_; }
   const PlaneSet& planes() const { return planes_; }  // the interpolated planes of the last tick
   const LocalDynamics& local_dynamics() const { return local_; }  // local coupling's model (tests)
+  const HandPort& hand_port() const { return hand_port_; }  // the passivity layer's half at the hand
 
  private:
   void idle_tick(bool fault);
@@ -135,6 +137,7 @@ class HapticServo {
   InterpolatedPlanes interpolated_;
   LocalDynamics local_;
   LocalYield local_yield_;  // deformable surfaces between frames
+  HandPort hand_port_;
   PlaneMotion* motion_ = &interpolated_;  // the coupling's, chosen by each frame
   bool frame_since_last_tick_ = false;
   std::array<WatchedPlane, kMaxActiveConstraints + 1> watched_{};

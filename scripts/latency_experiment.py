@@ -10,8 +10,8 @@ have no delay line, so the package must be built (scripts/build.sh).
          a round trip after the start, and a finger that strikes before would meet a cube nobody told it about),
          world 20 Hz, PHASES world-clock phases per (coupling, delay) for position, impulse and local coupling, and
          position and impulse coupling with the world's passivity layer (COUPLING+layer, world_manager --passivity
-         on; the energy it withheld from pushes, as predicted, plus what it damped out of bodies is the "layer
-         withheld + damped" column): the
+         on; the energy it withheld from pushes, as predicted, plus what it damped out of bodies and off the fingers
+         is the "layer withheld + damped" column): the
          cube's stop position (mean, phase spread, bias against the zero-delay single-rate 1 kHz reference as
          scripts/phase_experiment.py computes it), and stability: the largest energy
          gain beyond the hand's work (impetus_py/energy.py), the largest finger force, and how many separate contacts
@@ -122,6 +122,15 @@ def energy_gain(out_dir, summary, scene, devices, phase_ticks):
     return balance["excess_J"], balance["tolerance_J"]
 
 
+def layer_cost_J(summary):
+    """What the passivity layer held back in a trial, J: the energy the world withheld from pushes (as predicted) and
+    damped out of bodies (world_manager/couplings/passivity_layer.h), and what the hands' dampers took from the
+    force on the fingers (haptic_controller/hand_port.h)."""
+    port = summary.world["port"]
+    hands = summary.haptic.get("endpoints", [summary.haptic])
+    return port["withheld_J"] + port["damped_J"] + sum(h.get("hand_port", {}).get("damped_J", 0.0) for h in hands)
+
+
 def hard_case_trial(out_dir, scene, trajectory, label, phase_ticks, delay_ms):
     """One trial of a hard case's scene: (its hard_cases.Trial, the measurements every cell shares)."""
     import hard_cases  # scripts/: the cases' own checks
@@ -132,7 +141,7 @@ def hard_case_trial(out_dir, scene, trajectory, label, phase_ticks, delay_ms):
     gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(scene), [trial.device], phase_ticks)
     return trial, {"energy_gain_J": gain_J, "energy_tolerance_J": tolerance_J,
                    "max_force_N": float(force_magnitude_N(trial.haptic).max()),
-                   "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
+                   "layer_withheld_J": layer_cost_J(summary),
                    "ledger_error": ledger_error_Ns(summary, out_dir), "delay_ticks": summary.link["delay_ticks"],
                    "link_dropped": summary.link["dropped"]}
 
@@ -184,7 +193,7 @@ def tap_trial(out_dir, trajectory, label, rate_hz, phase_ticks, delay_ms, loss=(
     gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(TAP_SCENE), [device], phase_ticks)
     return {"stop_x_m": summary.final_position_m("cube")[0], "energy_gain_J": gain_J,
             "energy_tolerance_J": tolerance_J, "max_force_N": float(force.max()),
-            "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
+            "layer_withheld_J": layer_cost_J(summary),
             "contacts": contact_episodes(force), "ledger_error": ledger_error_Ns(summary, out_dir),
             "lost_frames": summary.link["lost_frames"], "lost_reports": summary.link["lost_reports"],
             "delay_ticks": summary.link["delay_ticks"],
@@ -211,7 +220,7 @@ def grasp_trial(out_dir, label, phase_ticks, delay_ms):
     return {"lift_mm": 1e3 * (hold[0] - z[0]), "lift_end_mm": 1e3 * (hold[-1] - z[0]),
             "slip_mm": 1e3 * (hold.max() - hold.min()),
             "hold_force_p2p_N": max(ripple), "max_force_N": largest, "energy_gain_J": gain_J,
-            "layer_withheld_J": summary.world["port"]["withheld_J"] + summary.world["port"]["damped_J"],
+            "layer_withheld_J": layer_cost_J(summary),
             "energy_tolerance_J": tolerance_J, "ledger_error": ledger_error_Ns(summary, out_dir),
             "delay_ticks": summary.link["delay_ticks"],
             "link_dropped": summary.link["dropped"]}

@@ -39,7 +39,7 @@ World::World(const Scene& scene, const WorldOptions& options)
 
   engine_ = make_engine(scene_);
   start_overlaps_ = engine_->overlaps(kStartOverlap_m);
-  port_ = std::make_unique<PassivityLayer>(states_, *engine_, options.passivity);
+  port_ = std::make_unique<PassivityLayer>(states_, *engine_, options.passivity, to_eigen(scene_.gravity_mps2));
   const CouplingContext context{scene_, period_s_, scene_.physics.substeps, *engine_, states_, applied_, *port_};
   coupling_ = make_coupling(options.coupling, context, stiffness_Npm, damping_Nspm);
 
@@ -67,7 +67,9 @@ World::World(const Scene& scene, const WorldOptions& options)
     frame.gravity_mps2 = scene_.gravity_mps2;
     frame.world_substep_s = period_s_ / scene_.physics.substeps;
     frame.reach_radius_m = scene_.haptic.reach_radius_m;
+    frame.port_layer = options.passivity ? 1 : 0;
   }
+  port_pushers_.reserve(static_cast<std::size_t>(kMaxEndpoints) * kMaxImpulseEntries);
 }
 
 World::~World() = default;
@@ -130,6 +132,7 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   engine_->step(scene_.physics.substeps, period_s_ / scene_.physics.substeps, coupling_->needs_contacts(), *coupling_);
   coupling_->after_step();
   port_->settle();
+  hand_back_unspent();
   // Deformable surfaces yield; bodies rest on the dented surface from the next step on.
   for (std::size_t id = 0; id < surfaces_.size(); ++id) {
     DeformableSurface* surface = surfaces_[id].get();
@@ -158,6 +161,29 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   features_.reindex(states_, period_s_, engine_->moved());
   for (std::size_t slot = 0; slot < reports.size(); ++slot) publish(slot, applied[slot]);
   return {frames_.data(), reports.size()};
+}
+
+void World::hand_back_unspent() {
+  if (port_pushers_.empty()) return;
+  // By object, then slot: the same order whatever order the reports came in.
+  std::sort(port_pushers_.begin(), port_pushers_.end(), [](const PortPusher& a, const PortPusher& b) {
+    return a.id != b.id ? a.id < b.id : a.slot < b.slot;
+  });
+  for (std::size_t first = 0; first < port_pushers_.size();) {
+    std::size_t last = first;
+    double weight_Ns = 0.0;
+    while (last < port_pushers_.size() && port_pushers_[last].id == port_pushers_[first].id) {
+      weight_Ns += port_pushers_[last++].weight_Ns;
+    }
+    const double unspent_J = port_->return_unspent(port_pushers_[first].id);
+    if (unspent_J > 0.0) {
+      for (std::size_t k = first; k < last; ++k) {
+        returned_J_[port_pushers_[k].slot] += unspent_J * port_pushers_[k].weight_Ns / weight_Ns;
+      }
+    }
+    first = last;
+  }
+  port_pushers_.clear();
 }
 
 void World::take_finger(Endpoint& endpoint, const HapticReport& report) {
@@ -274,7 +300,13 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
     }
     const std::size_t id = t.id;
     // The hand's input counts whole, clipped or not: the hand put it in.
-    if (id < floor_id && scene_.objects[id].dynamic) port_->add_hand_input(id, t.delta.hand_input_J);
+    if (id < floor_id && scene_.objects[id].dynamic) {
+      port_->add_hand_input(id, t.delta.hand_input_J);
+      const double weight_Ns = t.delta.impulse_Ns.norm();
+      if (port_->enabled() && weight_Ns > 0.0) {
+        port_pushers_.push_back({id, static_cast<std::size_t>(&endpoint - endpoints_.data()), weight_Ns});
+      }
+    }
     // Position coupling moves nothing by the reports (its penalty comes from the sampled finger): nothing applied.
     if (options_.coupling != Coupling::position) applied[id] += t.delta.impulse_Ns;
     // An entry whose total has not grown since the last report brings nothing new: handing it on would only wake a
@@ -332,6 +364,7 @@ void World::publish(std::size_t slot, const HapticReport* applied_report) {
     frame.report_session_applied = applied_report->haptic_session;
   }
   frame.world_time_s = time_s_;
+  frame.port_returned_J = returned_J_[slot];
   frame.stiffness_Npm = scene_.haptic.stiffness_Npm;
   frame.damping_Nspm = scene_.haptic.damping_Nspm;
   // Planes are taken around the finger's proxy, and, while the finger is absent (a device gone for a moment, a web

@@ -169,6 +169,9 @@ class World {
   // Reads the state of the dynamic objects in `moved` (static ones are set once, sleeping ones do not change).
   void refresh_states(std::span<const std::size_t> moved);
   void publish(std::size_t slot, const HapticReport* applied_report);
+  // The passivity layer's stage 3 (couplings/passivity_layer.h): each object's unspent budget back to the endpoints
+  // whose reports pushed it this step, shared by their part of its impulse |ΔJ|.
+  void hand_back_unspent();
 
   Scene scene_;
   WorldOptions options_;
@@ -192,6 +195,14 @@ class World {
   std::uint64_t clipped_reports_ = 0;
   double clipped_impulse_Ns_ = 0.0;
   std::uint64_t foreign_reports_ = 0;
+  // This step's pushes on dynamic objects, by endpoint slot, with the layer on: who gets each object's unspent budget.
+  struct PortPusher {
+    std::size_t id;
+    std::size_t slot;
+    double weight_Ns;
+  };
+  std::vector<PortPusher> port_pushers_;
+  std::array<double, kMaxEndpoints> returned_J_{};  // per slot: handed back since the world session began, J
 
   std::vector<Endpoint> endpoints_;   // kMaxEndpoints, allocated once
   std::vector<PlaneFrame> frames_;    // per slot; kMaxEndpoints, allocated once (a frame is ~40 KB)

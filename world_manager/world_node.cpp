@@ -271,6 +271,7 @@ nlohmann::json WorldNode::summary() const {
                           {"withheld_J", books.withheld_J},
                           {"damped_J", books.damped_J},
                           {"unrecovered_J", books.unrecovered_J},
+                          {"returned_J", books.returned_J},
                           {"removed_impulse_Ns", books.removed_impulse_Ns},
                           {"interventions", books.interventions}};
   };

@@ -148,6 +148,12 @@ struct PlaneFrame {
   // beyond, so the planes describe the world only that far (the god-object's bound on a meaningful solution).
   // 0: unknown, no bound.
   double reach_radius_m = 0.0;
+  // The passivity layer (world_manager/couplings/passivity_layer.h, haptic_controller/hand_port.h): 1 when it is on,
+  // and the energy the world has handed back to this endpoint's hand since the world session began, J (a running
+  // total: what the objects gave the port, and the hand's input they did not take). The hand may give the finger no
+  // more than it took from it and was handed back; 0 with the layer off.
+  std::uint32_t port_layer = 0;
+  double port_returned_J = 0.0;
   DentPatch dent_patch;  // the nearest deformable surface under the proxy, if any
   std::array<Plane, kMaxPlanes> planes{};
 };

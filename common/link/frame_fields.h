@@ -75,6 +75,8 @@ void visit_frame_header(A& a, B& b, F&& f) {
   f(a.gravity_mps2, b.gravity_mps2);
   f(a.world_substep_s, b.world_substep_s);
   f(a.reach_radius_m, b.reach_radius_m);
+  f(a.port_layer, b.port_layer);
+  f(a.port_returned_J, b.port_returned_J);
   f(a.dent_patch.object_id, b.dent_patch.object_id);
   f(a.dent_patch.origin_m, b.dent_patch.origin_m);
   f(a.dent_patch.axis_x, b.dent_patch.axis_x);

@@ -102,6 +102,13 @@ class Arguments(unittest.TestCase):
         self.assertLessEqual(port_on["port_work_J"], port_on["hand_input_J"] + 1e-12)
         self.assertGreater(port_on["withheld_J"] + port_on["damped_J"], 0.0)
         self.assertLess(on.summary["objects"]["cube"]["position"][0], off.summary["objects"]["cube"]["position"][0])
+        # The hand's half keeps books only with the layer on; what the world handed back came out of its budget.
+        hand_off, hand_on = off.summary["haptic"]["hand_port"], on.summary["haptic"]["hand_port"]
+        self.assertEqual(hand_off["input_J"] + hand_off["output_J"] + hand_off["credited_J"], 0.0)
+        self.assertGreater(hand_on["input_J"], 0.0)
+        self.assertGreater(hand_on["credited_J"], 0.0)
+        self.assertLessEqual(hand_on["returned_J"], port_on["returned_J"] + 1e-12)  # the last frame may be in flight
+        self.assertLessEqual(port_on["port_work_J"] + port_on["returned_J"], port_on["hand_input_J"] + 1e-12)
         processes = OUT / "passivity-processes"
         subprocess.run(["bash", str(ROOT / "scripts/run.sh"), "--scene", str(self.scene()), "--trajectory", "tap",
                         "--passivity", "on", "--clock", "lockstep", "--out", str(processes), "--quiet"], check=True)

@@ -9,15 +9,18 @@
 
 namespace impetus {
 
-PassivityLayer::PassivityLayer(std::span<const ObjectState> states, RigidBodyEngine& engine, bool enabled)
+PassivityLayer::PassivityLayer(std::span<const ObjectState> states, RigidBodyEngine& engine, bool enabled,
+                               const Eigen::Vector3d& gravity_mps2)
     : states_(states),
       engine_(engine),
       enabled_(enabled),
+      gravity_mps2_(gravity_mps2),
       books_(states.size()),
       force_N_(states.size(), Eigen::Vector3d::Zero()),
       torque_Nm_(states.size(), Eigen::Vector3d::Zero()),
       is_forced_(states.size(), false),
       admitted_J_(states.size(), 0.0),
+      low_water_J_(states.size(), 0.0),
       velocity_before_mps_(states.size(), Eigen::Vector3d::Zero()),
       angular_before_radps_(states.size(), Eigen::Vector3d::Zero()),
       is_touched_(states.size(), false) {
@@ -39,7 +42,7 @@ void PassivityLayer::add_hand_input(std::size_t id, double work_J) {
 
 double PassivityLayer::budget_J(std::size_t id) const {
   const PortEnergy& books = books_[id];
-  return books.hand_input_J - books.port_work_J - admitted_J_[id];
+  return books.hand_input_J - books.port_work_J - books.returned_J - admitted_J_[id];
 }
 
 void PassivityLayer::count(std::size_t id, double withheld_J, double damped_J, double impulse_Ns) {
@@ -49,6 +52,24 @@ void PassivityLayer::count(std::size_t id, double withheld_J, double damped_J, d
   books.removed_impulse_Ns += impulse_Ns;
   ++books.interventions;
 }
+
+namespace {
+
+// The largest α ∈ [0, 1] with α·a + α²·b ≤ B (b ≥ 0): the share of a push whose energy a·α + b·α² fits the budget B.
+double admitted_share(double a, double b, double budget_J) {
+  if (!(a + b > budget_J) || !(b > 0.0)) {
+    if (b > 0.0 || !(a > budget_J)) return 1.0;
+    return a > 0.0 ? std::clamp(budget_J / a, 0.0, 1.0) : 1.0;  // linear: a push along the motion, no b
+  }
+  if (a * a + 4.0 * b * budget_J >= 0.0) {
+    // The larger root of b·α² + a·α − B = 0: ΔKE(α) ≤ B on [0, α] when B ≥ 0; when B < 0 the roots bracket the
+    // braking part of the push (a < 0), and the larger one is the most of it that still leaves ΔKE ≤ B.
+    return std::clamp((-a + std::sqrt(a * a + 4.0 * b * budget_J)) / (2.0 * b), 0.0, 1.0);
+  }
+  return std::clamp(-a / (2.0 * b), 0.0, 1.0);  // B out of reach: the α that gives the least energy
+}
+
+}  // namespace
 
 double PassivityLayer::admit_velocity_change(std::size_t id, const Eigen::Vector3d& impulse_Ns,
                                              const Eigen::Vector3d& angular_impulse_Nms,
@@ -60,16 +81,8 @@ double PassivityLayer::admit_velocity_change(std::size_t id, const Eigen::Vector
   const double b = 0.5 * (inverse_mass_per_kg * impulse_Ns.squaredNorm() +
                           angular_impulse_Nms.dot(inverse_inertia_world * angular_impulse_Nms));
   const double full_J = a + b;
-  const double budget = budget_J(id);
-  if (!(full_J > budget) || !(b > 0.0)) return 1.0;
-  double alpha = 0.0;
-  if (a * a + 4.0 * b * budget >= 0.0) {
-    // The larger root of b·α² + a·α − B = 0: ΔKE(α) ≤ B on [0, α] when B ≥ 0; when B < 0 the roots bracket the
-    // braking part of the push (a < 0), and the larger one is the most of it that still leaves ΔKE ≤ B.
-    alpha = std::clamp((-a + std::sqrt(a * a + 4.0 * b * budget)) / (2.0 * b), 0.0, 1.0);
-  } else {
-    alpha = std::clamp(-a / (2.0 * b), 0.0, 1.0);  // B out of reach: the α that gives the least energy
-  }
+  if (!(full_J > budget_J(id)) || !(b > 0.0)) return 1.0;
+  const double alpha = admitted_share(a, b, budget_J(id));
   count(id, full_J - (alpha * a + alpha * alpha * b), 0.0, (1.0 - alpha) * impulse_Ns.norm());
   return alpha;
 }
@@ -80,12 +93,20 @@ double PassivityLayer::admit_force(std::size_t id, const Eigen::Vector3d& force_
   Eigen::Vector3d velocity_mps;
   Eigen::Vector3d angular_radps;
   engine_.velocity(id, velocity_mps, angular_radps);
-  const double work_J = substep_s * (force_N.dot(velocity_mps) + torque_Nm.dot(angular_radps));
-  const double budget = budget_J(id);
-  double alpha = 1.0;
-  if (work_J > 0.0 && work_J > budget) alpha = std::clamp(budget / work_J, 0.0, 1.0);
-  if (alpha < 1.0) count(id, (1.0 - alpha) * work_J, 0.0, (1.0 - alpha) * force_N.norm() * substep_s);
-  admitted_J_[id] += alpha * std::max(0.0, work_J);
+  // The work booked after the substep, h·F·(v₀+v₁)/2 with v₁ = v₀ + h·(F/m + g) on a free body, is α·a + α²·b
+  // (header). Several pushes on one body in a substep share the budget, each taken at the velocity now.
+  const ObjectState& state = states_[id];
+  const Eigen::Vector3d mid_fall_mps = velocity_mps + 0.5 * substep_s * gravity_mps2_;
+  const double a = substep_s * (force_N.dot(mid_fall_mps) + torque_Nm.dot(angular_radps));
+  const double b = 0.5 * substep_s * substep_s *
+                   (state.inverse_mass_per_kg * force_N.squaredNorm() +
+                    torque_Nm.dot(state.inverse_inertia_world * torque_Nm));
+  const double full_J = a + b;
+  const double alpha = full_J > budget_J(id) ? admitted_share(a, b, budget_J(id)) : 1.0;
+  if (alpha < 1.0) {
+    count(id, full_J - (alpha * a + alpha * alpha * b), 0.0, (1.0 - alpha) * force_N.norm() * substep_s);
+  }
+  admitted_J_[id] += std::max(0.0, alpha * a + alpha * alpha * b);
   return alpha;
 }
 
@@ -130,14 +151,16 @@ void PassivityLayer::after_substep(double substep_s) {
 void PassivityLayer::settle() {
   for (const std::size_t id : touched_) {
     is_touched_[id] = false;
-    if (enabled_) enforce(id);
+    if (!enabled_) continue;
+    enforce(id);
+    low_water_J_[id] = std::min(low_water_J_[id], budget_J(id));
   }
   touched_.clear();
 }
 
 void PassivityLayer::enforce(std::size_t id) {
   PortEnergy& books = books_[id];
-  const double excess_J = books.port_work_J - books.hand_input_J;
+  const double excess_J = books.port_work_J + books.returned_J - books.hand_input_J;
   if (!(excess_J > 0.0)) return;
   // Level again whatever happens: what the damper cannot take is counted as unrecovered (header, stage 2).
   books.port_work_J -= excess_J;
@@ -162,6 +185,18 @@ void PassivityLayer::enforce(std::size_t id) {
   count(id, 0.0, taken_J, (1.0 - lambda) * mass_kg * now.velocity_mps.norm());
 }
 
+double PassivityLayer::return_unspent(std::size_t id) {
+  if (!enabled_) return 0.0;
+  // What sat unspent through the whole step (its low-water mark) goes back; what came in or was freed during the
+  // step stays for the next.
+  const double budget = budget_J(id);
+  const double now_J = std::isfinite(budget) ? budget : 0.0;
+  const double given_J = std::max(0.0, std::min(now_J, low_water_J_[id]));
+  books_[id].returned_J += given_J;
+  low_water_J_[id] = std::max(0.0, now_J - given_J);
+  return given_J;
+}
+
 PortEnergy PassivityLayer::total() const {
   PortEnergy sum;
   for (const PortEnergy& books : books_) {
@@ -171,6 +206,7 @@ PortEnergy PassivityLayer::total() const {
     sum.damped_J += books.damped_J;
     sum.removed_impulse_Ns += books.removed_impulse_Ns;
     sum.unrecovered_J += books.unrecovered_J;
+    sum.returned_J += books.returned_J;
     sum.interventions += books.interventions;
   }
   return sum;

@@ -24,15 +24,23 @@
 //   1. It admits each push only as far as the budget B = input − output allows, scaling it by α ∈ [0, 1]:
 //        a velocity change: its kinetic energy gain ΔKE(α) = α·(J·v₀ + L·ω₀) + α²·½(J·M⁻¹J + L·I⁻¹L) is exact, so
 //        α is the largest with ΔKE(α) ≤ B (a push against the motion, ΔKE < 0, always goes in whole);
-//        a force over a substep: its work at the velocity the body has now, h·α·(F·v₀ + τ·ω₀), ≤ B (what the body's
-//        own acceleration within the substep adds, h²|F|²/2m on a free body, is booked after the substep and taken
-//        back by stage 2; a body a contact holds gains nothing, so a press on a resting object is never withheld).
+//        a force (F, τ) over a substep h: the work booked after it, h·(F·(v₀+v₁)/2 + τ·(ω₀+ω₁)/2), is on a free
+//        body under gravity g exactly α·a + α²·b with a = h·(F·(v₀ + ½·h·g) + τ·ω₀) and b = ½·h²·(F·M⁻¹F + τ·I⁻¹τ);
+//        the same α rule. A push that holds a body against gravity adds nothing (b cancels gravity's part of a);
+//        what contacts take or give within the substep is booked after it and settled by stage 2.
 //      So the layer withholds a push that would add energy, never one that holds or brakes a body: an object resting
 //      against a finger is held as without it.
 //   2. After each substep, whatever output still exceeds the input is taken out of the body by scaling its velocity
 //      and angular velocity by λ = √(1 − excess/KE), a damper that removes exactly the excess. Where the body has less
 //      kinetic energy than that (the energy went into height, or into other bodies), what cannot be taken is counted
 //      as unrecovered_J and the books start level again, rather than freezing the body until it is repaid.
+//   3. After each world step, what an object's budget held unspent through the whole step, its lowest level since
+//      the step before (the hand's input it did not take, and what it gave the port by being braked), is handed back
+//      to the hands that pushed it that step (return_unspent), whose half of the layer
+//      (haptic_controller/hand_port.h) lets the finger have it, or sends it on again behind the next push. What came
+//      in or was freed during the step stays one step more: a body held against gravity takes energy and gives it
+//      back within a step, and needs what it gave for the next push. Handed back, it leaves the object's budget:
+//      energy is spent on one side of the port, never on both.
 // What the layer withholds or takes out is counted: the energy the withheld part of each push would have given the body,
 // as stage 1 predicts it (withheld_J: exact for a velocity change, at the velocity before the substep for a force), the
 // kinetic energy stage 2 took out (damped_J), and the momentum, Σ of |ΔJ| withheld and m·|Δv| damped
@@ -58,15 +66,21 @@ struct PortEnergy {
   double damped_J = 0.0;            // kinetic energy taken out of the body (stage 2)
   double removed_impulse_Ns = 0.0;  // momentum it withheld or took out, Σ|ΔJ|
   double unrecovered_J = 0.0;       // output beyond input it could not take back (the body had no kinetic energy left)
+  double returned_J = 0.0;          // handed back to the hands (stage 3)
   std::uint64_t interventions = 0;  // pushes it scaled down, and dampings
-  // Output beyond input now: port_work_J − hand_input_J when positive (with the layer on, 0 after every settle()).
-  double overdraft_J() const { return port_work_J > hand_input_J ? port_work_J - hand_input_J : 0.0; }
+  // Output and what was handed back beyond input now (with the layer on, 0 after every settle()).
+  double overdraft_J() const {
+    const double out_J = port_work_J + returned_J;
+    return out_J > hand_input_J ? out_J - hand_input_J : 0.0;
+  }
 };
 
 class PassivityLayer {
  public:
   // `states` are the World's object states (their inverse masses); `engine` the bodies. Both outlive the layer.
-  PassivityLayer(std::span<const ObjectState> states, RigidBodyEngine& engine, bool enabled);
+  // `gravity_mps2` is the scene's: a force's admission counts the substep's fall under it (stage 1).
+  PassivityLayer(std::span<const ObjectState> states, RigidBodyEngine& engine, bool enabled,
+                 const Eigen::Vector3d& gravity_mps2 = Eigen::Vector3d::Zero());
 
   bool enabled() const { return enabled_; }
 
@@ -95,13 +109,16 @@ class PassivityLayer {
   void after_substep(double substep_s);
   // Enforces output ≤ input on every object booked since the last call (no-op when the layer is off).
   void settle();
+  // Stage 3: takes what object `id`'s budget has held since the last call out of it, to hand back to the hands (0
+  // when the layer is off or nothing was left unspent). Call after settle().
+  double return_unspent(std::size_t id);
 
   const PortEnergy& energy(std::size_t id) const { return books_[id]; }
   // Sums over objects.
   PortEnergy total() const;
 
  private:
-  // Input − output − work admitted but not booked yet, J.
+  // Input − output − handed back − work admitted but not booked yet, J.
   double budget_J(std::size_t id) const;
   // Counts an intervention: energy withheld from a push (stage 1) or damped out of the body (stage 2), and momentum.
   void count(std::size_t id, double withheld_J, double damped_J, double impulse_Ns);
@@ -111,6 +128,7 @@ class PassivityLayer {
   std::span<const ObjectState> states_;
   RigidBodyEngine& engine_;
   bool enabled_;
+  Eigen::Vector3d gravity_mps2_;
   std::vector<PortEnergy> books_;
   // Forces held over the current substep, per object, and which objects have one.
   std::vector<Eigen::Vector3d> force_N_;
@@ -120,6 +138,7 @@ class PassivityLayer {
   // Work admitted for the current substep's forces, not booked yet (several pushes on one body share the budget), and
   // the velocities the body had before the substep.
   std::vector<double> admitted_J_;
+  std::vector<double> low_water_J_;  // the lowest budget since the last return_unspent(), J
   std::vector<Eigen::Vector3d> velocity_before_mps_;
   std::vector<Eigen::Vector3d> angular_before_radps_;
   // Objects whose books changed since the last settle().

@@ -80,6 +80,7 @@ const char* to_string(FrameError error) {
       return "a deformable plane's yield force, depth rate, pad radius or room is negative, or its patch is malformed";
     case FrameError::bad_mass: return "a local contact's inverse mass is negative";
     case FrameError::bad_shape: return "a plane's shape is unknown or out of range, or its body axes not orthonormal";
+    case FrameError::bad_port: return "the passivity layer's flag is not 0 or 1, or its returned energy is negative";
   }
   return "unknown frame error";
 }
@@ -109,6 +110,9 @@ FrameError validate(const wire::PlaneFrame& frame) {
   if (!(frame.world_period_s > 0.0) || !finite(frame.world_period_s)) return FrameError::bad_period;
   if (frame.world_substep_s < 0.0) return FrameError::bad_period;
   if (frame.reach_radius_m < 0.0) return FrameError::bad_reach;
+  if (frame.port_layer > 1 || !(frame.port_returned_J >= 0.0) || !finite(frame.port_returned_J)) {
+    return FrameError::bad_port;
+  }
   if (frame.dent_patch.object_id >= 0) {
     const wire::DentPatch& patch = frame.dent_patch;
     if (!all_finite(patch.origin_m) || !all_finite(patch.axis_x) || !all_finite(patch.axis_y) ||

@@ -84,6 +84,9 @@ struct PlaneFrame {
   Vec3 gravity_mps2{};
   double world_substep_s = 0.0;
   double reach_radius_m = 0.0;
+  std::uint32_t port_layer = 0;
+  std::uint32_t reserved_port = 0;
+  double port_returned_J = 0.0;
   DentPatch dent_patch;
   std::array<Plane, kMaxPlanes> planes{};  // the first plane_count are used
 };
@@ -155,6 +158,7 @@ enum class FrameError : std::uint32_t {
   bad_mass,
   bad_shape,
   bad_yield,
+  bad_port,
 };
 const char* to_string(FrameError error);
 
