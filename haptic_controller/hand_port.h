@@ -25,8 +25,9 @@
 //    reservoir to the world behind that push (in place of the accumulator's Σ max(0, J·v)). A press first fills the
 //    spring and then pays for the object's motion; a finger that trembles against a held object draws its give-back
 //    from what it pressed in.
-// The world hands back what a body gave the port (a push that braked it) and the hand's input a body did not take (a
-// press on an object the floor holds), and the next push sends it on again if the spring does not need it.
+// The world hands back what a body left unspent through a whole step: what it gave the port (a push that braked it)
+// and the hand's input it did not take (a press on an object the floor holds). The next push sends it on again if the
+// spring does not need it.
 //
 // Off (no frame, or frames without the layer) it changes nothing and books nothing. Owned by the servo thread;
 // allocation-free.
