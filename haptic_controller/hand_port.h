@@ -17,7 +17,10 @@
 // 1. The damper. The tick's force f_k will do about f_k·Δx_k on the finger over the coming tick (the last
 //    displacement as the prediction). Where that is more than the reservoir holds, a damper along Δx takes out the
 //    difference: f'_k = f_k − d/|Δx_k|²·Δx_k, so the prediction is f'_k·Δx_k = reservoir. A wrong prediction is
-//    booked exactly at the next tick and paid for by the next damping; damped_J counts Σ (f − f')·Δx as it came.
+//    booked exactly at the next tick and leaves the reservoir in debt, which later input pays before any output;
+//    damped_J counts Σ (f − f')·Δx as it came. The prediction sees only the force along the last displacement: a
+//    force whose direction jitters across the finger's motion (friction chatter as a cube slides past it) does work
+//    it does not see (the deepest debt over the hard cases, docs/latency.md, "The passivity layer").
 //    The contact force f itself is what the objects receive (the reaction the accumulator shares): the damper stands
 //    between the finger and the port, not between the port and the world.
 // 2. The credit. The hand keeps what its spring could give back, the proxy spring's stored energy ½·k·|D − C|², and
