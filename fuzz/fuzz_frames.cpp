@@ -70,6 +70,7 @@ void check_accepted(const HapticReport& report) {
   FUZZ_CHECK(std::isfinite(report.haptic_time_s) && all_finite(report.finger_m) &&
              all_finite(report.finger_velocity_mps) && all_finite(report.proxy_m) &&
              all_finite(report.static_impulse_Ns));
+  FUZZ_CHECK(std::isfinite(report.link_round_trip_s) && report.link_round_trip_s >= 0.0);
   for (std::uint32_t k = 0; k < report.entry_count; ++k) {
     const ObjectImpulse& entry = report.entries[k];
     FUZZ_CHECK(all_finite(entry.impulse_Ns) && all_finite(entry.angular_impulse_Nms) &&

@@ -323,6 +323,7 @@ nlohmann::json HapticNode::endpoint_summary(const Endpoint& endpoint) const {
           {"local_replay_gaps", counters.local_replay_gaps},
           {"local_unlogged_shares", counters.local_unlogged_shares},
           {"hand_port", hand_port},
+          {"link_round_trip_s", report.link_round_trip_s},
           {"log_rows_dropped", endpoint.log ? endpoint.log->dropped() : 0},
           {"max_force_N", endpoint.max_force_N},
           {"stiffness_Npm", endpoint.stiffness_Npm},

@@ -48,6 +48,14 @@ void HapticServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   frame_arrival_s_ = now_s;
   accumulator_.on_plane_frame(frame);
   hand_port_.on_plane_frame(frame);
+  // The link's round trip as seen here (HapticReport::link_round_trip_s): the ticks from the report this frame
+  // applied to now. 0 when it applied the tick just rendered.
+  HapticReport& report = accumulator_.report();
+  if (frame.report_session_applied == report.haptic_session && frame.report_tick_applied > 0 &&
+      counters_.ticks >= frame.report_tick_applied) {
+    const auto round_trip_ticks = static_cast<double>(counters_.ticks - frame.report_tick_applied);
+    report.link_round_trip_s = round_trip_ticks * options_.tick_period_s;
+  }
 }
 
 void HapticServo::measure_frame_boundary(const ProxySolution& contact) {

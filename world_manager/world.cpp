@@ -196,6 +196,10 @@ void World::take_finger(Endpoint& endpoint, const HapticReport& report) {
   // to the finger.
   endpoint.plane_query = finger.finger;
   endpoint.plane_query_known = true;
+  // The link's round trip, as the haptic side measured it, up to the longest a link may hold (kMaxRoundTrip_s).
+  if (std::isfinite(report.link_round_trip_s)) {
+    endpoint.plane_query.round_trip_s = std::clamp(report.link_round_trip_s, 0.0, kMaxRoundTrip_s);
+  }
   if (all_finite(report.proxy_m)) {
     endpoint.plane_query.position_m = to_eigen(report.proxy_m);
     endpoint.plane_query.reach_extra_m = (finger.finger.position_m - endpoint.plane_query.position_m).norm();

@@ -95,6 +95,9 @@ class World {
   // Deeper than any resting contact sinks (the contact spring's give under a body's weight is microns), shallower
   // than a placement mistake a user would notice.
   static constexpr double kStartOverlap_m = 1e-4;
+  // The longest link round trip a report's measure is taken at: twice the in-process delay line's 1 s one way; a
+  // longer measure (a stalled servo's) widens the reach no further.
+  static constexpr double kMaxRoundTrip_s = 2.0;
 
   // Whether dynamic object `id` sleeps (scene physics.auto_disable): at rest, not simulated until something wakes it.
   bool asleep(std::size_t id) const { return engine_->asleep(id); }

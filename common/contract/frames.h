@@ -208,6 +208,10 @@ struct HapticReport {
   std::uint32_t finger_valid = 0;   // 0 while no device is attached: position coupling must not use finger_m
   std::uint32_t entry_count = 0;
   Vec3 static_impulse_Ns{};         // share of the reaction that went into static geometry (floor, fixed objects)
+  // The link's round trip as this endpoint's servo measured it at its newest frame, s: the ticks from the report that
+  // frame applied to the frame's arrival, at the nominal tick period (0 when the frame applied the tick just rendered,
+  // as in lockstep without delay). The world widens its reach by the finger's travel over it (feature_extractor.h).
+  double link_round_trip_s = 0.0;
   std::array<ObjectImpulse, kMaxImpulseEntries> entries{};
 };
 

@@ -114,6 +114,7 @@ void visit_report_header(A& a, B& b, F&& f) {
   f(a.finger_valid, b.finger_valid);
   f(a.entry_count, b.entry_count);
   f(a.static_impulse_Ns, b.static_impulse_Ns);
+  f(a.link_round_trip_s, b.link_round_trip_s);
 }
 
 // A loop's statistics (not a frame: no seal, no counts), for the transports that carry them.

@@ -279,6 +279,17 @@ TEST_CASE("a whole delayed tap ends with the impulse applied equal to the impuls
   }
 }
 
+TEST_CASE("the servo measures the link's round trip, 2d in lockstep, which the world widens its reach by") {
+  // A frame published at world step k·n applied the report of tick k·n − d and reaches the servo at tick k·n + d.
+  for (const double delay_s : {0.0, 0.005, 0.1}) {
+    DYNAMIC_SECTION("delay " << delay_s << " s") {
+      const nlohmann::json summary = run_in_process_trial(tap_options(Coupling::local, 11, delay_s));
+      CHECK(summary["haptic"]["endpoints"][0]["link_round_trip_s"].get<double>() ==
+            Approx(2.0 * delay_s).margin(1e-12));
+    }
+  }
+}
+
 TEST_CASE("a link delay under half a tick is no delay: the trial is the undelayed one, bit for bit") {
   InProcessTrialOptions none = tap_options(Coupling::impulse, 17, 0.0);
   none.out_dir = test::out_dir("link-delay-none");

@@ -58,14 +58,15 @@ RandomWorld make_random_world(std::uint32_t seed, int count) {
 std::set<std::int32_t> brute_force_within_reach(const RandomWorld& world, const ReachQuery& finger) {
   std::set<std::int32_t> ids;
   const double finger_speed = finger.velocity_mps.norm();
+  const double horizon_s = kPeriod_s + finger.round_trip_s;
   for (std::size_t i = 0; i < world.states.size(); ++i) {
     const auto surface = impetus::nearest_surface_point(world.scene.objects[i].shape, world.states[i].pose,
                                                         finger.position_m);
     const double reach_m =
-        world.scene.haptic.reach_radius_m + (finger_speed + world.states[i].velocity_mps.norm()) * kPeriod_s;
+        world.scene.haptic.reach_radius_m + (finger_speed + world.states[i].velocity_mps.norm()) * horizon_s;
     if (surface.signed_distance_m <= reach_m) ids.insert(static_cast<std::int32_t>(i));
   }
-  if (finger.position_m.z() <= world.scene.haptic.reach_radius_m + finger_speed * kPeriod_s) {
+  if (finger.position_m.z() <= world.scene.haptic.reach_radius_m + finger_speed * horizon_s) {
     ids.insert(world.scene.floor_object_id());
   }
   return ids;
@@ -87,7 +88,7 @@ Scene lone_cube(double size_m, double mass_kg) {
 
 }  // namespace
 
-TEST_CASE("the feature query returns exactly the objects within reach, checked against brute force") {
+TEST_CASE("the feature query returns exactly the objects within reach, over a round trip too, against brute force") {
   const RandomWorld world = make_random_world(2024, 500);
   FeatureExtractor extractor(world.scene);
   extractor.index(world.states, kPeriod_s);
@@ -99,6 +100,8 @@ TEST_CASE("the feature query returns exactly the objects within reach, checked a
     ReachQuery finger;
     finger.position_m = Vector3d(unit(rng), unit(rng), 0.1 * unit(rng) + (trial % 2) * unit(rng));
     finger.velocity_mps = (trial % 5 == 0 ? 2.0 : 0.3) * Vector3d(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5);
+    // A third of the queries come over a delayed link: the reach covers the round trip too.
+    finger.round_trip_s = trial % 3 == 0 ? 0.2 * unit(rng) : 0.0;
     std::vector<ReachCandidate> found;
     extractor.within_reach(finger, world.states, kPeriod_s, found);
     std::set<std::int32_t> found_ids;

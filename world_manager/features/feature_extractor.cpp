@@ -55,7 +55,11 @@ Eigen::AlignedBox3d FeatureExtractor::swept_bounds(std::size_t id, const ObjectS
 
 void FeatureExtractor::index(std::span<const ObjectState> states, double world_period_s) {
   swept_bounds_.resize(states.size());
-  for (std::size_t i = 0; i < states.size(); ++i) swept_bounds_[i] = swept_bounds(i, states[i], world_period_s);
+  fastest_mps_ = 0.0;
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    swept_bounds_[i] = swept_bounds(i, states[i], world_period_s);
+    fastest_mps_ = std::max(fastest_mps_, states[i].velocity_mps.norm());
+  }
   grid_.rebuild(swept_bounds_);
 }
 
@@ -65,6 +69,7 @@ void FeatureExtractor::reindex(std::span<const ObjectState> states, double world
   for (const std::size_t id : moved) {
     if (id >= states.size()) continue;
     swept_bounds_[id] = swept_bounds(id, states[id], world_period_s);
+    fastest_mps_ = std::max(fastest_mps_, states[id].velocity_mps.norm());
     grid_.update(static_cast<std::int32_t>(id), swept_bounds_[id]);
   }
 }
@@ -75,9 +80,12 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
   out.clear();
   const double finger_speed_mps = finger.velocity_mps.norm();
   const double base_reach_m = scene_.haptic.reach_radius_m + finger.reach_extra_m;
-  const double finger_reach_m = base_reach_m + finger_speed_mps * world_period_s;
-  const Eigen::AlignedBox3d query(finger.position_m.array() - finger_reach_m,
-                                  finger.position_m.array() + finger_reach_m);
+  // The time until the planes of this step are replaced at the finger: a world period, and the link's round trip.
+  const double horizon_s = world_period_s + finger.round_trip_s;
+  const double finger_reach_m = base_reach_m + finger_speed_mps * horizon_s;
+  // The grid holds bounds swept over one period: over a round trip any object may come further by its speed.
+  const double query_m = finger_reach_m + (finger.round_trip_s > 0.0 ? fastest_mps_ * finger.round_trip_s : 0.0);
+  const Eigen::AlignedBox3d query(finger.position_m.array() - query_m, finger.position_m.array() + query_m);
   grid_.query(query, candidate_ids_);
 
   for (std::int32_t id : candidate_ids_) {
@@ -112,8 +120,8 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
         }
       }
     }
-    // docs/architecture.md §1.1 step 4: reach = base radius + (finger speed + object speed)·T_w.
-    const double reach_m = base_reach_m + (finger_speed_mps + state.velocity_mps.norm()) * world_period_s;
+    // docs/architecture.md §1.1 step 4: reach = base radius + (finger speed + object speed)·(T_w + round trip).
+    const double reach_m = base_reach_m + (finger_speed_mps + state.velocity_mps.norm()) * horizon_s;
     // A NaN distance fails this test: a broken object gives no plane rather than a frame the haptic side rejects.
     if (surface.signed_distance_m <= reach_m && surface.point_m.allFinite() && surface.normal.allFinite()) {
       out.push_back({id, surface});

@@ -36,10 +36,14 @@ namespace impetus {
 // Where the planes are extracted around: the haptic proxy when the report has one (it never enters an object, so a
 // finger pushed deep into a thin plate still gets the plate's near face), else the finger itself. `reach_extra_m`
 // widens the reach by how far the finger is from that point, so nothing between proxy and finger is missed.
+// `round_trip_s` is the link's round trip as the haptic side measured it (HapticReport::link_round_trip_s): the
+// planes reach the finger that much later than a world period after the finger was where the query says, so the
+// reach covers the travel over T_w + round trip.
 struct ReachQuery {
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
   double reach_extra_m = 0.0;
+  double round_trip_s = 0.0;
 };
 
 // One object within reach and its nearest surface point to the finger.
@@ -86,6 +90,9 @@ class FeatureExtractor {
   const Scene& scene_;
   SpatialGrid grid_;
   std::vector<Eigen::AlignedBox3d> swept_bounds_;
+  // At least the fastest indexed object's speed (exact after index(), never lower after reindex()): a query over a
+  // round trip widens its box by how far any object can come in it beyond the period its bounds are swept over.
+  double fastest_mps_ = 0.0;
   mutable std::vector<std::int32_t> candidate_ids_;     // reused between queries: no allocation per step
   mutable std::vector<ReachCandidate> reach_scratch_;
 };

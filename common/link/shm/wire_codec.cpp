@@ -72,7 +72,7 @@ const char* to_string(FrameError error) {
     case FrameError::count_out_of_range: return "count out of range";
     case FrameError::not_finite: return "non-finite number";
     case FrameError::normal_not_unit: return "normal is not a unit vector";
-    case FrameError::bad_period: return "world period is not positive";
+    case FrameError::bad_period: return "world period is not positive, or a round trip is negative";
     case FrameError::bad_coupling: return "unknown coupling";
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
     case FrameError::bad_reach: return "reach radius or plane extent is negative";
@@ -191,9 +191,10 @@ FrameError validate(const wire::HapticReport& report) {
   if (report.entry_count > kMaxImpulseEntries) return FrameError::count_out_of_range;
   if (!finite(report.haptic_time_s) || !all_finite(report.finger_m) || !all_finite(report.finger_velocity_mps) ||
       !all_finite(report.proxy_m) || !all_finite(report.force_N) ||
-      !all_finite(report.static_impulse_Ns)) {
+      !all_finite(report.static_impulse_Ns) || !finite(report.link_round_trip_s)) {
     return FrameError::not_finite;
   }
+  if (report.link_round_trip_s < 0.0) return FrameError::bad_period;
   for (std::uint32_t k = 0; k < report.entry_count; ++k) {
     const wire::ObjectImpulse& entry = report.entries[k];
     if (!all_finite(entry.impulse_Ns) || !all_finite(entry.angular_impulse_Nms) ||

@@ -120,6 +120,7 @@ struct HapticReport {
   std::uint32_t finger_valid = 0;
   std::uint32_t entry_count = 0;
   Vec3 static_impulse_Ns{};
+  double link_round_trip_s = 0.0;
   std::array<ObjectImpulse, kMaxImpulseEntries> entries{};  // the first entry_count are used
 };
 
