@@ -28,8 +28,9 @@
 //        body under gravity g exactly α·a + α²·b with a = h·(F·(v₀ + ½·h·g) + τ·ω₀) and b = ½·h²·(F·M⁻¹F + τ·I⁻¹τ);
 //        the same α rule. A push that holds a body against gravity adds nothing (b cancels gravity's part of a);
 //        what contacts take or give within the substep is booked after it and settled by stage 2.
-//      So the layer withholds a push that would add energy, never one that holds or brakes a body: an object resting
-//      against a finger is held as without it.
+//      So the layer withholds a push that would add energy to a free body, never a velocity change that brakes one.
+//      A force pressing a body onto a support counts as free-body energy, so with no budget it is withheld as well,
+//      although the support takes it (hard case 4 under position coupling, docs/latency.md).
 //   2. After each substep, whatever output still exceeds the input is taken out of the body by scaling its velocity
 //      and angular velocity by λ = √(1 − excess/KE), a damper that removes exactly the excess. Where the body has less
 //      kinetic energy than that (the energy went into height, or into other bodies), what cannot be taken is counted
