@@ -10,12 +10,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <span>
 #include <set>
 #include <sstream>
 #include <string_view>
+#include <utility>
 
 namespace impetus {
 
@@ -149,6 +151,19 @@ constexpr std::string_view kObjectKeys[] = {
     "name", "shape", "dynamic", "mass_kg", "density_kgpm3", "position_m", "orientation_wxyz", "linear_velocity_mps",
     "angular_velocity_radps", "static_friction", "dynamic_friction", "restitution", "deformable"};
 
+// The value named by string key `key` of `node` among two `choices`, or `fallback` when the key is absent; another
+// string fails, naming the key and both choices.
+template <class Enum>
+Enum parse_choice(const Node& node, const char* key, const std::array<std::pair<const char*, Enum>, 2>& choices,
+                  Enum fallback) {
+  if (!node.has(key)) return fallback;
+  const std::string name = node.child(key).string();
+  for (const auto& [choice, value] : choices) {
+    if (name == choice) return value;
+  }
+  node.child(key).fail(std::string("unknown ") + key + ", expected " + choices[0].first + " or " + choices[1].first);
+}
+
 // A "deformable" block (docs/scene-format.md): a plastic or elastic top face for a static box. The plastic ranges
 // span the materials a finger can dent (wet clay at ~1 kPa to stiff wax at ~1 MPa) with room either side, the elastic
 // ones foams to hard rubbers; grids a step can yield in milliseconds (DeformableSurface::kMaxCells) and elastic
@@ -160,16 +175,9 @@ DeformableMaterial parse_deformable(const Node& node, const SceneObject& object)
   if (object.dynamic) node.fail("only a static object can be deformable (\"dynamic\": false)");
   if (object.shape.kind != ShapeKind::box) node.fail("only a box can be deformable (its top face yields)");
   DeformableMaterial material;
-  if (node.has("law")) {
-    const std::string law = node.child("law").string();
-    if (law == "plastic") {
-      material.law = DeformableMaterial::Law::plastic;
-    } else if (law == "elastic") {
-      material.law = DeformableMaterial::Law::elastic;
-    } else {
-      node.child("law").fail("unknown law, expected plastic or elastic");
-    }
-  }
+  material.law = parse_choice(node, "law", {{{"plastic", DeformableMaterial::Law::plastic},
+                                             {"elastic", DeformableMaterial::Law::elastic}}},
+                              material.law);
   const bool elastic = material.law == DeformableMaterial::Law::elastic;
   for (const char* key : {"yield_stress_Pa", "flow_resistance_Paspm", "plasticity"}) {
     if (elastic && node.has(key)) node.child(key).fail("a key of the plastic law, and this slab's law is elastic");
@@ -187,16 +195,9 @@ DeformableMaterial parse_deformable(const Node& node, const SceneObject& object)
     material.areal_density_kgpm2 = node.child("areal_density_kgpm2").in_range(1e-2, 1e4, " kg/m²");
   }
   if (node.has("damping_Paspm")) material.damping_Paspm = node.child("damping_Paspm").in_range(0.0, 1e9, " Pa·s/m");
-  if (node.has("rule")) {
-    const std::string rule = node.child("rule").string();
-    if (rule == "impulse") {
-      material.rule = DeformableMaterial::Rule::impulse;
-    } else if (rule == "penetration") {
-      material.rule = DeformableMaterial::Rule::penetration;
-    } else {
-      node.child("rule").fail("unknown rule, expected impulse or penetration");
-    }
-  }
+  material.rule = parse_choice(node, "rule", {{{"impulse", DeformableMaterial::Rule::impulse},
+                                               {"penetration", DeformableMaterial::Rule::penetration}}},
+                               material.rule);
   if (node.has("yield_stress_Pa")) material.yield_stress_Pa = node.child("yield_stress_Pa").in_range(0.0, 1e8, " Pa");
   if (node.has("flow_resistance_Paspm")) {
     material.flow_resistance_Paspm = node.child("flow_resistance_Paspm").in_range(1e2, 1e12, " Pa·s/m");
