@@ -221,17 +221,12 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
   // first. A report seen again (a transport keeps the last one while its controller is silent) brings nothing and
   // leaves that time alone, so the report after a silence covers the whole of it.
   const double covered_world_s = known_start ? time_s_ - endpoint.last_applied_world_time_s : period_s_;
+  // The wall time the world did not simulate since then (its clock skipped steps: a stall).
+  const double stalled_s = known_start ? stalled_s_ - endpoint.stalled_at_last_applied_s : 0.0;
   const bool new_report = known_start || endpoint.last_report_session != report.haptic_session;
-  // A report that lagged (the world read an older one than its step's: the newer ones lost or late on the link)
-  // covered less haptic time than the world time it was applied over, and the next one covers that much more, which
-  // the device could render: the limit below carries that lag over, up to one world period (a longer run of lost
-  // reports leaves the world a stale finger, which the staleness rules handle; and a carry cannot grow into an
-  // allowance for a stall's backlog). A stall is the opposite, more haptic time than world time, and carries nothing.
-  const double lag_carried_s = known_start ? std::min(endpoint.report_lag_s, period_s_) : 0.0;
   if (new_report) {
     endpoint.last_applied_world_time_s = time_s_;
-    endpoint.report_lag_s =
-        known_start ? std::clamp(lag_carried_s + covered_world_s - window.length_s, 0.0, period_s_) : 0.0;
+    endpoint.stalled_at_last_applied_s = stalled_s_;
   }
   endpoint.last_report_session = report.haptic_session;
   endpoint.last_report_time_s = report.haptic_time_s;
@@ -273,17 +268,21 @@ void World::take_report(Endpoint& endpoint, const HapticReport& report) {
   if (all_finite(report.static_impulse_Ns)) static_delta_Ns = ledger_.take_static(owner, report.static_impulse_Ns);
   reaction_Ns += static_delta_Ns;
   reaction_sum_Ns += static_delta_Ns.norm();
-  // What a device can have put in: its force limit over the world time the report covers (plus the lag carried
-  // over, above), |Σ ΔJ| ≤ F_max·T, the
-  // reaction split among the contacts by at most kMaxReactionSplitRatio (Σ|ΔJ| ≤ √3·|reaction| for ≤ 3 constraints,
-  // haptic_controller/impulse_accumulator.cpp). World time, not haptic time: after a stalled world the controller has
-  // rendered against a plane that did not move for the whole stall, but the world simulates one step, and applying
-  // more than F_max·T_w in it would be a force the device cannot make, doing work nobody put in. The excess is cut
-  // from every share alike, dropped and counted: the world receives less, never more.
+  // What a device can have put in: its force limit over the time the report's rendering may stand for in this step,
+  // |Σ ΔJ| ≤ F_max·T, the reaction split among the contacts by at most kMaxReactionSplitRatio (Σ|ΔJ| ≤ √3·|reaction|
+  // for ≤ 3 constraints, haptic_controller/impulse_accumulator.cpp). T is the haptic time the report covers (its
+  // window) less the wall time the world stalled through: after a stall the controller has rendered against a plane
+  // that did not move, but the world simulates one step, and more than F_max·T_w in it would be a force the device
+  // cannot make, doing work nobody put in. Timing that only shifts (a world step woken late, a report read older or
+  // fresher than the last; the next report covers that much less or more) is not a stall: its whole window goes in.
+  // T is at least one step (a first report, a short window) and at most the world time covered plus one step (a
+  // rogue haptic time). The excess is cut from every share alike, dropped and counted: the world receives less,
+  // never more.
   constexpr double kMaxReactionSplitRatio = 1.7320508075688772;
   constexpr double kRounding = 1.0 + 1e-9;  // sums of a tick's worth of rounding
-  const double limit_Ns =
-      options_.report_force_limit_N * std::max(covered_world_s + lag_carried_s, period_s_) * kRounding;
+  const double rendered_s = known_start ? window.length_s - stalled_s : period_s_;
+  const double limit_s = std::max(std::min(rendered_s, covered_world_s + period_s_), period_s_);
+  const double limit_Ns = options_.report_force_limit_N * limit_s * kRounding;
   double scale = 1.0;
   if (reaction_Ns.norm() > limit_Ns) scale = limit_Ns / reaction_Ns.norm();
   if (reaction_sum_Ns > kMaxReactionSplitRatio * limit_Ns) {

@@ -71,6 +71,10 @@ class World {
   // The same with a single endpoint slot: the one-finger trial.
   const PlaneFrame& step(const HapticReport* report) { return step(std::span<const HapticReport* const>(&report, 1))[0]; }
 
+  // Before a step: the world's real-time clock skipped `count` steps' worth of wall time since the last (a stall;
+  // never in lockstep). Reports rendered over that time bring no more than the steps simulated (take_report).
+  void note_skipped_steps(std::uint64_t count) { stalled_s_ += static_cast<double>(count) * period_s_; }
+
   const Scene& scene() const { return scene_; }
   Coupling coupling() const { return options_.coupling; }
   double world_period_s() const { return period_s_; }
@@ -164,7 +168,7 @@ class World {
     double last_report_time_s = 0.0;
     std::uint64_t last_report_tick = 0;
     double last_applied_world_time_s = 0.0;  // the world time its previous report was applied at (same session)
-    double report_lag_s = 0.0;  // haptic time its reports so far covered less than the world time (take_report)
+    double stalled_at_last_applied_s = 0.0;  // stalled_s_ when its previous report was applied (take_report)
   };
 
   void take_finger(Endpoint& endpoint, const HapticReport& report);
@@ -214,6 +218,7 @@ class World {
   std::uint64_t simulated_object_steps_ = 0;
   double floor_penetration_max_m_ = 0.0;
   double time_s_ = 0.0;
+  double stalled_s_ = 0.0;  // wall time not simulated so far (note_skipped_steps)
   std::uint64_t steps_taken_ = 0;
 };
 

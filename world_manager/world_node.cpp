@@ -211,7 +211,7 @@ int WorldNode::run() {
   } else {
     RealtimeClock clock(world_.world_period_s());
     while (!g_stop_requested.load() && world_.steps_taken() < max_steps) {
-      clock.wait_next();
+      world_.note_skipped_steps(clock.wait_next().skipped);
       step_world();
       publish_stats(&clock);
     }

@@ -137,7 +137,7 @@ TEST_CASE("a restarted haptic session or a new epoch starts from a zero baseline
   }
 }
 
-TEST_CASE("a report bringing more impulse than a device renders in the world time it covers is cut to that, counted") {
+TEST_CASE("a report bringing more impulse than a device renders in the time it covers is cut to that, counted") {
   // 10 N over one 50 ms step is 0.5 N·s. A report claiming 1.61 N·s in one step (a world resumed after a stall, whose
   // controller rendered against a frozen plane all along; or a rogue participant) gets 0.5 and 1.11 is counted.
   auto world = make_world(impetus::parse_scene(impetus::test::free_body_document(tilted_box()), "free.json"));
@@ -165,10 +165,10 @@ TEST_CASE("a report bringing more impulse than a device renders in the world tim
   step_with_total(300, 2.01 + 1.9);
   CHECK(world->step_impulse_Ns(0).x() == Approx(1.9));
   CHECK(world->clipped_reports() == 1);
-  // The same report again for three steps (a transport keeps the last one while its controller is silent, e.g. a
-  // network link down), then a new one: it covers all four steps.
+  // The same report again for three steps (a transport keeps the last one while the link is down and the controller
+  // renders on), then a new one: it covers all four steps.
   for (int k = 0; k < 3; ++k) world->step(&report);
-  step_with_total(400, 3.91 + 1.9);
+  step_with_total(500, 3.91 + 1.9);
   CHECK(world->step_impulse_Ns(0).x() == Approx(1.9));
   CHECK(world->clipped_reports() == 1);
   // Shares on several contacts: |Σ ΔJ| ≤ F·T and Σ|ΔJ| ≤ √3·F·T. Two opposite shares of 0.6 N·s each (a pinch) sum
@@ -181,11 +181,8 @@ TEST_CASE("a report bringing more impulse than a device renders in the world tim
   CHECK(world->step_impulse_Ns(0).x() == Approx(0.5 * 1.7320508075688772 * 0.5).epsilon(1e-8));
 }
 
-TEST_CASE("a report that catches up on one that lagged (a lossy link) is applied whole, a stall's backlog is not") {
-  // Steps 50 ms apart. The world reads the report of tick 100, then (its tick-150 report lost) the one of tick 140,
-  // then the one of tick 200: that one covers 60 ms of rendering in a 50 ms step, and the device could have pushed
-  // 10 N all along, so 0.6 N·s goes in whole. The lag is used up: a report covering 80 ms in the next 50 ms step (a
-  // stall's backlog) is cut to the step's 0.5 N·s.
+TEST_CASE("a report covering more rendering than its step (a lossy link, a late step) goes in whole, a stall's not") {
+  // Steps 50 ms apart, the device's limit 10 N: 0.5 N·s a step.
   auto world = make_world(impetus::parse_scene(impetus::test::free_body_document(tilted_box()), "free.json"));
   HapticReport report = make_report(7, 100);
   add_entry(report, 0, 1, {0.1, 0.0, 0.0});
@@ -196,14 +193,29 @@ TEST_CASE("a report that catches up on one that lagged (a lossy link) is applied
     world->step(&report);
   };
   step_with_total(100, 0.1);
-  step_with_total(140, 0.5);  // 40 ms of rendering in a 50 ms step: 10 ms of lag carried
+  // The report of tick 150 lost, the world reads tick 140's, then tick 200's: 60 ms of rendering in a 50 ms step,
+  // which the device could have pushed at 10 N all along.
+  step_with_total(140, 0.5);
   CHECK(world->step_impulse_Ns(0).x() == Approx(0.4));
-  step_with_total(200, 1.1);  // 60 ms: within 10 N over 50 ms + the 10 ms carried
+  step_with_total(200, 1.1);
   CHECK(world->step_impulse_Ns(0).x() == Approx(0.6));
+  // A step woken 3 ms late reads a report 3 ms fresher than its last (a loaded machine; the next step is on time
+  // again and reads 3 ms less): nothing was lost to a stall, so the 53 ms of pushing go in whole.
+  step_with_total(253, 1.63);
+  CHECK(world->step_impulse_Ns(0).x() == Approx(0.53));
+  step_with_total(300, 2.1);
+  CHECK(world->step_impulse_Ns(0).x() == Approx(0.47));
   CHECK(world->clipped_reports() == 0);
-  step_with_total(280, 1.9);  // 80 ms in 50 ms, nothing carried
+  // A stall: the world's clock skipped two steps (100 ms it did not simulate), and the report then covers 150 ms of
+  // pushing against a plane that stood still. One step simulated, one step's 0.5 N·s goes in.
+  world->note_skipped_steps(2);
+  step_with_total(450, 3.6);
   CHECK(world->step_impulse_Ns(0).x() == Approx(0.5).epsilon(1e-8));
   CHECK(world->clipped_reports() == 1);
+  // A haptic time far ahead of the world's (a rogue clock) stands for at most the world time covered and one step.
+  step_with_total(10450, 100.0);
+  CHECK(world->step_impulse_Ns(0).x() == Approx(1.0).epsilon(1e-8));
+  CHECK(world->clipped_reports() == 2);
 }
 
 TEST_CASE("entries on static geometry or unknown ids move nothing") {

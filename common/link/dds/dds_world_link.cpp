@@ -38,6 +38,9 @@ constexpr const char* kStatsTopic = "impetus_haptic_stats";
 // world matched the writer (the first, which asks for a slot) is sent again.
 constexpr std::chrono::microseconds kSendPeriod{250};
 constexpr double kReportRepeat_s = 0.1;
+// How long a stopping controller waits for the world to acknowledge its last reports (a live world on a LAN answers
+// within milliseconds; a world that went away is not waited for).
+constexpr dds_duration_t kFinalAckWait = DDS_MSECS(500);
 // How long the receiver blocks before it looks at its stop flag (a guard condition wakes it sooner).
 constexpr dds_duration_t kReceiveWait = DDS_MSECS(100);
 // Samples taken per call: more than a world's endpoints' frames in one period.
@@ -450,17 +453,15 @@ struct DdsWorldLinkClient::State {
     alive.store(true);
   }
 
-  // Sender thread: each endpoint's newest report, once per period.
+  // Sender thread: each endpoint's newest report, once per period. When the controller stops, the reports its servo
+  // wrote after the last period go out too, and the world has up to kFinalAckWait to acknowledge them: the running
+  // totals it applies last are then the controller's last.
   void send() {
     std::array<std::uint64_t, kMaxEndpoints> last_sequence{};
     std::array<std::chrono::steady_clock::time_point, kMaxEndpoints> last_sent{};
     std::uint64_t stats_sequence = 0;
     auto next = std::chrono::steady_clock::now();
-    while (!stop.load()) {
-      next += kSendPeriod;
-      std::this_thread::sleep_until(next);
-      const auto now = std::chrono::steady_clock::now();
-      if (now - next > 100 * kSendPeriod) next = now;  // after a long stall, do not try to catch up
+    const auto send_reports = [&](std::chrono::steady_clock::time_point now) {
       for (std::uint32_t k = 0; k < endpoints; ++k) {
         const bool fresh = reports[k].try_read(sent_wire[k], last_sequence[k]);
         const bool repeat = std::chrono::duration<double>(now - last_sent[k]).count() > kReportRepeat_s;
@@ -469,12 +470,21 @@ struct DdsWorldLinkClient::State {
         if (dds_write(report_writer, &*send_sample) >= 0) sent.fetch_add(1);
         last_sent[k] = now;
       }
+    };
+    while (!stop.load()) {
+      next += kSendPeriod;
+      std::this_thread::sleep_until(next);
+      const auto now = std::chrono::steady_clock::now();
+      if (now - next > 100 * kSendPeriod) next = now;  // after a long stall, do not try to catch up
+      send_reports(now);
       if (stats.try_read(sent_stats.stats_local, stats_sequence)) {
         sent_stats.sample.client_id = client_id;
         to_dds(sent_stats.stats_local, sent_stats.sample.stats);
         dds_write(stats_writer, &sent_stats.sample);
       }
     }
+    send_reports(std::chrono::steady_clock::now());
+    if (alive.load()) dds_wait_for_acks(report_writer, kFinalAckWait);
   }
 
   DdsParticipant participant;
