@@ -171,7 +171,7 @@ start=$(date +%s.%N)
 "$build/world_manager/world_manager" "${world_args[@]}" 2>"$out/world.err" & world=$!; pids+=("$world")
 if ((view)); then
   # The viewer is a bystander: if it cannot start (the port is taken), the trial runs without it.
-  viewer_args=(--shm "$shm" --listen "$view_listen")
+  viewer_args=(--shm "$shm" --listen "$view_listen" --meshes-from "$scene")
   ((web)) && viewer_args+=(--touch)
   "$build/viewer/viewer" "${viewer_args[@]}" >"$out/viewer.out" 2>"$out/viewer.err" & viewer_pid=$!
   for _ in $(seq 100); do

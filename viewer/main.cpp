@@ -29,6 +29,10 @@ int main(int argc, char** argv) {
   app.add_flag("--allow-remote-touch", options.allow_remote_touch,
                "with --touch and --allow-remote: accept input from pages on other machines")
       ->needs("--touch");
+  app.add_option("--meshes-from", options.meshes_from,
+                 "live: the world's scene file; its meshes are read so the page draws their triangles (else a mesh "
+                 "is drawn as a ball that holds it)")
+      ->check(CLI::ExistingFile);
   app.add_option("--web", web_dir, "folder with the page (default: the installed or source viewer/web)")
       ->check(CLI::ExistingDirectory);
   app.add_option("--duration", options.duration_s, "seconds to serve (default: until stopped)")

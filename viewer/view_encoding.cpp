@@ -1,15 +1,20 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "viewer/view_encoding.h"
 
+#include "common/mesh/mesh_body.h"
+#include "common/shape/mesh_geometry.h"
 #include "common/shape/shape.h"
 #include "viewer/view_protocol.h"
 
 #include <nlohmann/json.hpp>
 
 #include <bit>
+#include <cinttypes>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
+#include <vector>
 
 namespace impetus::view {
 namespace {
@@ -33,6 +38,30 @@ class Packer {
   std::string& out_;
 };
 
+// A mesh body's form for the page (view_protocol.h §1 "mesh"): its triangles when this process loaded the file (the
+// registry has its hash) and they are few enough to send, else why the page draws its bound instead.
+nlohmann::json mesh_form(const Shape& shape) {
+  const auto* body = dynamic_cast<const MeshBody*>(find_mesh_geometry(shape.mesh_hash));
+  if (body == nullptr) return {{"drawn", "bound"}, {"why", "its file was not loaded (viewer --meshes-from SCENE)"}};
+  const TriangleMesh& mesh = body->bvh().mesh();
+  if (mesh.triangles.size() > kMaxViewMeshTriangles) {
+    return {{"drawn", "bound"},
+            {"why", std::to_string(mesh.triangles.size()) + " triangles, more than the " +
+                        std::to_string(kMaxViewMeshTriangles) + " a page is sent"}};
+  }
+  // Micrometres are finer than a pixel of any view of a desk-sized scene, and keep the numbers short.
+  constexpr double kVertexResolution_m = 1e-6;
+  std::vector<double> vertices;
+  vertices.reserve(3 * mesh.vertices_m.size());
+  for (const Eigen::Vector3d& v : mesh.vertices_m) {
+    for (int i = 0; i < 3; ++i) vertices.push_back(std::round(v[i] / kVertexResolution_m) * kVertexResolution_m);
+  }
+  std::vector<std::uint32_t> triangles;
+  triangles.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles) triangles.insert(triangles.end(), t.begin(), t.end());
+  return {{"drawn", "triangles"}, {"vertices_m", std::move(vertices)}, {"triangles", std::move(triangles)}};
+}
+
 }  // namespace
 
 std::string scene_message(const ViewScene& scene, const std::string& source, const std::optional<ReplayRange>& replay) {
@@ -45,12 +74,19 @@ std::string scene_message(const ViewScene& scene, const std::string& source, con
   nlohmann::json bodies = nlohmann::json::array();
   for (std::uint32_t k = 0; k < scene.body_count; ++k) {
     const ViewBodyInfo& body = scene.bodies[k];
-    bodies.push_back({{"name", std::string(body.name.data())},  // NUL-terminated (scene_problem checked)
-                      {"shape", to_string(body.shape.kind)},
-                      {"dynamic", body.dynamic != 0},
-                      {"size_m", body.shape.box_size_m},
-                      {"radius_m", body.shape.radius_m},
-                      {"length_m", body.shape.length_m}});
+    nlohmann::json entry = {{"name", std::string(body.name.data())},  // NUL-terminated (scene_problem checked)
+                            {"shape", to_string(body.shape.kind)},
+                            {"dynamic", body.dynamic != 0},
+                            {"size_m", body.shape.box_size_m},
+                            {"radius_m", body.shape.radius_m},
+                            {"length_m", body.shape.length_m}};
+    if (body.shape.kind == ShapeKind::mesh) {
+      char hash[17];
+      std::snprintf(hash, sizeof hash, "%016" PRIx64, body.shape.mesh_hash);
+      entry["mesh_hash"] = hash;
+      entry["mesh"] = mesh_form(body.shape);
+    }
+    bodies.push_back(std::move(entry));
   }
   message["bodies"] = std::move(bodies);
   if (replay) {

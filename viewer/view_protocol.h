@@ -10,6 +10,11 @@
 //       "floor": {"present": true, "height_m": 0.0},
 //       "bodies": [{"name": "cube", "shape": "box" | "sphere" | ... (common/shape/shape.h to_string), "dynamic": true,
 //                   "size_m": [x, y, z], "radius_m": r, "length_m": l}, ...],   (common/shape/shape_descriptor.h)
+//       a mesh body also has "mesh_hash": "<16 hex digits>" and "mesh": either
+//         {"drawn": "triangles", "vertices_m": [x0, y0, z0, x1, ...], "triangles": [a0, b0, c0, a1, ...]}
+//       (body frame, m, to the micrometre; vertex indices, counter-clockwise seen from outside), when the viewer read
+//       its file (--meshes-from, or a replay's scene) and it has at most kMaxViewMeshTriangles, or
+//         {"drawn": "bound", "why": "..."}: the page draws a ball of radius_m about its centre instead.
 //       "replay": {"start_s": t0, "end_s": t1, "frame_count": n}}          (replay only)
 //    Body k of every frame below is bodies[k]. A shape's axis of symmetry is its body z.
 //
@@ -57,6 +62,9 @@ inline constexpr std::size_t kEndpointValues = 12;
 inline constexpr std::size_t kPlaneValues = 6;
 inline constexpr std::size_t kDentValues = 8;
 inline constexpr std::size_t kMaxClientMessageBytes = 4096;
+// A mesh of 10^5 triangles is a scene message of about 3 MB, sent to each page as it connects; a finer one (a terrain)
+// is drawn as its bound rather than hold up a page for seconds.
+inline constexpr std::size_t kMaxViewMeshTriangles = 100'000;
 inline constexpr double kMinReplaySpeed = 0.1;
 inline constexpr double kMaxReplaySpeed = 10.0;
 

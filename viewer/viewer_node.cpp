@@ -6,6 +6,7 @@
 
 #include "common/link/shm/names.h"
 #include "common/link/shm/shm_touch_port.h"
+#include "common/mesh/mesh_object.h"
 #include "common/runtime/process.h"
 #include "viewer/view_feed.h"
 #include "viewer/touch_control.h"
@@ -78,6 +79,8 @@ int ViewerNode::run() {
                                 "push the world); add --allow-remote-touch if that is what you want");
   }
   const WebRoot web(options_.web_dir.empty() ? WebRoot::find_default(executable_) : options_.web_dir);
+  // The meshes' triangles are registered by their hash, which the world's scene names for each mesh body.
+  if (!options_.meshes_from.empty()) load_scene_meshes(options_.meshes_from);
   std::unique_ptr<ViewFeed> feed;
   LiveFeed* live = nullptr;
   if (!options_.replay_dir.empty()) {

@@ -25,6 +25,7 @@ struct ViewerOptions {
   bool touch = false;
   bool allow_remote_touch = false;  // touch with allow_remote: input from pages on other machines
   std::filesystem::path web_dir; // the page's files; empty: WebRoot::find_default
+  std::string meshes_from;       // live: the world's scene file, whose meshes the page is sent (a replay reads its own)
   double duration_s = 0.0;       // 0: until stopped
 };
 

@@ -202,7 +202,9 @@ export async function view(page) { return page.evaluate(() => window.impetusView
   scene: window.impetusView.scene, connected: window.impetusView.connected,
   framesReceived: window.impetusView.framesReceived, latest: window.impetusView.latest,
   fps: window.impetusView.fps, renderedFrames: window.impetusView.renderedFrames,
-  rejectedFrames: window.impetusView.rejectedFrames, dent: window.impetusView.dent })) : null); }
+  rejectedFrames: window.impetusView.rejectedFrames, rejectedMessages: window.impetusView.rejectedMessages,
+  dent: window.impetusView.dent,
+  meshes: window.impetusView.meshes })) : null); }
 
 // Runs case `which` of `cases` (each an async function of the processes and the browser) as a test program: prints
 // what it checks, and on a failure the reason and each process's last stderr; kills what it started and removes the

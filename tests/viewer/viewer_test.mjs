@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The viewer in a real browser (headless Chromium driven by Playwright), against the project's own binaries.
-//   node tests/viewer/viewer_test.mjs --build BUILD_DIR --case live|replay|bodies|kill|bad-input|clay [--picture FILE]
+//   node tests/viewer/viewer_test.mjs --build BUILD_DIR --case live|replay|bodies|kill|bad-input|clay|meshes
+//     [--picture FILE]
 // --picture (replay only): also saves the page at the tap's hardest push as FILE (the README's picture;
 // scripts/make_figures.sh).
 // Each case starts what it needs under a shared-memory name of its own, prints what it checks and measures, and exits
@@ -409,5 +410,40 @@ async function clay(procs, browser) {
   check(state.rejectedFrames === 0, "no frame rejected by the page");
 }
 
-const cases = { live, replay, bodies, kill, "bad-input": badInput, clay };
+// The meshes scene live, the viewer given its file: every mesh is drawn as its own triangles (as many as the world's
+// files have, which world_manager prints), not as a ball; without the file the page says so and draws the bound.
+async function meshes(procs, browser) {
+  const scene = path.join(source, "scenes", "meshes.json");
+  const world = procs.start("world", "world_manager", ["--scene", scene, "--clock", "realtime", "--shm", shm]);
+  const viewer = await procs.viewer(["--shm", shm, "--meshes-from", scene]);
+  const page = await openPage(browser, viewer.url);
+  await waitFor("the page's first frames", async () => (await view(page))?.framesReceived > 5);
+  await page.evaluate(() => window.impetusView.lookAt([0.12, -0.05, 0.02], 0.16));
+  await sleep(500);
+  await capture(page, "bowl");  // throws if the page drew no bowl
+  await page.screenshot({ path: path.join(outDir, "meshes.png") });
+  const withFiles = await view(page);
+  const bare = await procs.viewer(["--shm", shm]);
+  const barePage = await openPage(browser, bare.url);
+  await waitFor("the second page's first frames", async () => (await view(barePage))?.framesReceived > 5);
+  const withoutFiles = await view(barePage);
+  await procs.stop(bare);
+  await procs.stop(viewer);
+  await procs.stop(world);
+
+  // The triangle counts of scenes/meshes/*.obj (scripts/make_meshes.py); the cube's 12 are the fewest a cube has.
+  const counts = Object.fromEntries(withFiles.meshes.map((m) => [m.name, m]));
+  for (const name of ["cube", "pebble", "bowl", "shell"]) {
+    check(counts[name]?.drawn === "triangles" && counts[name].triangles >= 12,
+      `${name} drawn as its ${counts[name]?.triangles} triangles`);
+  }
+  check(counts.pebble.triangles === 1280,
+    `the pebble has the 1280 triangles its scene says (${counts.pebble.triangles})`);
+  check(withoutFiles.meshes.length === 4 && withoutFiles.meshes.every((m) => m.drawn === "bound"),
+    "a viewer not given the scene draws each mesh as a ball that holds it");
+  check(withFiles.rejectedMessages === 0 && withFiles.rejectedFrames === 0,
+    `no message rejected by the page (${withFiles.rejectedMessages} text, ${withFiles.rejectedFrames} frames)`);
+}
+
+const cases = { live, replay, bodies, kill, "bad-input": badInput, clay, meshes };
 await runCase("viewer_test", cases, which, build, outDir, shm);

@@ -4,6 +4,8 @@
 
 #include "common/link/dds/dds_world_view.h"
 #include "common/link/shm/shm_world_view.h"
+#include "common/mesh/mesh_body.h"
+#include "common/shape/mesh_geometry.h"
 #include "viewer/replay.h"
 #include "viewer/request_check.h"
 #include "viewer/view_feed.h"
@@ -239,6 +241,79 @@ TEST_CASE("a snapshot with a bad count, a non-finite pose or a non-unit quaterni
   snapshot->bodies[1].position_m[2] = 0.0;
   snapshot->bodies[1].orientation_wxyz = {0.9, 0.0, 0.0, 0.0};
   CHECK_THAT(snapshot_problem(*snapshot), Catch::Contains("unit quaternion"));
+}
+
+TEST_CASE("the scene message carries a loaded mesh's triangles in its body frame, an unknown mesh says why not") {
+  const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/meshes.json");
+  auto described = std::make_unique<ViewScene>();
+  describe_scene(scene, Coupling::impulse, 20.0, 1, *described);
+  // A fifth body whose mesh no file of this process gave (a live viewer without --meshes-from).
+  REQUIRE(described->body_count < kMaxViewBodies);
+  ViewBodyInfo& unknown = described->bodies[described->body_count++];
+  unknown = described->bodies[0];
+  unknown.shape.mesh_hash ^= 1;
+  REQUIRE(find_mesh_geometry(unknown.shape.mesh_hash) == nullptr);
+  const nlohmann::json message = nlohmann::json::parse(view::scene_message(*described, "test", std::nullopt));
+  const auto& bodies = message["bodies"];
+  REQUIRE(bodies.size() == scene.objects.size() + 1);
+  for (std::size_t k = 0; k < scene.objects.size(); ++k) {
+    INFO(scene.objects[k].name);
+    const auto* mesh_body = dynamic_cast<const MeshBody*>(find_mesh_geometry(scene.objects[k].shape.mesh_hash));
+    REQUIRE(mesh_body != nullptr);
+    const TriangleMesh& mesh = mesh_body->bvh().mesh();
+    const auto& form = bodies[k]["mesh"];
+    REQUIRE(form["drawn"] == "triangles");
+    REQUIRE(form["vertices_m"].size() == 3 * mesh.vertices_m.size());
+    REQUIRE(form["triangles"].size() == 3 * mesh.triangles.size());
+    double worst_m = 0.0;
+    for (std::size_t v = 0; v < mesh.vertices_m.size(); ++v) {
+      for (int i = 0; i < 3; ++i) {
+        worst_m = std::max(worst_m, std::abs(form["vertices_m"][3 * v + i].get<double>() - mesh.vertices_m[v][i]));
+      }
+    }
+    CHECK(worst_m <= 0.5e-6 + 1e-12);  // to the micrometre (view_protocol.h)
+    bool same_triangles = true;
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      for (int i = 0; i < 3; ++i) {
+        same_triangles = same_triangles && form["triangles"][3 * t + i] == mesh.triangles[t][i];
+      }
+    }
+    CHECK(same_triangles);
+    CHECK(bodies[k]["mesh_hash"].get<std::string>().size() == 16);
+  }
+  const auto& missing = bodies.back()["mesh"];
+  CHECK(missing["drawn"] == "bound");
+  CHECK(missing["why"].get<std::string>().find("--meshes-from") != std::string::npos);
+  CHECK_FALSE(bodies.back()["mesh"].contains("vertices_m"));
+}
+
+TEST_CASE("a mesh of more triangles than a page is sent is drawn as its bound, and the message says so") {
+  // A flat sheet of 2·225² = 101 250 triangles, just over the limit.
+  constexpr int kCells = 225;
+  static_assert(2 * kCells * kCells > static_cast<int>(view::kMaxViewMeshTriangles));
+  const fs::path file = fs::temp_directory_path() / ("impetus_viewer_sheet_" + std::to_string(getpid()) + ".obj");
+  {
+    std::ofstream obj(file);
+    for (int j = 0; j <= kCells; ++j) {
+      for (int i = 0; i <= kCells; ++i) obj << "v " << i * 1e-3 << ' ' << j * 1e-3 << " 0\n";
+    }
+    const auto at = [](int i, int j) { return j * (kCells + 1) + i + 1; };
+    for (int j = 0; j < kCells; ++j) {
+      for (int i = 0; i < kCells; ++i) {
+        obj << "f " << at(i, j) << ' ' << at(i + 1, j) << ' ' << at(i + 1, j + 1) << "\n";
+        obj << "f " << at(i, j) << ' ' << at(i + 1, j + 1) << ' ' << at(i, j + 1) << "\n";
+      }
+    }
+  }
+  const MeshBody& sheet = MeshBody::load(file.string(), Eigen::Vector3d::Ones(), false);
+  fs::remove(file);
+  auto described = std::make_unique<ViewScene>();
+  described->body_count = 1;
+  described->bodies[0].shape = sheet.shape();
+  const nlohmann::json message = nlohmann::json::parse(view::scene_message(*described, "test", std::nullopt));
+  const auto& form = message["bodies"][0]["mesh"];
+  CHECK(form["drawn"] == "bound");
+  CHECK(form["why"].get<std::string>().find("101250 triangles") != std::string::npos);
 }
 
 TEST_CASE("a frame message is the header, 7 values per body, and per endpoint 12 plus 6 per plane") {

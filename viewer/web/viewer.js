@@ -98,7 +98,7 @@ const view = {
   send(message) { return sendControl(message); },
   project(name) { return projectBody(name); },   // where body `name` was drawn: {x, y} page pixels, or null
   projectPoint(point) { return projectPoint(point); },  // where world point [x, y, z] (m) is drawn: {x, y} page pixels
-  projectPoint(point) { return projectPoint(point); },   // where world point [x, y, z] is drawn: {x, y} page pixels
+  meshes: [],                // each mesh body of the scene: {name, drawn: 'triangles' | 'bound', triangles}
   // Points the camera at a sphere (centre [x, y, z] m, radius m) and stops it following the bodies, as a user's
   // own camera move does.
   lookAt(center, radius) {
@@ -246,10 +246,17 @@ function shapeOf(body) {
       const l = nonNegative(body.length_m) ? body.length_m : 0;
       return { key: `capsule:${r}:${l}`, kind: 'capsule', radius: r, length: l, boundingRadius: r + l / 2 };
     }
-    case 'mesh':
-      // Its triangles stay with the world (docs/meshes.md): drawn as a coarse ball about its centre of mass that
-      // holds it (radius_m), so the page shows where it is and how it turns, not its form.
+    case 'mesh': {
+      // Its triangles when the viewer sent them (view_protocol.h §1); else a coarse ball about its centre of mass
+      // that holds it (radius_m), so the page shows where it is and how it turns, not its form.
+      const form = body.mesh;
+      if (form && form.drawn === 'triangles' && validTriangles(form.vertices_m, form.triangles)) {
+        return { key: `triangles:${body.mesh_hash}`, kind: 'triangles', vertices: form.vertices_m,
+                 triangles: form.triangles, boundingRadius: r };
+      }
+      if (form && form.why) console.info(`impetus viewer: ${body.name} is drawn as its bound: ${form.why}`);
       return { key: `mesh:${r}`, kind: 'mesh', radius: r, boundingRadius: r };
+    }
     default: {
       if (body.shape !== 'box') {
         console.warn(`impetus viewer: unknown shape ${body.shape} of ${body.name}, drawn as a box`);
@@ -261,6 +268,67 @@ function shapeOf(body) {
   }
 }
 
+// Whether a mesh's arrays are whole: finite coordinates in threes, vertex indices in threes and in range.
+function validTriangles(vertices, triangles) {
+  if (!Array.isArray(vertices) || !Array.isArray(triangles)) return false;
+  if (vertices.length % 3 !== 0 || triangles.length % 3 !== 0 || triangles.length === 0) return false;
+  const count = vertices.length / 3;
+  return vertices.every(Number.isFinite) && triangles.every((i) => Number.isInteger(i) && i >= 0 && i < count);
+}
+
+// Corners whose triangles meet at less than this angle share a normal (a scan or a sphere looks smooth); a sharper
+// crease (a box's edge, a bowl's rim) stays sharp.
+const CREASE_COS = Math.cos(35 * Math.PI / 180);
+
+// A user's mesh in its body frame: each triangle's corners get the mean normal of the triangles around that vertex
+// within the crease angle of its own.
+function triangleGeometry(vertices, triangles) {
+  const vertexCount = vertices.length / 3;
+  const triangleCount = triangles.length / 3;
+  const faceNormals = new Float32Array(triangles.length);
+  const a = new THREE.Vector3();
+  const b = new THREE.Vector3();
+  const c = new THREE.Vector3();
+  for (let f = 0; f < triangleCount; f++) {
+    a.fromArray(vertices, 3 * triangles[3 * f]);
+    b.fromArray(vertices, 3 * triangles[3 * f + 1]).sub(a);
+    c.fromArray(vertices, 3 * triangles[3 * f + 2]).sub(a);
+    b.cross(c).normalize().toArray(faceNormals, 3 * f);   // a zero-area triangle's stays zero
+  }
+  // The triangles around each vertex, as one list in vertex order (start[v] .. start[v + 1]).
+  const start = new Uint32Array(vertexCount + 1);
+  for (const v of triangles) start[v + 1]++;
+  for (let v = 0; v < vertexCount; v++) start[v + 1] += start[v];
+  const around = new Uint32Array(triangles.length);
+  const filled = start.slice(0, vertexCount);
+  triangles.forEach((v, n) => { around[filled[v]++] = Math.floor(n / 3); });
+
+  const position = new Float32Array(triangles.length * 3);
+  const normal = new Float32Array(triangles.length * 3);
+  const sum = new THREE.Vector3();
+  const own = new THREE.Vector3();
+  const other = new THREE.Vector3();
+  for (let n = 0; n < triangles.length; n++) {
+    const v = triangles[n];
+    const f = Math.floor(n / 3);
+    position.set(vertices.slice(3 * v, 3 * v + 3), 3 * n);
+    own.fromArray(faceNormals, 3 * f);
+    sum.set(0, 0, 0);
+    for (let k = start[v]; k < start[v + 1]; k++) {
+      other.fromArray(faceNormals, 3 * around[k]);
+      if (other.dot(own) >= CREASE_COS) sum.add(other);
+    }
+    (sum.lengthSq() > 0 ? sum.normalize() : own).toArray(normal, 3 * n);
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(position, 3));
+  geometry.setAttribute('normal', new THREE.BufferAttribute(normal, 3));
+  const index = new Uint32Array(triangles.length);
+  for (let n = 0; n < index.length; n++) index[n] = n;
+  geometry.setIndex(new THREE.BufferAttribute(index, 1));
+  return geometry;
+}
+
 // The solid of a shape in the body's frame, axis along z for capsule and cylinder (three.js builds them along y).
 // Detail 2 is smooth; 1 and 0 (hundreds, thousands of bodies) have few triangles a body, since a software renderer
 // (headless browsers) spends its time per triangle, and bodies that many are small on screen.
@@ -269,6 +337,7 @@ function solidGeometry(shape, detail) {
   switch (shape.kind) {
     case 'sphere': return new THREE.SphereGeometry(shape.radius, radial, [4, 8, 20][detail]);
     case 'mesh': return new THREE.SphereGeometry(shape.radius, 8, 6);  // coarse: a bound, not the form
+    case 'triangles': return triangleGeometry(shape.vertices, shape.triangles);
     case 'cylinder':
       return new THREE.CylinderGeometry(shape.radius, shape.radius, shape.length, radial).rotateX(Math.PI / 2);
     case 'capsule':
@@ -354,6 +423,7 @@ function pushArc(out, c, u, v, r, a0, a1, segments) {
 // flat faces need it most; shading tells round shapes apart.
 function outlinePositions(shape, detail) {
   if (detail < 2 && shape.kind !== 'box') return [];
+  if (shape.kind === 'triangles') return [];   // its creases show in its shading
   const n = 48;
   const X = [1, 0, 0];
   const Y = [0, 1, 0];
@@ -510,6 +580,11 @@ function buildScene(message) {
   const count = bodies.length;
   const shapes = bodies.map(shapeOf);
   sceneShapes = shapes;
+  view.meshes = bodies.flatMap((body, k) => body.shape !== 'mesh' ? [] : [{
+    name: body.name,
+    drawn: shapes[k].kind === 'triangles' ? 'triangles' : 'bound',
+    triangles: shapes[k].kind === 'triangles' ? shapes[k].triangles.length / 3 : 0,
+  }]);
   sceneDetail = detailFor(count);
   view.dent = null;
   dentBuiltAt = -Infinity;
