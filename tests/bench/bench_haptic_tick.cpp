@@ -2,7 +2,9 @@
 // Tick cost of the haptic servo with its SPIDAR driver (kinematics + interpolation + proxy + force + accumulation +
 // tensions) against the number of planes in the world frame: p50 / p99 in ns. Then the cost of one controller tick
 // with 1, 2, 4 and 8 endpoints (a SPIDAR string set, port and servo per finger, 4 planes each, the pushes exchanged
-// among them). Prints only; no assertions. `--planes N` runs only the plane sweep's N (for counting instructions).
+// among them). The plane sweep runs without and with the passivity layer (the hand port's books and damper on every
+// tick, the world handing energy back each frame). Prints only; no assertions. `--planes N` runs only the plane
+// sweep's N, without the layer (for counting instructions).
 
 #include <algorithm>
 #include <chrono>
@@ -28,8 +30,11 @@ constexpr int kTicksPerWorldStep = 50;  // 1 kHz servo, 20 Hz world
 
 // Planes around the workspace centre facing it, at 2–6 cm, a few of them moving and with friction, so the finger
 // wandering near the centre touches several at once.
-PlaneFrame make_frame(int planes, std::uint64_t index, double phase) {
+PlaneFrame make_frame(int planes, std::uint64_t index, double phase, bool port_layer = false) {
   PlaneFrame frame;
+  // With the layer on, the world hands back a little energy every frame (its running total grows).
+  frame.port_layer = port_layer ? 1u : 0u;
+  frame.port_returned_J = port_layer ? 1e-3 * static_cast<double>(index) : 0.0;
   frame.frame_index = index;
   frame.world_session = 1;
   frame.world_period_s = kTicksPerWorldStep * 1e-3;
@@ -68,7 +73,7 @@ class ScriptedDevice final : public DeviceStepper {
   InProcessDevicePort& port_;
 };
 
-void run(int planes) {
+void run(int planes, bool port_layer) {
   ServoOptions options;
   HapticServo servo(options, 1);
   const SpidarGeometry geometry;
@@ -82,7 +87,7 @@ void run(int planes) {
   for (int tick = 0; tick < kTicks; ++tick) {
     const double now_s = tick * 1e-3;
     if (tick % kTicksPerWorldStep == 0)
-      servo.on_plane_frame(make_frame(planes, tick / kTicksPerWorldStep, now_s), now_s);
+      servo.on_plane_frame(make_frame(planes, tick / kTicksPerWorldStep, now_s, port_layer), now_s);
     const Eigen::Vector3d finger =
         to_eigen(geometry.centre_m) +
         0.05 * Eigen::Vector3d(std::sin(tick * 0.0031), std::sin(tick * 0.0023), std::sin(tick * 0.0017));
@@ -96,8 +101,9 @@ void run(int planes) {
     contact_ticks += result.active_planes > 0 ? 1 : 0;
   }
   std::sort(ns.begin(), ns.end());
-  std::printf("planes %3d  tick p50 %8.0f ns  p99 %8.0f ns  max %8.0f ns  (contact ticks %.0f%%)\n", planes,
-              ns[kTicks / 2], ns[kTicks * 99 / 100], ns.back(), 100.0 * contact_ticks / kTicks);
+  std::printf("planes %3d  layer %-3s  tick p50 %8.0f ns  p99 %8.0f ns  max %8.0f ns  (contact ticks %.0f%%)\n",
+              planes, port_layer ? "on" : "off", ns[kTicks / 2], ns[kTicks * 99 / 100], ns.back(),
+              100.0 * contact_ticks / kTicks);
 }
 
 // One controller tick with `endpoints` fingers: the finger set's read (each finger's port turn and kinematics), a
@@ -161,14 +167,16 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "bench_haptic_tick: --planes must be 1 to %u, not '%s'\n", kMaxPlanes, argv[2]);
       return 2;
     }
-    run(planes);
+    run(planes, false);
     return 0;
   }
   if (argc != 1) {
     std::fprintf(stderr, "usage: bench_haptic_tick [--planes N]\n");
     return argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") ? 0 : 2;
   }
-  for (const int planes : {1, 4, 16, 64}) run(planes);
+  for (const bool port_layer : {false, true}) {
+    for (const int planes : {1, 4, 16, 64}) run(planes, port_layer);
+  }
   for (const int endpoints : {1, 2, 4, 8}) run_endpoints(endpoints);
   return 0;
 }
