@@ -4,7 +4,8 @@
 # shared 2-core VM is a measurement, not a pass/fail test (timing goals live in benchmarks).
 #   scripts/bench.sh [--short]       --short: 5 s instead of 30 s for the real-time loop benchmark
 #
-#   1. haptic tick cost vs number of planes            build/tests/bench_haptic_tick
+#   1. haptic tick cost vs number of planes (passivity layer off and on), per endpoint count, and the 8-string
+#      grip SPIDAR's pose and tensions                 build/tests/bench_haptic_tick
 #   2. world step and feature query vs object count, physics in the 1 kHz loop vs the 20 Hz world, a world of
 #      N resting bodies with sleeping on and off (--short: up to 10 k, else 100 k)   build/tests/bench_world
 #   3. channel latency between processes               build/tests/bench_channel

@@ -4,7 +4,8 @@
 // with 1, 2, 4 and 8 endpoints (a SPIDAR string set, port and servo per finger, 4 planes each, the pushes exchanged
 // among them). The plane sweep runs without and with the passivity layer (the hand port's books and damper on every
 // tick, the world handing energy back each frame). Prints only; no assertions. `--planes N` runs only the plane
-// sweep's N, without the layer (for counting instructions).
+// sweep's N, without the layer (for counting instructions). Last, the 8-string grip SPIDAR's device work a tick: its
+// pose from eight lengths (warm, from the last tick's) and its tension distribution, within the motors and beyond.
 
 #include <algorithm>
 #include <chrono>
@@ -18,6 +19,8 @@
 
 #include "common/link/inproc/inproc_device_port.h"
 #include "haptic_controller/device/finger_set.h"
+#include "haptic_controller/device/grip_kinematics.h"
+#include "haptic_controller/device/grip_tension.h"
 #include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/servo.h"
 
@@ -157,6 +160,52 @@ void run_endpoints(int endpoints) {
               endpoints, ns[kTicks / 2], ns[kTicks * 99 / 100], ns.back(), ns[kTicks / 2] / endpoints);
 }
 
+// The grip's device work a tick, on a wandering, turning grip: the pose from its quantised lengths (warm start), then
+// the tensions for a wrench within the motors, and for one beyond them (the bisection's cost).
+void run_grip() {
+  const SpidarGripGeometry geometry;
+  const GripKinematics kinematics(geometry);
+  std::vector<double> pose_ns(kTicks);
+  std::vector<double> tension_ns(kTicks);
+  std::vector<double> saturated_ns(kTicks);
+  GripPose found;
+  found.position_m = Eigen::Vector3d(geometry.centre_m[0], geometry.centre_m[1], geometry.centre_m[2]);
+  int failures = 0;
+  for (int tick = 0; tick < kTicks; ++tick) {
+    GripPose truth;
+    truth.position_m = Eigen::Vector3d(geometry.centre_m[0], geometry.centre_m[1], geometry.centre_m[2]) +
+                       0.05 * Eigen::Vector3d(std::sin(tick * 0.0031), std::sin(tick * 0.0023), std::sin(tick * 0.0017));
+    truth.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * std::sin(tick * 0.002),
+                                                             Eigen::Vector3d(1.0, 2.0, 3.0).normalized()));
+    const GripLengths lengths = kinematics.lengths_m(kinematics.encoder_counts(truth));
+    auto start = std::chrono::steady_clock::now();
+    failures += kinematics.pose(lengths, found, found).status == GripSolveStatus::ok ? 0 : 1;
+    auto stop = std::chrono::steady_clock::now();
+    pose_ns[tick] = std::chrono::duration<double, std::nano>(stop - start).count();
+    const GripWrenchMatrix w = kinematics.wrench_matrix(found);
+    GripWrench wrench;
+    wrench << 4.0 * std::sin(tick * 0.01), 3.0, -2.0, 0.02, -0.01, 0.03 * std::cos(tick * 0.01);
+    start = std::chrono::steady_clock::now();
+    const GripTensionSolution within =
+        distribute_grip_tension(wrench, w, geometry.tension_min_N, geometry.tension_max_N);
+    stop = std::chrono::steady_clock::now();
+    tension_ns[tick] = std::chrono::duration<double, std::nano>(stop - start).count();
+    start = std::chrono::steady_clock::now();
+    const GripTensionSolution beyond =
+        distribute_grip_tension(50.0 * wrench, w, geometry.tension_min_N, geometry.tension_max_N);
+    stop = std::chrono::steady_clock::now();
+    saturated_ns[tick] = std::chrono::duration<double, std::nano>(stop - start).count();
+    failures += within.saturated || !beyond.saturated ? 1 : 0;
+  }
+  for (auto* samples : {&pose_ns, &tension_ns, &saturated_ns}) std::sort(samples->begin(), samples->end());
+  std::printf("grip pose (8 strings, warm)      p50 %8.0f ns  p99 %8.0f ns\n", pose_ns[kTicks / 2],
+              pose_ns[kTicks * 99 / 100]);
+  std::printf("grip tensions within the motors  p50 %8.0f ns  p99 %8.0f ns\n", tension_ns[kTicks / 2],
+              tension_ns[kTicks * 99 / 100]);
+  std::printf("grip tensions beyond (scaled)    p50 %8.0f ns  p99 %8.0f ns  (%d unexpected outcomes)\n",
+              saturated_ns[kTicks / 2], saturated_ns[kTicks * 99 / 100], failures);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -178,5 +227,6 @@ int main(int argc, char** argv) {
     for (const int planes : {1, 4, 16, 64}) run(planes, port_layer);
   }
   for (const int endpoints : {1, 2, 4, 8}) run_endpoints(endpoints);
+  run_grip();
   return 0;
 }

@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "haptic_controller/device/grip_tension.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace impetus {
+namespace {
+
+using Tensions = Eigen::Matrix<double, kGripStringCount, 1>;
+using NullBasis = Eigen::Matrix<double, kGripStringCount, 2>;
+
+// The λ nearest the origin with t_min ≤ base + N·λ ≤ t_max (header: the origin, the feet of the perpendiculars on the
+// sixteen limit lines, and their pairwise corners). False if no candidate is feasible: the polygon is empty (it is
+// bounded, N having full column rank, so a non-empty one has a feasible corner). With `any`, whether the polygon is
+// empty only: the first feasible corner ends the search (the bisection's question).
+bool nearest_feasible(const Tensions& base, const NullBasis& n, double lo, double hi, Eigen::Vector2d& best,
+                      bool any = false) {
+  // Feasible to rounding: 10⁻⁹ of the motors' range (the candidates' own rounding is ~10⁻¹⁵ of it), so the clamp
+  // into the box afterwards moves a tension by nanonewtons at most.
+  const double tolerance = 1e-9 * (hi - lo);
+  const auto feasible = [&](const Eigen::Vector2d& lambda) {
+    for (int k = 0; k < kGripStringCount; ++k) {
+      const double t = base[k] + n.row(k).dot(lambda);
+      if (t < lo - tolerance || t > hi + tolerance) return false;
+    }
+    return true;
+  };
+  // The sixteen lines a_j·λ = b_j: string k at its minimum (j = 2k) or its maximum (j = 2k + 1).
+  constexpr int kLines = 2 * kGripStringCount;
+  std::array<Eigen::Vector2d, kLines> a;
+  std::array<double, kLines> b;
+  for (int k = 0; k < kGripStringCount; ++k) {
+    a[2 * k] = a[2 * k + 1] = n.row(k).transpose();
+    b[2 * k] = lo - base[k];
+    b[2 * k + 1] = hi - base[k];
+  }
+  double best_norm = std::numeric_limits<double>::infinity();
+  const auto consider = [&](const Eigen::Vector2d& lambda) {
+    const double norm = lambda.squaredNorm();
+    if (norm < best_norm && feasible(lambda)) {
+      best_norm = norm;
+      best = lambda;
+    }
+  };
+  for (int i = 0; i < kLines; ++i) {
+    for (int j = i + 1; j < kLines; ++j) {
+      const double det = a[i].x() * a[j].y() - a[i].y() * a[j].x();
+      if (std::abs(det) < 1e-12) continue;  // parallel: a string's two limits, or two strings alike
+      consider(Eigen::Vector2d((b[i] * a[j].y() - b[j] * a[i].y()) / det, (a[i].x() * b[j] - a[j].x() * b[i]) / det));
+      if (any && best_norm < std::numeric_limits<double>::infinity()) return true;
+    }
+  }
+  if (any) return false;
+  consider(Eigen::Vector2d::Zero());
+  for (int j = 0; j < kLines; ++j) {
+    const double length2 = a[j].squaredNorm();
+    if (length2 > 1e-24) consider(b[j] / length2 * a[j]);
+  }
+  return best_norm < std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+GripTensionSolution distribute_grip_tension(const GripWrench& wrench, const GripWrenchMatrix& w, double tension_min_N,
+                                            double tension_max_N) {
+  GripTensionSolution solution;
+  const auto at_minimum = [&] {
+    solution.tension_N.fill(tension_min_N);
+    solution.achieved = w * Tensions::Constant(tension_min_N);
+    solution.closure = false;
+    solution.saturated = true;
+    solution.scale = 0.0;
+    return solution;
+  };
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> factor(w * w.transpose());
+  const auto pivots = factor.vectorD();
+  if (!wrench.allFinite() || factor.info() != Eigen::Success || !(pivots.minCoeff() > 1e-12 * pivots.maxCoeff())) {
+    return at_minimum();  // no wrench to render, or a pose where the strings do not span the six directions
+  }
+  const Tensions least = w.transpose() * factor.solve(wrench);  // t_p = Wᵀ(W·Wᵀ)⁻¹·w, the least-norm exact answer
+  // W's null space: the last two columns of Q in Wᵀ = Q·R (W has rank 6, checked above).
+  const Eigen::HouseholderQR<Eigen::Matrix<double, kGripStringCount, 6>> qr(w.transpose());
+  const Eigen::Matrix<double, kGripStringCount, kGripStringCount> q = qr.householderQ();
+  const NullBasis n = q.rightCols<2>();
+
+  Eigen::Vector2d lambda;
+  double scale = 1.0;
+  if (!nearest_feasible(least, n, tension_min_N, tension_max_N, lambda)) {
+    if (!nearest_feasible(Tensions::Zero(), n, tension_min_N, tension_max_N, lambda, true)) return at_minimum();
+    // The largest feasible fraction: feasibility along s is an interval containing 0 (the polygons are convex in
+    // (λ, s) jointly), so bisection finds its end.
+    double feasible_s = 0.0;
+    double infeasible_s = 1.0;
+    Eigen::Vector2d probe;
+    for (int step = 0; step < kGripScaleSteps; ++step) {
+      const double s = 0.5 * (feasible_s + infeasible_s);
+      (nearest_feasible(s * least, n, tension_min_N, tension_max_N, probe, true) ? feasible_s : infeasible_s) = s;
+    }
+    scale = feasible_s;
+    nearest_feasible(scale * least, n, tension_min_N, tension_max_N, lambda);
+    solution.saturated = true;
+  }
+  const Tensions t = (scale * least + n * lambda).cwiseMax(tension_min_N).cwiseMin(tension_max_N);
+  for (int k = 0; k < kGripStringCount; ++k) solution.tension_N[k] = t[k];
+  solution.achieved = w * t;
+  solution.scale = scale;
+  return solution;
+}
+
+}  // namespace impetus
