@@ -16,7 +16,8 @@
 #   6. peak RSS of each process during a tap trial
 #   7. the world view: snapshot size and cost per world step, a viewer's read and encode   build/tests/bench_world_view
 #   8. world link one-way latency, shared memory and DDS, and DDS across a veth   build/tests/bench_dds_link
-#   9. ghost force, release, lost walls and pop-through in clutter and streams   build/tests/bench_ghost_force
+#   9. ghost force, release, lost walls and pop-through in clutter and streams, of primitives and of users' meshes
+#      build/tests/bench_ghost_force
 #  10. the closed loop from Python: ticks/s at 1 to 1000 ticks a call, free and in contact (goal: >= 200 k at 50)
 #      tests/bench/bench_closed_loop.py
 #  11. nearest point on a user's mesh of 10^3 to 10^6 triangles: tree build, memory, query percentiles

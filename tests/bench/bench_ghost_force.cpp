@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // Ghost force, release, lost walls and pop-through at 20 and 10 Hz worlds, scored against the true geometry
 // (tests/support/ghost_score.h): static clutter of boxes, capsules, cylinders and spheres, and streams of them sliding
-// past the finger under each coupling, on every engine. Prints; asserts nothing (tests/loop/test_ghost_force.cpp asserts the goals).
+// past the finger under each coupling, on every engine; then the same made users' meshes (tests/support/
+// mesh_clutter.h), with and without bowls. Prints; asserts nothing (tests/loop/test_ghost_force.cpp asserts the goals).
 
 #include "tests/support/ghost_score.h"
+#include "tests/support/mesh_clutter.h"
 
 #include <cstdio>
 #include <string>
@@ -42,6 +44,23 @@ int main() {
           print_row(what.c_str(), count, rate_hz, test::score(scene, rate_hz, 20.0, coupling));
         }
       }
+    }
+  }
+  // Users' meshes (ODE): the clutter with and without bowls (open, thin-walled), and a stream of closed meshes.
+  for (const double rate_hz : {20.0, 10.0}) {
+    for (const int count : {4, 16, 64}) {
+      print_row("mesh clutter, closed", count, rate_hz,
+                test::score(test::as_meshes(test::clutter(count, 7), false), rate_hz, 20.0));
+      print_row("mesh clutter, bowls", count, rate_hz,
+                test::score(test::as_meshes(test::clutter(count, 7), true), rate_hz, 20.0));
+    }
+  }
+  for (const Coupling coupling : {Coupling::impulse, Coupling::position, Coupling::local}) {
+    const std::string what = std::string("mesh stream, ") + impetus::to_string(coupling);
+    for (const double rate_hz : {20.0, 10.0}) {
+      const impetus::Scene scene =
+          test::as_meshes(test::stream(4, 7, Eigen::Vector3d(0.1, 0.03, 0.0), 1.0, 20.0), false);
+      print_row(what.c_str(), 4, rate_hz, test::score(scene, rate_hz, 20.0, coupling));
     }
   }
   return 0;

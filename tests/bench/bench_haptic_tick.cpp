@@ -173,8 +173,9 @@ void run_grip() {
   int failures = 0;
   for (int tick = 0; tick < kTicks; ++tick) {
     GripPose truth;
-    truth.position_m = Eigen::Vector3d(geometry.centre_m[0], geometry.centre_m[1], geometry.centre_m[2]) +
-                       0.05 * Eigen::Vector3d(std::sin(tick * 0.0031), std::sin(tick * 0.0023), std::sin(tick * 0.0017));
+    const Eigen::Vector3d wander(std::sin(tick * 0.0031), std::sin(tick * 0.0023), std::sin(tick * 0.0017));
+    truth.position_m =
+        Eigen::Vector3d(geometry.centre_m[0], geometry.centre_m[1], geometry.centre_m[2]) + 0.05 * wander;
     truth.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * std::sin(tick * 0.002),
                                                              Eigen::Vector3d(1.0, 2.0, 3.0).normalized()));
     const GripLengths lengths = kinematics.lengths_m(kinematics.encoder_counts(truth));

@@ -214,8 +214,8 @@ TEST_CASE("the grip's pose and tensions allocate nothing") {
   int saturated = 0;
   for (const GripPose& pose : poses) {
     kinematics.pose(kinematics.lengths_m(kinematics.encoder_counts(pose)), found, found);
-    const GripTensionSolution solution =
-        distribute_grip_tension(wrench, kinematics.wrench_matrix(found), geometry.tension_min_N, geometry.tension_max_N);
+    const GripTensionSolution solution = distribute_grip_tension(wrench, kinematics.wrench_matrix(found),
+                                                                 geometry.tension_min_N, geometry.tension_max_N);
     saturated += solution.saturated ? 1 : 0;
   }
   REQUIRE(impetus::test::stop_counting_allocations() == 0);

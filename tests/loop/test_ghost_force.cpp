@@ -5,6 +5,7 @@
 // (docs/ghost_force.md).
 
 #include "tests/support/ghost_score.h"
+#include "tests/support/mesh_clutter.h"
 
 #include <catch2/catch.hpp>
 
@@ -12,6 +13,8 @@ namespace impetus {
 namespace {
 
 void check_goals(const test::Score& s, int least_contact_ticks) {
+  INFO(s.contact_ticks << " contact ticks, " << s.ghost_ticks << " ghost, " << s.lost_wall_ticks << " lost wall, "
+                       << s.pop_through_ticks << " pop-through, worst release " << s.worst_release_ms << " ms");
   CHECK(s.contact_ticks > least_contact_ticks);  // the finger really went through the objects
   CHECK(s.ghost_fraction() <= 0.01);
   CHECK(s.worst_release_ms <= 2.0);
@@ -53,6 +56,26 @@ TEST_CASE("a dense stream of objects past the finger is felt where it is, under 
     for (const double rate_hz : {20.0, 10.0}) {
       INFO(name(coupling) << " coupling, " << rate_hz << " Hz world, 16 objects per finger's cube");
       check_goals(test::score(test_stream(16), rate_hz, 20.0, coupling), 800);
+    }
+  }
+}
+
+TEST_CASE("users' closed meshes in static clutter are felt as they are: boxes, spheres and pebbles, at 20 and 10 Hz") {
+  // With bowls among them (open, a thin wall) the goals are not met yet: docs/meshes.md, "The ghost-force scorer".
+  for (const int count : {4, 16}) {
+    for (const double rate_hz : {20.0, 10.0}) {
+      INFO(count << " meshes, " << rate_hz << " Hz world");
+      check_goals(test::score(test::as_meshes(test::clutter(count, 7), false), rate_hz, 20.0),
+                  count == 4 ? 100 : 500);
+    }
+  }
+}
+
+TEST_CASE("a stream of users' meshes past the finger is felt where it is, under every coupling, at 20 and 10 Hz") {
+  for (const Coupling coupling : {Coupling::impulse, Coupling::position, Coupling::local}) {
+    for (const double rate_hz : {20.0, 10.0}) {
+      INFO(name(coupling) << " coupling, " << rate_hz << " Hz world, 4 meshes per finger's cube");
+      check_goals(test::score(test::as_meshes(test_stream(4), false), rate_hz, 20.0, coupling), 300);
     }
   }
 }
