@@ -14,15 +14,61 @@ namespace {
 using Tensions = Eigen::Matrix<double, kGripStringCount, 1>;
 using NullBasis = Eigen::Matrix<double, kGripStringCount, 2>;
 
+// Feasible to rounding: 10⁻⁹ of the motors' range (the candidates' own rounding is ~10⁻¹⁵ of it), so the clamp into
+// the box afterwards moves a tension by nanonewtons at most.
+constexpr double kFeasible = 1e-9;
+
+// The largest s in [0, 1] for which some λ has t_min ≤ s·t_p + N·λ ≤ t_max: a linear programme in (λ, s), whose
+// optimum is a vertex where two of the sixteen limits meet (the polytope is bounded in λ). Two limits meet on a line
+// λ(s) = λ₀ + s·λ₁, along which each string's tension is affine in s, α_k + β_k·s; the sixteen limits then bound s
+// to an interval, and the largest end over the 120 pairs is the answer. One pass over the corners, as one
+// feasibility test costs, exact to rounding. Called with s = 0 feasible, so the answer is at least 0.
+double largest_scale(const Tensions& least, const NullBasis& n, double lo, double hi) {
+  const double tolerance = kFeasible * (hi - lo);
+  constexpr int kLines = 2 * kGripStringCount;
+  double largest = 0.0;
+  for (int i = 0; i < kLines; ++i) {
+    for (int j = i + 1; j < kLines; ++j) {
+      const Eigen::Vector2d ai = n.row(i / 2).transpose();
+      const Eigen::Vector2d aj = n.row(j / 2).transpose();
+      const double det = ai.x() * aj.y() - ai.y() * aj.x();
+      if (std::abs(det) < 1e-12) continue;  // parallel: a string's two limits, or two strings alike
+      // a_i·λ = c_i − s·t_p,i and likewise for j: λ₀ solves the constants, λ₁ the coefficients of s.
+      const double ci = i % 2 ? hi : lo;
+      const double cj = j % 2 ? hi : lo;
+      const double pi = -least[i / 2];
+      const double pj = -least[j / 2];
+      const Eigen::Vector2d lambda0((ci * aj.y() - cj * ai.y()) / det, (ai.x() * cj - aj.x() * ci) / det);
+      const Eigen::Vector2d lambda1((pi * aj.y() - pj * ai.y()) / det, (ai.x() * pj - aj.x() * pi) / det);
+      double from = 0.0;
+      double to = 1.0;
+      for (int k = 0; k < kGripStringCount && from <= to; ++k) {
+        const double alpha = n.row(k).dot(lambda0);
+        const double beta = least[k] + n.row(k).dot(lambda1);
+        // lo − tol ≤ α + β·s ≤ hi + tol.
+        if (std::abs(beta) < 1e-15) {
+          if (alpha < lo - tolerance || alpha > hi + tolerance) to = -1.0;
+        } else if (beta > 0.0) {
+          from = std::max(from, (lo - tolerance - alpha) / beta);
+          to = std::min(to, (hi + tolerance - alpha) / beta);
+        } else {
+          from = std::max(from, (hi + tolerance - alpha) / beta);
+          to = std::min(to, (lo - tolerance - alpha) / beta);
+        }
+      }
+      if (from <= to) largest = std::max(largest, to);
+    }
+  }
+  return largest;
+}
+
 // The λ nearest the origin with t_min ≤ base + N·λ ≤ t_max (header: the origin, the feet of the perpendiculars on the
 // sixteen limit lines, and their pairwise corners). False if no candidate is feasible: the polygon is empty (it is
 // bounded, N having full column rank, so a non-empty one has a feasible corner). With `any`, whether the polygon is
-// empty only: the first feasible corner ends the search (the bisection's question).
+// empty only: the first feasible corner ends the search.
 bool nearest_feasible(const Tensions& base, const NullBasis& n, double lo, double hi, Eigen::Vector2d& best,
                       bool any = false) {
-  // Feasible to rounding: 10⁻⁹ of the motors' range (the candidates' own rounding is ~10⁻¹⁵ of it), so the clamp
-  // into the box afterwards moves a tension by nanonewtons at most.
-  const double tolerance = 1e-9 * (hi - lo);
+  const double tolerance = kFeasible * (hi - lo);
   const auto feasible = [&](const Eigen::Vector2d& lambda) {
     for (int k = 0; k < kGripStringCount; ++k) {
       const double t = base[k] + n.row(k).dot(lambda);
@@ -92,17 +138,13 @@ GripTensionSolution distribute_grip_tension(const GripWrench& wrench, const Grip
   double scale = 1.0;
   if (!nearest_feasible(least, n, tension_min_N, tension_max_N, lambda)) {
     if (!nearest_feasible(Tensions::Zero(), n, tension_min_N, tension_max_N, lambda, true)) return at_minimum();
-    // The largest feasible fraction: feasibility along s is an interval containing 0 (the polygons are convex in
-    // (λ, s) jointly), so bisection finds its end.
-    double feasible_s = 0.0;
-    double infeasible_s = 1.0;
-    Eigen::Vector2d probe;
-    for (int step = 0; step < kGripScaleSteps; ++step) {
-      const double s = 0.5 * (feasible_s + infeasible_s);
-      (nearest_feasible(s * least, n, tension_min_N, tension_max_N, probe, true) ? feasible_s : infeasible_s) = s;
+    scale = largest_scale(least, n, tension_min_N, tension_max_N);
+    // At the largest scale the polygon may have shrunk to a point that rounding puts just outside; the scale a
+    // hair smaller (10⁻⁹ of it) always has one.
+    if (!nearest_feasible(scale * least, n, tension_min_N, tension_max_N, lambda)) {
+      scale *= 1.0 - 1e-9;
+      if (!nearest_feasible(scale * least, n, tension_min_N, tension_max_N, lambda)) lambda.setZero();
     }
-    scale = feasible_s;
-    nearest_feasible(scale * least, n, tension_min_N, tension_max_N, lambda);
     solution.saturated = true;
   }
   const Tensions t = (scale * least + n * lambda).cwiseMax(tension_min_N).cwiseMin(tension_max_N);

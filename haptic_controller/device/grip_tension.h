@@ -13,9 +13,9 @@
 // not converge, no allocation.
 //
 // A wrench beyond the motors (the polygon empty) is scaled down, direction kept, to the largest fraction s of it the
-// strings can render (bisection on s, kScaleSteps halvings: s to 2⁻¹⁶) and `saturated` set. A pose where not even zero
-// wrench is feasible (no tension balance holds the grip: outside the frame's force-closure volume) gets every string
-// at t_min and `closure` false.
+// strings can render (a linear programme in (λ, s), solved exactly over the same corners) and `saturated` set. A pose
+// where not even zero wrench is feasible (no tension balance holds the grip: outside the frame's force-closure volume)
+// gets every string at t_min and `closure` false.
 
 #include "haptic_controller/device/grip_kinematics.h"
 
@@ -34,8 +34,6 @@ struct GripTensionSolution {
   bool saturated = false;   // scale < 1
   bool closure = true;      // false: no tension balance at this pose (every string at t_min)
 };
-
-inline constexpr int kGripScaleSteps = 16;
 
 // Allocation-free.
 GripTensionSolution distribute_grip_tension(const GripWrench& wrench, const GripWrenchMatrix& w, double tension_min_N,

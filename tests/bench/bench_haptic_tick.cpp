@@ -161,7 +161,7 @@ void run_endpoints(int endpoints) {
 }
 
 // The grip's device work a tick, on a wandering, turning grip: the pose from its quantised lengths (warm start), then
-// the tensions for a wrench within the motors, and for one beyond them (the bisection's cost).
+// the tensions for a wrench within the motors, and for one beyond them (the largest scale's search too).
 void run_grip() {
   const SpidarGripGeometry geometry;
   const GripKinematics kinematics(geometry);

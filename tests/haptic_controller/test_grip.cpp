@@ -180,17 +180,20 @@ TEST_CASE("a wrench beyond the motors is scaled down, its direction kept, and th
   CHECK(solution.scale > 0.0);
   CHECK(solution.scale < 1.0);
   CHECK((solution.achieved - solution.scale * wrench).norm() < 1e-6 * wrench.norm());
-  // A motor at its limit is what stopped the scale, to the bisection's resolution: 2⁻¹⁶ of the wrench moves the
-  // tensions by 2⁻¹⁶ of the least-norm tensions for all of it (here a few hundred newtons: millinewtons).
+  // A motor at its limit is what stopped the scale (the scale is exact: to rounding, micronewtons).
   double highest_N = 0.0;
   for (double t : solution.tension_N) highest_N = std::max(highest_N, t);
-  const Eigen::Matrix<double, 8, 1> least = w.transpose() * (w * w.transpose()).ldlt().solve(wrench);
   INFO("highest tension " << highest_N << " N, scale " << solution.scale);
-  CHECK(highest_N > geometry.tension_max_N - std::ldexp(least.norm(), -kGripScaleSteps));
-  // A little more than the scale found cannot be rendered.
+  CHECK(highest_N > geometry.tension_max_N - 1e-6);
+  // A little more than the scale found cannot be rendered, a little less can, exactly.
   const GripTensionSolution more =
-      distribute_grip_tension((solution.scale + 1e-3) * wrench, w, geometry.tension_min_N, geometry.tension_max_N);
+      distribute_grip_tension((solution.scale * (1.0 + 1e-6)) * wrench, w, geometry.tension_min_N,
+                              geometry.tension_max_N);
   CHECK(more.saturated);
+  const GripTensionSolution less =
+      distribute_grip_tension((solution.scale * (1.0 - 1e-6)) * wrench, w, geometry.tension_min_N,
+                              geometry.tension_max_N);
+  CHECK_FALSE(less.saturated);
   SECTION("a non-finite wrench commands the minimum tensions") {
     wrench[2] = std::nan("");
     const GripTensionSolution none =
@@ -208,7 +211,7 @@ TEST_CASE("the grip's pose and tensions allocate nothing") {
   std::array<GripPose, 50> poses;
   for (GripPose& pose : poses) pose = random_pose(random, geometry);
   GripWrench wrench;
-  wrench << 300.0, 2.0, -1.0, 0.01, 0.02, 0.5;  // saturated: the bisection too
+  wrench << 300.0, 2.0, -1.0, 0.01, 0.02, 0.5;  // saturated: the largest scale's search too
   impetus::test::start_counting_allocations();
   GripPose found = centre_pose(geometry);
   int saturated = 0;

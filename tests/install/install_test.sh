@@ -48,7 +48,10 @@ python_trial "$prefix"
 
 # The installed viewer finds its page and three.js in the prefix (no source tree, no network).
 viewer_serves() {
-  # Long enough to outlast a loaded machine's start-up and requests; stopped below once they are answered.
+  # Long enough to outlast a loaded machine's start-up and requests; stopped below once they are answered. The output
+  # file exists before the viewer starts: the background shell may open it after the first look below, and a sed
+  # that cannot read it would end this script (set -e).
+  : > "$scratch/viewer.out"
   "$1/bin/impetus-viewer" --shm "impetus_install_test_$$" --listen 127.0.0.1:0 --duration 60 > "$scratch/viewer.out" 2>&1 &
   local pid=$! url=""
   for _ in $(seq 100); do

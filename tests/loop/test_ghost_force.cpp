@@ -75,7 +75,8 @@ TEST_CASE("a stream of users' meshes past the finger is felt where it is, under 
   for (const Coupling coupling : {Coupling::impulse, Coupling::position, Coupling::local}) {
     for (const double rate_hz : {20.0, 10.0}) {
       INFO(name(coupling) << " coupling, " << rate_hz << " Hz world, 4 meshes per finger's cube");
-      check_goals(test::score(test::as_meshes(test_stream(4), false), rate_hz, 20.0, coupling), 300);
+      // 10 s of the stream (a mesh costs the scorer's truth more than a primitive): about 420 contact ticks a cell.
+      check_goals(test::score(test::as_meshes(test_stream(4), false), rate_hz, 10.0, coupling), 300);
     }
   }
 }
