@@ -18,6 +18,11 @@ using NullBasis = Eigen::Matrix<double, kGripStringCount, 2>;
 // the box afterwards moves a tension by nanonewtons at most.
 constexpr double kFeasible = 1e-9;
 
+// Where the lines a_i·λ = b_i and a_j·λ = b_j meet (Cramer's rule; det = a_i × a_j, non-zero).
+Eigen::Vector2d meet(const Eigen::Vector2d& ai, const Eigen::Vector2d& aj, double bi, double bj, double det) {
+  return Eigen::Vector2d((bi * aj.y() - bj * ai.y()) / det, (ai.x() * bj - aj.x() * bi) / det);
+}
+
 // The largest s in [0, 1] for which some λ has t_min ≤ s·t_p + N·λ ≤ t_max: a linear programme in (λ, s), whose
 // optimum is a vertex where two of the sixteen limits meet (the polytope is bounded in λ). Two limits meet on a line
 // λ(s) = λ₀ + s·λ₁, along which each string's tension is affine in s, α_k + β_k·s; the sixteen limits then bound s
@@ -34,12 +39,8 @@ double largest_scale(const Tensions& least, const NullBasis& n, double lo, doubl
       const double det = ai.x() * aj.y() - ai.y() * aj.x();
       if (std::abs(det) < 1e-12) continue;  // parallel: a string's two limits, or two strings alike
       // a_i·λ = c_i − s·t_p,i and likewise for j: λ₀ solves the constants, λ₁ the coefficients of s.
-      const double ci = i % 2 ? hi : lo;
-      const double cj = j % 2 ? hi : lo;
-      const double pi = -least[i / 2];
-      const double pj = -least[j / 2];
-      const Eigen::Vector2d lambda0((ci * aj.y() - cj * ai.y()) / det, (ai.x() * cj - aj.x() * ci) / det);
-      const Eigen::Vector2d lambda1((pi * aj.y() - pj * ai.y()) / det, (ai.x() * pj - aj.x() * pi) / det);
+      const Eigen::Vector2d lambda0 = meet(ai, aj, i % 2 ? hi : lo, j % 2 ? hi : lo, det);
+      const Eigen::Vector2d lambda1 = meet(ai, aj, -least[i / 2], -least[j / 2], det);
       double from = 0.0;
       double to = 1.0;
       for (int k = 0; k < kGripStringCount && from <= to; ++k) {
@@ -97,7 +98,7 @@ bool nearest_feasible(const Tensions& base, const NullBasis& n, double lo, doubl
     for (int j = i + 1; j < kLines; ++j) {
       const double det = a[i].x() * a[j].y() - a[i].y() * a[j].x();
       if (std::abs(det) < 1e-12) continue;  // parallel: a string's two limits, or two strings alike
-      consider(Eigen::Vector2d((b[i] * a[j].y() - b[j] * a[i].y()) / det, (a[i].x() * b[j] - a[j].x() * b[i]) / det));
+      consider(meet(a[i], a[j], b[i], b[j], det));
       if (any && best_norm < std::numeric_limits<double>::infinity()) return true;
     }
   }
