@@ -97,6 +97,9 @@ void HapticNode::tick(std::uint64_t tick, double now_s, double dt_s, std::int64_
   }
   exchange_pushes(servos_);
   if (sampled) tick_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
+  bool world_present = false;
+  for (const HapticServo* servo : servos_) world_present = world_present || servo->has_world();
+  device_.note_world(world_present);
   const std::uint32_t saturated = device_.command_fingers(tick, commands_.data());
   for (std::size_t k = 0; k < endpoints_.size(); ++k) {
     Endpoint& endpoint = *endpoints_[k];

@@ -102,6 +102,8 @@ class HapticServo {
   }
   // What the last tick gave (as tick() returned it).
   const TickResult& last_result() const { return result_; }
+  // A world frame has arrived since the servo started (a world it renders, even if stale now).
+  bool has_world() const { return have_frame_; }
   // Cumulative impulses and the finger, updated by every tick; the caller seals and publishes it.
   const HapticReport& report() const { return accumulator_.report(); }
   const ServoCounters& counters() const { return counters_; }

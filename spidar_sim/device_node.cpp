@@ -37,6 +37,15 @@ void DeviceNode::tick(double dt_s) {
   tensions.fill(sim_.hardware().geometry().tension_min_N);
   DeviceCommand command;
   const bool received = port_.latest_command(command);
+  if (received && (command.flags & kCommandWorldPresent) != 0) world_seen_ = true;
+  if (holding_for_world_) {
+    if (world_seen_ || held_s_ >= world_wait_s_) {
+      holding_for_world_ = false;
+    } else {
+      sim_.hold_trajectory(dt_s);
+      held_s_ += dt_s;
+    }
+  }
   if (watchdog_.applies(received ? &command : nullptr, sim_.time_s())) tensions = command.tension_N;
   DeviceState state = sim_.tick(tensions, dt_s);
   state.device_session = session_;
@@ -109,11 +118,26 @@ int DeviceNode::run() {
   } else {
     RealtimeClock clock(kDevicePeriod_s);
     bool host_alive = true;
+    holding_for_world_ = world_wait_s_ > 0.0;
+    if (holding_for_world_) {
+      std::fprintf(stderr, "spidar_sim: holding the trajectory at its start until the haptic controller renders a "
+                           "world (at most %.3g s)\n", world_wait_s_);
+    }
     while (!g_stop_requested.load() && !sim_.finished() && host_alive) {
       const TickTiming timing = clock.wait_next();
       if (timing.index % kCheckEveryTicks == 0) host_alive = port_.host_alive();
+      const bool was_holding = holding_for_world_;
       // After a host stall the finger is advanced by the real elapsed time, capped so one tick stays a tick.
       tick(std::min(timing.elapsed_s, DeviceSim::kMaxTick_s));
+      if (was_holding && !holding_for_world_) {
+        if (world_seen_) {
+          std::fprintf(stderr, "spidar_sim: the haptic controller renders a world; playing the trajectory (held "
+                               "%.3f s)\n", held_s_);
+        } else {
+          std::fprintf(stderr, "spidar_sim: warning: no world reached the haptic controller within %.3g s; playing "
+                               "the trajectory anyway\n", world_wait_s_);
+        }
+      }
       if (timing.index % kCheckEveryTicks == 0) publish_stats(&clock);
     }
     publish_stats(&clock);
@@ -132,6 +156,8 @@ nlohmann::json DeviceNode::summary() const {
             {"time_s", sim_.time_s()},
             {"rejected_commands", port_.rejected_commands()},
             {"stale_command_ticks", watchdog_.stale_ticks()},
+            {"held_for_world_s", held_s_},
+            {"world_seen", world_seen_},
             {"channel_repairs", port_.channel_repairs()},
             {"finger_mass_kg", finger.mass_kg},
             {"hand_stiffness_Npm", finger.hand_stiffness_Npm},

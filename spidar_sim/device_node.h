@@ -3,7 +3,9 @@
 // The device node (docs/architecture.md §1.3): a simulated SPIDAR and finger (DeviceSim) on the device port. Each tick
 // takes the newest commanded tensions (minimum tension before the first command), advances the simulation and publishes
 // the encoder counts. Lockstep: one tick per turn the host gives (shared memory), or per in-process step_device() call;
-// when the trajectory ends the node detaches. Real time: its own 1 kHz clock until the trajectory ends.
+// when the trajectory ends the node detaches. Real time: its own 1 kHz clock until the trajectory ends; the trajectory
+// holds at its start until the haptic controller says it renders a world (kCommandWorldPresent), at most the world
+// wait, so a script is not played before there is anything to touch (the processes start in any order).
 //
 // Owns the simulation's log and statistics.
 
@@ -31,6 +33,11 @@ class DeviceNode final : public DeviceStepper {
   // Runs until the trajectory ends, the host ends the session or dies, or a stop is requested. Returns the exit
   // status.
   int run();
+  // Real time: the longest the trajectory holds at its start for a world, s (0: play at once). Default kWorldWait_s.
+  void set_world_wait(double max_s) { world_wait_s_ = max_s; }
+  // A world frame reaches a controller within a second of both starting; ten is a controller with no world coming.
+  static constexpr double kWorldWait_s = 10.0;
+
   // One lockstep tick (the in-process port's turn); false once the trajectory has ended and the node detached.
   bool step_device() override;
 
@@ -52,6 +59,10 @@ class DeviceNode final : public DeviceStepper {
   // for room (a complete log), real time drops and counts.
   std::optional<RtLog<DeviceLogRow>> log_;
   bool cut_short_ = false;               // lockstep: the haptic controller died before the trajectory ended
+  double world_wait_s_ = kWorldWait_s;
+  bool holding_for_world_ = false;       // real time: the trajectory holds at its start (set by run())
+  bool world_seen_ = false;              // a command said the controller renders a world
+  double held_s_ = 0.0;                  // device time the trajectory held for a world
   std::uint64_t ticks_ = 0;
 };
 

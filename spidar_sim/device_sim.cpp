@@ -78,7 +78,11 @@ const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& comma
   const double h_s = dt_s / substeps;
   if (!motor_lag) hardware_.apply(commanded_tension_N, h_s);
   for (int k = 0; k < substeps; ++k) {
-    const double t_s = time_s_ + k * h_s;
+    // The trajectory's time (it starts at 0 when nothing was held, so the subtraction is exact); a tick being held
+    // spans [−dt_s, 0] of it, where the trajectory is its start.
+    const double session_s = time_s_ + k * h_s;
+    const double t_s = std::max(0.0, session_s - trajectory_start_s_);
+    const double t_end_s = std::max(0.0, session_s + h_s - trajectory_start_s_);
     if (motor_lag) hardware_.apply(commanded_tension_N, h_s);
     Eigen::Vector3d force_N = hardware_.force_on_finger(finger_.position_m());
     // The target over the sub-step as the chord from where it is now to where it will be: the finger's step takes it
@@ -93,7 +97,7 @@ const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& comma
       if (hand_force_N_ != Vec3{}) force_N += to_eigen(hand_force_N_);
     } else {
       from_m = to_eigen(trajectory_.sample_at(t_s, segment_hint_).position_m);
-      to_m = to_eigen(trajectory_.sample_at(t_s + h_s, segment_hint_).position_m);
+      to_m = to_eigen(trajectory_.sample_at(t_end_s, segment_hint_).position_m);
     }
     finger_.step(from_m, (to_m - from_m) / h_s, force_N, h_s);
   }
@@ -105,13 +109,13 @@ const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& comma
 }
 
 void DeviceSim::steer(const Vec3& target_m) {
-  if (!steered_) target_now_m_ = trajectory_.position_at(time_s_);
+  if (!steered_) target_now_m_ = trajectory_.position_at(trajectory_time_s());
   steered_ = true;
   target_next_m_ = target_m;
 }
 
 void DeviceSim::set_hand_force(const Vec3& force_N) {
-  if (!steered_) steer(trajectory_.position_at(time_s_));
+  if (!steered_) steer(trajectory_.position_at(trajectory_time_s()));
   hand_force_N_ = force_N;
 }
 

@@ -56,13 +56,19 @@ class DeviceSim {
   // controller that pushes instead of aiming. Steers the target where it is, as steer() does. Finite (not checked).
   void set_hand_force(const Vec3& force_N);
   bool steered() const { return steered_; }
+  // Holds the trajectory for the next tick of dt_s: its clock stands still, the target stays where the trajectory is
+  // now (its start, before it began), and the finger rests there under the device's forces. A real-time device
+  // waiting for a world to touch calls it before each tick it waits (device_node.h).
+  void hold_trajectory(double dt_s) { trajectory_start_s_ += dt_s; }
 
   // A realtime hiccup longer than this is a bug upstream, not a tick: the sub-step count would explode.
   static constexpr double kMaxTick_s = 1.0;
 
   const DeviceState& state() const { return state_; }
   double time_s() const { return time_s_; }
-  Vec3 target_m() const { return steered_ ? target_now_m_ : trajectory_.position_at(time_s_); }
+  // Where the trajectory's clock is: session time less the time it was held.
+  double trajectory_time_s() const { return time_s_ - trajectory_start_s_; }
+  Vec3 target_m() const { return steered_ ? target_now_m_ : trajectory_.position_at(trajectory_time_s()); }
   const Vec3& hand_force_N() const { return hand_force_N_; }
   Vec3 finger_m() const { return to_vec3(finger_.position_m()); }
   Vec3 finger_velocity_mps() const { return to_vec3(finger_.velocity_mps()); }
@@ -71,7 +77,7 @@ class DeviceSim {
   const std::array<double, kStringCount>& tensions_N() const { return hardware_.tensions_N(); }
   const std::array<std::int64_t, kStringCount>& encoder_counts() const { return state_.encoder_counts; }
   // True once the session time reaches the end of the trajectory (the target then holds still).
-  bool finished() const { return !steered_ && time_s_ >= trajectory_.duration_s(); }
+  bool finished() const { return !steered_ && trajectory_time_s() >= trajectory_.duration_s(); }
 
   const Trajectory& trajectory() const { return trajectory_; }
   const SpidarHardware& hardware() const { return hardware_; }
@@ -93,6 +99,7 @@ class DeviceSim {
   std::size_t segment_hint_ = 0;  // the trajectory segment of the last sub-step (Trajectory::sample_at)
   Finger finger_;
   double time_s_ = 0.0;
+  double trajectory_start_s_ = 0.0;  // session time of the trajectory's time 0 (hold_trajectory)
   DeviceState state_{};
   // Steered (closed loop): the target now and at the end of the next tick, and the hand's own push.
   bool steered_ = false;

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   std::string summary_path;
   std::string shm = "impetus";
   double attach_timeout_s = 10.0;
+  double world_wait_s = DeviceNode::kWorldWait_s;
   std::string device_spec = "spidar";
   HardwareParams hardware;
   FingerParams finger;
@@ -47,6 +48,10 @@ int main(int argc, char** argv) {
   add_shm_flag(app, shm);
   app.add_option("--attach-timeout", attach_timeout_s, "seconds to wait for the haptic controller's port")
       ->check(positive_number(kMaxFlagSeconds));
+  app.add_option("--world-wait", world_wait_s,
+                 "real time: seconds the trajectory holds at its start until the haptic controller renders a world "
+                 "(10; 0 plays at once)")
+      ->check(number_in(0.0, kMaxFlagSeconds));
   app.add_option("--device", device_spec,
                  "spidar (the built-in geometry) or spidar:FILE.json; must match the haptic controller's");
   app.add_option("--hand-stiffness", finger.hand_stiffness_Npm, "hand impedance stiffness, N/m (300)")
@@ -72,7 +77,7 @@ int main(int argc, char** argv) {
       ports.push_back(std::make_unique<ShmDevicePortClient>(
           shm, clock, attach_timeout_s, DeviceDescription{geometry_hash(spidar.geometry), spidar.source},
           static_cast<unsigned>(k)));
-      rig.attach(k, *ports.back(), log_path, new_session_id());
+      rig.attach(k, *ports.back(), log_path, new_session_id()).set_world_wait(world_wait_s);
       std::fprintf(stderr, "spidar_sim: '%s' attached to '%s' (%s), trajectory %.3f s\n", rig.finger(k).name.c_str(),
                    ports.back()->name().c_str(), to_string(clock), rig.finger(k).trajectory.duration_s());
     }

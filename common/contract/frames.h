@@ -217,11 +217,17 @@ struct HapticReport {
 
 inline constexpr int kStringCount = 4;
 
+// DeviceCommand::flags: the haptic controller renders a world (a world frame has reached its servo). A device may
+// show it; a simulated hand playing a script waits for it in real time, so the script does not start before there is
+// anything to touch (the processes of a trial start in any order).
+inline constexpr std::uint64_t kCommandWorldPresent = 1;
+
 // Haptic → device: the tensions to command (docs/architecture.md §1.2 step 6).
 struct DeviceCommand {
   std::uint64_t tick = 0;
   std::uint64_t haptic_session = 0;
   std::array<double, kStringCount> tension_N{};
+  std::uint64_t flags = 0;  // kCommand* bits; others are reserved and ignored
 };
 
 // Device → haptic: the encoder readings.

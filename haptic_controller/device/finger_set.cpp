@@ -55,6 +55,10 @@ std::uint32_t FingerSet::command_fingers(std::uint64_t tick, const FingerCommand
   return saturated;
 }
 
+void FingerSet::note_world(bool present) {
+  for (std::uint32_t k = 0; k < count_; ++k) fingers_[k]->note_world(present);
+}
+
 void FingerSet::end_session() {
   for (std::uint32_t k = 0; k < count_; ++k) fingers_[k]->end_session();
 }

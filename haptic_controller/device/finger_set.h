@@ -26,6 +26,7 @@ class FingerSet final : public HapticDevice {
   bool wait_attached() override;
   const FingerSample* read(std::uint64_t tick, double now_s) override;
   bool command(std::uint64_t tick, const Eigen::Vector3d& force_N, bool render) override;
+  void note_world(bool present) override;
   std::uint32_t command_fingers(std::uint64_t tick, const FingerCommand* commands) override;
   void end_session() override;
   DeviceCounters counters() const override;

@@ -66,6 +66,9 @@ class HapticDevice {
   virtual std::uint32_t command_fingers(std::uint64_t tick, const FingerCommand* commands) {
     return command(tick, commands[0].force_N, commands[0].render) ? 0u : 1u;
   }
+  // Whether the servos render a world (a world frame has reached them), told before each tick's command(): a device
+  // may show it, and the simulated SPIDAR's scripted hand waits for it (kCommandWorldPresent). Default: ignored.
+  virtual void note_world(bool present) { (void)present; }
   // Lockstep: ends the session (a waiting device is released).
   virtual void end_session() = 0;
 

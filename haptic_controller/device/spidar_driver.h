@@ -27,6 +27,7 @@ class SpidarDriver final : public HapticDevice {
   bool wait_attached() override { return port_.wait_for_device(); }
   const FingerSample* read(std::uint64_t tick, double now_s) override;
   bool command(std::uint64_t tick, const Eigen::Vector3d& force_N, bool render) override;
+  void note_world(bool present) override { command_.flags = present ? kCommandWorldPresent : 0; }
   void end_session() override { port_.end_session(); }
   DeviceCounters counters() const override;
 

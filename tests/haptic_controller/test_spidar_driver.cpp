@@ -85,3 +85,21 @@ TEST_CASE("spidar driver: no device gives no sample, a broken reading an invalid
   REQUIRE(port.latest_command(command));
   for (double tension : command.tension_N) CHECK(tension == broken.tension_min_N);
 }
+
+TEST_CASE("spidar driver: its commands say whether the servos render a world, from the tick it is told") {
+  const SpidarGeometry geometry;
+  InProcessDevicePort port(1e-3);
+  SpidarDriver driver(geometry, port, ClockMode::lockstep, 9);
+  DeviceCommand command;
+  driver.command(0, Vector3d::Zero(), false);
+  REQUIRE(port.latest_command(command));
+  CHECK(command.flags == 0);  // no world yet
+  driver.note_world(true);
+  driver.command(1, Vector3d::Zero(), false);
+  REQUIRE(port.latest_command(command));
+  CHECK(command.flags == kCommandWorldPresent);
+  driver.note_world(false);
+  driver.command(2, Vector3d::Zero(), false);
+  REQUIRE(port.latest_command(command));
+  CHECK(command.flags == 0);
+}

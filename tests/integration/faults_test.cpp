@@ -240,6 +240,33 @@ TEST_CASE("killing spidar_sim: minimum tension is commanded and a new device att
   CHECK_FALSE(daemons.segments_left());
 }
 
+TEST_CASE("a device holds its trajectory until the controller renders a world, then plays it") {
+  // The processes of a trial start in any order, and the controller attaches to the world link before its first
+  // frame: a world at 2 Hz sends it one period, 0.5 s, after it starts. A tap played from the device's attach would
+  // reach the cube (at 0.4 s) before the cube's plane reached the controller; the device holds the tap at its start.
+  Daemons daemons = make_daemons("worldfirstframe");
+  daemons.world_flags = {"--rate", "2"};
+  const pid_t world = daemons.world("");
+  const pid_t haptic = daemons.haptic("");
+  const pid_t device = test::spawn({test::binary("spidar_sim"), "--shm", daemons.shm, "--trajectory", "tap",
+                                    "--summary", (daemons.dir / "device.json").string()},
+                                   daemons.dir / "device.out");
+  CHECK(test::wait_for(device, 30.0) == 0);
+  stop_like_a_user(haptic, world);
+  INFO(test::read_text(daemons.dir / "device.out"));
+
+  const auto device_summary = test::read_json(daemons.dir / "device.json")["device"];
+  CHECK(device_summary["world_seen"] == true);
+  // Held from the device's attach to the first frame: the world period less the start-up of the controller and the
+  // device (tens of milliseconds; half the period is room for a loaded machine), and not much beyond the period.
+  CHECK(device_summary["held_for_world_s"].get<double>() > 0.25);
+  CHECK(device_summary["held_for_world_s"].get<double>() < 1.0);
+  // The tap then met the cube: the finger felt it, and the world applied a push along +x.
+  CHECK(test::read_json(daemons.dir / "haptic.json")["haptic"]["max_force_N"].get<double>() > 2.0);
+  CHECK(test::read_json(daemons.dir / "world.json")["objects"]["cube"]["impulse_Ns"][0].get<double>() > 0.1);
+  CHECK_FALSE(daemons.segments_left());
+}
+
 TEST_CASE("random bytes written into a live world link are rejected and counted while both sides keep running") {
   const Daemons daemons = make_daemons("scribble");
   const pid_t world = daemons.world("");

@@ -185,3 +185,33 @@ TEST_CASE("a trajectory that leaves the device's frame is refused, naming the ti
   std::istringstream edge("t,x,y,z\n0,0,0,0.05\n1,0.2,0,0.05\n");
   CHECK(impetus::trajectory_problem(impetus::parse_trajectory_csv(edge, "edge.csv"), geometry).empty());
 }
+
+TEST_CASE("a held trajectory waits at its start, then plays as it would have from the start") {
+  SpidarGeometry slack;
+  slack.tension_min_N = 0.0;  // no device force: the finger at rest on a still target stays exactly there
+  const Trajectory tap = load_trajectory("tap");
+  DeviceSim held(slack, HardwareParams{}, FingerParams{}, tap);
+  DeviceSim played(slack, HardwareParams{}, FingerParams{}, tap);
+  const impetus::Vec3 start_m = held.finger_m();
+  constexpr int kHeldTicks = 700;
+  for (int k = 0; k < kHeldTicks; ++k) {
+    held.hold_trajectory(kTick_s);
+    held.tick(kZeroTension, kTick_s);
+  }
+  CHECK(held.finger_m() == start_m);
+  CHECK(held.target_m() == start_m);
+  CHECK(held.trajectory_time_s() == 0.0);
+  CHECK(held.time_s() == Approx(kHeldTicks * kTick_s));
+  // From the release on, the finger follows the same path, kHeldTicks later (the clocks differ by a rounding).
+  double worst_m = 0.0;
+  while (!played.finished()) {
+    REQUIRE_FALSE(held.finished());
+    played.tick(kZeroTension, kTick_s);
+    held.tick(kZeroTension, kTick_s);
+    worst_m = std::max(worst_m, (to_eigen(held.finger_m()) - to_eigen(played.finger_m())).norm());
+  }
+  CHECK(worst_m < 1e-9);
+  CHECK(held.trajectory_time_s() == Approx(played.time_s()));
+  held.tick(kZeroTension, kTick_s);  // the held one's clock lags by rounding only: at most one tick more
+  CHECK(held.finished());
+}

@@ -240,6 +240,7 @@ void encode(const DeviceCommand& command, wire::DeviceCommand& out) {
   out.tick = command.tick;
   out.haptic_session = command.haptic_session;
   out.tension_N = command.tension_N;
+  out.flags = command.flags;
   seal(out);
 }
 
@@ -284,6 +285,7 @@ FrameError decode(const wire::DeviceCommand& in, DeviceCommand& out) {
   out.tick = in.tick;
   out.haptic_session = in.haptic_session;
   out.tension_N = in.tension_N;
+  out.flags = in.flags;
   return FrameError::ok;
 }
 

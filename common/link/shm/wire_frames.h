@@ -128,6 +128,7 @@ struct DeviceCommand {
   std::uint64_t tick = 0;
   std::uint64_t haptic_session = 0;
   std::array<double, kStringCount> tension_N{};
+  std::uint64_t flags = 0;
   std::uint64_t checksum = 0;
 };
 
