@@ -35,6 +35,9 @@ struct ContactPlane : ShapePlane {
   double yield_radius_m = 0.0;
   double yield_room_m = 0.0;
   double yield_compliance_mpN = 0.0;
+  // A mesh triangle the god-object's walk met on the proxy's way this tick (mesh_walk.h): the surface itself, not a
+  // first-order picture of it, so it holds the proxy however far from its point the finger is (no extent).
+  bool met = false;
 
   // Whether the plane carries its body's shape (the floor's does not).
   bool shaped() const { return shape.kind != ShapeKind::none; }
@@ -42,7 +45,10 @@ struct ContactPlane : ShapePlane {
 
   // How far from point_m the plane still describes its object (0: unbounded), for telling a plane whose object is
   // beside the finger from one it is in (proxy_projection.h): the shape's (common/shape/shape.h describes_within_m).
-  double describes_within_m() const { return shaped() ? impetus::describes_within_m(shape) : extent_m; }
+  double describes_within_m() const {
+    if (met) return 0.0;
+    return shaped() ? impetus::describes_within_m(shape) : extent_m;
+  }
 
   // Velocity of the object's material point at `x` (rigid body: v + ω × (x − com)).
   Eigen::Vector3d surface_velocity_mps(const Eigen::Vector3d& x_m) const {
@@ -65,9 +71,13 @@ struct ContactPlane : ShapePlane {
   }
 };
 
+// The planes one servo tick can hold: a frame's, and the triangles the mesh walk holds beyond one per mesh
+// (mesh_walk.h: three at most in all, the first of each mesh in that mesh's own place).
+inline constexpr std::uint32_t kMaxServoPlanes = kMaxPlanes + 2;
+
 // Fixed-capacity set, filled in place each tick.
 struct PlaneSet {
-  std::array<ContactPlane, kMaxPlanes> planes{};
+  std::array<ContactPlane, kMaxServoPlanes> planes{};
   std::uint32_t count = 0;
   // How far from the finger the planes describe the world (the frame's reach radius): the world sent every object
   // within it, so a proxy the planes place farther away may lie inside an object nobody sent (proxy_projection.h).

@@ -22,7 +22,7 @@ double clearance_m(const ContactPlane& plane, const Eigen::Vector3d& finger_m) {
 const PlaneSet& GodObject::armed_planes(const PlaneSet& planes, const Eigen::Vector3d& finger_m) {
   if (session_starting_ && planes.count > 0) {
     session_starting_ = false;
-    for (std::uint32_t k = 0; k < planes.count && sunk_count_ < static_cast<int>(kMaxPlanes); ++k) {
+    for (std::uint32_t k = 0; k < planes.count && sunk_count_ < static_cast<int>(kMaxServoPlanes); ++k) {
       // Only a resting object is set back: one that moves onto the finger pushes it out like any moving plane.
       const ContactPlane& plane = planes.planes[k];
       const double approach_mps = plane.surface_velocity_mps(plane.point_m).dot(plane.normal);

@@ -83,14 +83,14 @@ class GodObject {
   GodObjectResult result_;
   bool session_starting_ = false;
   Eigen::Vector3d session_start_finger_m_ = Eigen::Vector3d::Zero();
-  std::array<Sunk, kMaxPlanes> sunk_{};
+  std::array<Sunk, kMaxServoPlanes> sunk_{};
   int sunk_count_ = 0;
   std::array<Pressed, kMaxActiveConstraints + 1> pressed_{};  // by the last solve
   int pressed_count_ = 0;
-  std::array<Pressed, kMaxActiveConstraints + 1 + kMaxPlanes> held_{};  // when the finger vanished
+  std::array<Pressed, kMaxActiveConstraints + 1 + kMaxServoPlanes> held_{};  // when the finger vanished
   int held_count_ = 0;
   PlaneSet armed_;
-  std::array<int, kMaxPlanes> armed_index_{};  // armed_ index → index in the caller's PlaneSet
+  std::array<int, kMaxServoPlanes> armed_index_{};  // armed_ index → index in the caller's PlaneSet
 };
 
 }  // namespace impetus

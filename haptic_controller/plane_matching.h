@@ -15,7 +15,7 @@
 namespace impetus {
 
 inline std::uint32_t plane_count(const PlaneFrame& frame) { return std::min(frame.plane_count, kMaxPlanes); }
-inline std::uint32_t plane_count(const PlaneSet& set) { return std::min(set.count, kMaxPlanes); }
+inline std::uint32_t plane_count(const PlaneSet& set) { return std::min(set.count, kMaxServoPlanes); }
 
 // The rank of plane k among the planes of its object in `set`.
 template <class Planes>
@@ -38,7 +38,7 @@ int find_plane(const Planes& set, std::int32_t object_id, int occurrence) {
 // For each plane k of `current`, the index of the same plane in `previous` ((object_id, occurrence) as above), or −1:
 // what interpolation needs every tick, found once per pair of frames.
 struct PlaneMatches {
-  std::array<std::int16_t, kMaxPlanes> previous_index{};
+  std::array<std::int16_t, kMaxServoPlanes> previous_index{};
 };
 template <class Planes>
 void match_planes(const Planes& previous, const Planes& current, PlaneMatches& out) {

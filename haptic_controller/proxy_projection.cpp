@@ -21,7 +21,7 @@ constexpr double kFeasibilityTolerance_m = 1e-12;
 constexpr double kParallelSine = 1e-6;
 // Each iteration adds or drops one constraint; Goldfarb–Idnani terminates in finitely many, typically a handful. This
 // bound only guards against cycling from rounding on ties.
-constexpr int kMaxIterations = 4 * static_cast<int>(kMaxPlanes) + 8;
+constexpr int kMaxIterations = 4 * static_cast<int>(kMaxServoPlanes) + 8;
 
 double slack(const ContactPlane& plane, const Eigen::Vector3d& x) { return plane.normal.dot(x - plane.point_m); }
 
@@ -65,6 +65,11 @@ bool beside_or_on(const ContactPlane& plane, const Eigen::Vector3d& goal) {
 // extent of its point, and within the world's reach of the goal (header, "Locally infeasible sets").
 bool within_validity(const PlaneSet& planes, const ProxySolution& s, int p, const Eigen::Vector3d& x,
                      const Eigen::Vector3d& goal) {
+  // Triangles a mesh walk met are the surface the proxy's way found (ContactPlane::met): among themselves they hold
+  // wherever they put it, as the walk did.
+  bool all_met = planes.planes[static_cast<std::size_t>(p)].met;
+  for (int j = 0; j < s.active_count; ++j) all_met = all_met && planes.planes[s.active[j].plane].met;
+  if (all_met) return true;
   if ((x - goal).norm() > planes.valid_within_m) return false;
   auto covers = [&](int k) {
     const ContactPlane& plane = planes.planes[static_cast<std::size_t>(k)];

@@ -31,10 +31,11 @@
 //    planes of balls packed around the finger close a pocket whose corners lie beside the balls. A plane is §3.1's
 //    first-order picture of its object near its point: it holds within its extent (common/shape/shape.h
 //    describes_within_m: a sphere's radius, a box's diagonal, a long body's bounding diagonal), and the plane set as
-//    a whole within planes.valid_within_m of the goal (the world's reach: it sent nothing beyond). Once the proxy has left the finger's spot (an edge or corner is
-//    being built), a step that takes it beyond either treats the plane being added as conflicting with the active ones,
-//    exactly as an opposite parallel plane: same compromise, same flag. A single plane is never bounded: however deep
-//    the finger, its proxy is the projection onto that face.
+//    a whole within planes.valid_within_m of the goal (the world's reach: it sent nothing beyond). Once the proxy has
+//    left the finger's spot (an edge or corner is being built), a step that takes it beyond either treats the plane
+//    being added as conflicting with the active ones, exactly as an opposite parallel plane: same compromise, same
+//    flag. A single plane is never bounded: however deep the finger, its proxy is the projection onto that face. Nor
+//    are the triangles a mesh walk met (ContactPlane::met): they are the surface itself, found along the proxy's way.
 
 #include "haptic_controller/contact_plane.h"
 

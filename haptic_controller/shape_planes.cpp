@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/shape_planes.h"
 
+#include "haptic_controller/mesh_walk.h"
+
 #include <array>
 
 namespace impetus {
@@ -48,26 +50,33 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m) {
 void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& finger_m) {
   // About the proxy, as always. A retake moves only the plane, not the body, so the plane as it came is its point and
   // normal, kept here (uninitialised storage: nothing is built per tick).
-  std::array<Eigen::Vector3d, kMaxPlanes> sent_point_m, sent_normal;
+  std::array<Eigen::Vector3d, kMaxServoPlanes> sent_point_m, sent_normal;
   auto as_sent = [&](std::uint32_t k) {
     ContactPlane plane = planes.planes[k];
     plane.point_m = sent_point_m[k];
     plane.normal = sent_normal[k];
     return plane;
   };
+  // Meshes whose triangles are here are walked together (mesh_walk.h): the triangles the proxy's way meets become
+  // their planes and hold it, and the rest of this function leaves them alone. A mesh the walk holds nothing of gets
+  // its plane about where the walk ended; if the walk met nothing, the straight way to the finger goes into no mesh.
+  const std::uint32_t sent_count = planes.count;
+  std::array<bool, kMaxServoPlanes> walked{};
+  const bool held_by_mesh = walk_mesh_planes(planes, proxy_m, finger_m, walked) > 0;
   bool finger_held = false;
-  for (std::uint32_t k = 0; k < planes.count; ++k) {
+  for (std::uint32_t k = 0; k < sent_count; ++k) {
     ContactPlane& plane = planes.planes[k];
-    if (!plane.shaped()) continue;
+    if (walked[k] || !plane.shaped()) continue;
     sent_point_m[k] = plane.point_m;
     sent_normal[k] = plane.normal;
     retake_plane(plane, proxy_m);
     finger_held = finger_held || !in_front(plane, finger_m);
   }
-  if (!finger_held) return;
+  if (!finger_held || held_by_mesh) return;
   // Is the straight way from the proxy to the finger clear of every body? Any one it enters holds the proxy back,
   // and the proxy then slides along that body, where the others may meet it: only a way clear of all lets it go.
-  for (std::uint32_t k = 0; k < planes.count; ++k) {
+  for (std::uint32_t k = 0; k < sent_count; ++k) {
+    if (walked[k]) continue;  // the walk went to the finger: the way goes into no mesh
     const ContactPlane& plane = planes.planes[k];
     const bool enters = plane.shaped() ? segment_enters(plane, proxy_m, finger_m, kOnSurface_m)
                                              : !in_front(plane, proxy_m) || !in_front(plane, finger_m);
@@ -76,9 +85,9 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const
   // Clear: every body behind a plane with both ends of the way in front. The one about the proxy if the finger is in
   // front of it; else the finger's supporting plane, if the proxy is in front of that; else the plane at the body's
   // point nearest the way.
-  for (std::uint32_t k = 0; k < planes.count; ++k) {
+  for (std::uint32_t k = 0; k < sent_count; ++k) {
     ContactPlane& plane = planes.planes[k];
-    if (!plane.shaped() || in_front(plane, finger_m)) continue;
+    if (walked[k] || !plane.shaped() || in_front(plane, finger_m)) continue;
     const ContactPlane sent = as_sent(k);
     ContactPlane at_finger = sent;
     retake_plane(at_finger, finger_m);

@@ -28,13 +28,17 @@ class MeshBody final : public MeshGeometry {
   const Shape& shape() const { return shape_; }
   // Where the body's origin lies in the (scaled) file's frame: a scene's position_m puts this point there.
   const Eigen::Vector3d& origin_in_file_m() const { return origin_in_file_m_; }
-  bool closed() const { return closed_; }
+  bool closed() const override { return closed_; }
   bool winding_flipped() const { return flipped_; }
   const MeshBvh& bvh() const { return bvh_; }
 
   SurfacePoint nearest(const Eigen::Vector3d& query_m) const override;
   double support(const Eigen::Vector3d& normal) const override;
   bool segment_enters(const Eigen::Vector3d& a, const Eigen::Vector3d& d, double margin_m) const override;
+  bool first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double tolerance_m, const std::uint32_t* skip,
+                   int skip_count, MeshEntry& out) const override {
+    return bvh_.first_entry(a, b, tolerance_m, skip, skip_count, out);
+  }
   Eigen::Vector3d bounds_half(const Eigen::Matrix3d& rotation) const override;
   double volume_m3() const override { return volume_m3_; }
   Eigen::Matrix3d inertia_per_kg() const override { return inertia_per_kg_; }

@@ -291,6 +291,59 @@ bool MeshBvh::segment_crosses(const Eigen::Vector3d& a, const Eigen::Vector3d& b
   return false;
 }
 
+bool MeshBvh::first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double tolerance_m,
+                          const std::uint32_t* skip, int skip_count, MeshEntry& out) const {
+  if (nodes_.empty()) return false;
+  const Eigen::Vector3d d = b - a;
+  double best_t = std::numeric_limits<double>::infinity();
+  std::array<std::uint32_t, kMaxDepth + 1> stack{};
+  std::size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    // A crossing lies within tolerance_m of its triangle, so within that much of every box holding it.
+    Eigen::AlignedBox3d bounds = node.bounds;
+    bounds.min().array() -= tolerance_m;
+    bounds.max().array() += tolerance_m;
+    if (!segment_meets_box(bounds, a, d)) continue;
+    if (node.count == 0) {
+      const std::uint32_t self = static_cast<std::uint32_t>(&node - nodes_.data());
+      stack[top++] = node.first;  // right
+      stack[top++] = self + 1;    // left
+      continue;
+    }
+    for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+      const std::uint32_t triangle = order_[i];
+      if (std::find(skip, skip + skip_count, triangle) != skip + skip_count) continue;
+      const auto& tri = mesh_.triangles[triangle];
+      const Eigen::Vector3d& p = mesh_.vertices_m[tri[0]];
+      const Eigen::Vector3d& n = face_normals_[triangle];
+      const double height_a_m = n.dot(a - p);
+      const double height_b_m = n.dot(b - p);
+      if (height_a_m < -tolerance_m || height_b_m >= -tolerance_m) continue;  // not from in front to behind
+      // Where the way meets the plane; a start on it to rounding (slightly behind) meets it at once.
+      const double t = height_a_m > 0.0 ? height_a_m / (height_a_m - height_b_m) : 0.0;
+      if (t >= best_t) continue;
+      const Eigen::Vector3d x = a + t * d;
+      // Within the triangle: on the inner side of each edge, or less than tolerance_m outside it. (e × (x − v))·n
+      // is the edge's length times x's distance inside it.
+      bool within = true;
+      for (int k = 0; k < 3 && within; ++k) {
+        const Eigen::Vector3d& from = mesh_.vertices_m[tri[k]];
+        const Eigen::Vector3d edge = mesh_.vertices_m[tri[(k + 1) % 3]] - from;
+        within = edge.cross(x - from).dot(n) >= -tolerance_m * edge.norm();
+      }
+      if (!within) continue;
+      best_t = t;
+      out.point_m = x;
+      out.normal = n;
+      out.t = t;
+      out.triangle = triangle;
+    }
+  }
+  return best_t <= 1.0;
+}
+
 std::size_t MeshBvh::memory_bytes() const {
   return mesh_.vertices_m.capacity() * sizeof(Eigen::Vector3d) +
          mesh_.triangles.capacity() * sizeof(mesh_.triangles[0]) + nodes_.capacity() * sizeof(Node) +

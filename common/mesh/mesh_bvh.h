@@ -13,6 +13,7 @@
 // so any number of threads may query it.
 
 #include "common/mesh/triangle_mesh.h"
+#include "common/shape/mesh_geometry.h"  // MeshEntry
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -48,6 +49,12 @@ class MeshBvh {
   // Whether the segment from `a` to `b` crosses a triangle at a parameter t in (t_min, 1] (t = 0 at `a`): the
   // triangle's plane between its two ends, within its edges (Möller and Trumbore's test). Both sides count.
   bool segment_crosses(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double t_min) const;
+  // The first triangle whose outer side the way from `a` to `b` goes in through: `a` in front of its plane or at most
+  // `tolerance_m` behind it (on it, to rounding), `b` behind it by more than `tolerance_m`, and the crossing within
+  // `tolerance_m` of the triangle (so a way cannot slip between two triangles through their shared edge). The least
+  // t wins; triangles in `skip` are not tried. A way along a triangle's plane, or out of it, does not go in.
+  bool first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double tolerance_m,
+                   const std::uint32_t* skip, int skip_count, MeshEntry& out) const;
 
   const TriangleMesh& mesh() const { return mesh_; }
   const Eigen::AlignedBox3d& bounds() const { return nodes_.front().bounds; }

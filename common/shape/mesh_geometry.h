@@ -19,6 +19,14 @@
 
 namespace impetus {
 
+// Where a way goes into a mesh through a triangle's outer side (MeshGeometry::first_entry).
+struct MeshEntry {
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  // on the triangle (within the query's tolerance of its edges)
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // the triangle's own unit outward normal
+  double t = 0.0;                                     // along the way, in [0, 1]
+  std::uint32_t triangle = 0;
+};
+
 // What the shape module asks of a mesh. Every function is const, allocation-free and never throws.
 class MeshGeometry {
  public:
@@ -31,9 +39,18 @@ class MeshGeometry {
   // than the margin, or a crossing of the surface past the first `margin_m` of the way (a way that starts on the
   // surface and leaves does not enter; one through a thin wall does).
   virtual bool segment_enters(const Eigen::Vector3d& a, const Eigen::Vector3d& d, double margin_m) const = 0;
+  // The first triangle whose outer side the way from `a` to `b` goes in through, skipping the `skip_count`
+  // triangles at `skip`: `a` in front of its plane or at most `tolerance_m` behind it, `b` more than `tolerance_m`
+  // behind it, the crossing within `tolerance_m` of the triangle. False if the way goes in through none. What the
+  // god-object's walk over the triangles asks (haptic_controller/mesh_walk.h).
+  virtual bool first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double tolerance_m,
+                           const std::uint32_t* skip, int skip_count, MeshEntry& out) const = 0;
   // Half extents of the smallest world-aligned box centred on the origin that holds the mesh turned by `rotation`:
   // max over the vertices of |(rotation·x)_i| (shape.h's bounds are centred on the body's origin).
   virtual Eigen::Vector3d bounds_half(const Eigen::Matrix3d& rotation) const = 0;
+  // Whether every edge has two triangles (a body with an inside; the pseudo-normals' side is exact). An open mesh's
+  // side is that of its triangles' winding only near them.
+  virtual bool closed() const = 0;
   virtual double volume_m3() const = 0;
   virtual Eigen::Matrix3d inertia_per_kg() const = 0;  // m², about the centre of mass, body frame
 };
