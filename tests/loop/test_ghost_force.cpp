@@ -60,13 +60,16 @@ TEST_CASE("a dense stream of objects past the finger is felt where it is, under 
   }
 }
 
-TEST_CASE("users' closed meshes in static clutter are felt as they are: boxes, spheres and pebbles, at 20 and 10 Hz") {
-  // With bowls among them (open, a thin wall) the goals are not met yet: docs/meshes.md, "The ghost-force scorer".
-  for (const int count : {4, 16}) {
-    for (const double rate_hz : {20.0, 10.0}) {
-      INFO(count << " meshes, " << rate_hz << " Hz world");
-      check_goals(test::score(test::as_meshes(test::clutter(count, 7), false), rate_hz, 20.0),
-                  count == 4 ? 100 : 500);
+TEST_CASE("users' meshes in static clutter are felt as they are: boxes, spheres, pebbles and bowls, at 20 and 10 Hz") {
+  // Closed meshes alone, and with the bowls in the cylinders' places (open, concave, a 1.2-1.9 mm wall: the exact
+  // god-object's walk over the triangles holds the proxy on the inner face, where one tangent plane went into it).
+  for (const bool bowls : {false, true}) {
+    for (const int count : {4, 16}) {
+      for (const double rate_hz : {20.0, 10.0}) {
+        INFO(count << " meshes" << (bowls ? " with bowls, " : ", ") << rate_hz << " Hz world");
+        check_goals(test::score(test::as_meshes(test::clutter(count, 7), bowls), rate_hz, 20.0),
+                    count == 4 ? 100 : 500);
+      }
     }
   }
 }
