@@ -16,12 +16,11 @@ bool finite(const GripLengths& lengths) {
 }
 
 // Residuals r_k = |motor_k − (p + R·a_k)| − length_k, and their sum of squares.
-double residuals(const std::array<Eigen::Vector3d, kGripStringCount>& motors,
-                 const std::array<Eigen::Vector3d, kGripStringCount>& attachments, const GripPose& pose,
-                 const GripLengths& lengths, Eigen::Matrix<double, kGripStringCount, 1>& r) {
+double residuals(const GripStrings& strings, const GripPose& pose, const GripLengths& lengths,
+                 Eigen::Matrix<double, kGripStringCount, 1>& r) {
   const Eigen::Matrix3d rotation = pose.orientation.toRotationMatrix();
   for (int k = 0; k < kGripStringCount; ++k) {
-    r[k] = (motors[k] - pose.position_m - rotation * attachments[k]).norm() - lengths[k];
+    r[k] = (strings.motor_m(k) - pose.position_m - rotation * strings.attachment_m(k)).norm() - lengths[k];
   }
   return r.squaredNorm();
 }
@@ -51,51 +50,6 @@ const char* to_string(GripSolveStatus status) {
   return "unknown";
 }
 
-GripKinematics::GripKinematics(const SpidarGripGeometry& geometry) : geometry_(geometry) {
-  for (int k = 0; k < kGripStringCount; ++k) {
-    motors_m_[k] = geometry.motor_m(k);
-    attachments_m_[k] = geometry.attachment_m(k);
-  }
-}
-
-GripLengths GripKinematics::lengths_m(const GripPose& pose) const {
-  const Eigen::Matrix3d rotation = pose.orientation.toRotationMatrix();
-  GripLengths lengths{};
-  for (int k = 0; k < kGripStringCount; ++k) {
-    lengths[k] = (motors_m_[k] - pose.position_m - rotation * attachments_m_[k]).norm();
-  }
-  return lengths;
-}
-
-GripCounts GripKinematics::encoder_counts(const GripPose& pose) const {
-  const GripLengths lengths = lengths_m(pose);
-  GripCounts counts{};
-  for (int k = 0; k < kGripStringCount; ++k) {
-    counts[k] = static_cast<std::int64_t>(std::llround(lengths[k] / geometry_.metres_per_count));
-  }
-  return counts;
-}
-
-GripLengths GripKinematics::lengths_m(const GripCounts& counts) const {
-  GripLengths lengths{};
-  for (int k = 0; k < kGripStringCount; ++k) lengths[k] = static_cast<double>(counts[k]) * geometry_.metres_per_count;
-  return lengths;
-}
-
-GripWrenchMatrix GripKinematics::wrench_matrix(const GripPose& pose) const {
-  const Eigen::Matrix3d rotation = pose.orientation.toRotationMatrix();
-  GripWrenchMatrix w;
-  for (int k = 0; k < kGripStringCount; ++k) {
-    const Eigen::Vector3d arm = rotation * attachments_m_[k];
-    const Eigen::Vector3d toward = motors_m_[k] - pose.position_m - arm;
-    const double length = toward.norm();
-    const Eigen::Vector3d u = length > 0.0 ? Eigen::Vector3d(toward / length) : Eigen::Vector3d::Zero();
-    w.col(k).head<3>() = u;
-    w.col(k).tail<3>() = arm.cross(u);
-  }
-  return w;
-}
-
 GripSolve GripKinematics::pose(const GripLengths& lengths, const GripPose& guess, GripPose& out) const {
   GripSolve solve;
   out = guess;
@@ -105,9 +59,9 @@ GripSolve GripKinematics::pose(const GripLengths& lengths, const GripPose& guess
   }
   out.orientation.normalize();
   Eigen::Matrix<double, kGripStringCount, 1> r;
-  double cost = residuals(motors_m_, attachments_m_, out, lengths, r);
+  double cost = residuals(*this, out, lengths, r);
   // The grip radius turns an angle into a length, so one tolerance serves both parts of a step.
-  const double radius_m = std::max(geometry_.grip_radius_m, 1e-3);
+  const double radius_m = std::max(geometry().grip_radius_m, 1e-3);
   bool converged = false;
   for (solve.iterations = 0; solve.iterations < kMaxIterations && !converged; ++solve.iterations) {
     // Gauss–Newton with J = −Wᵀ: (W·Wᵀ)·δ = W·r.
@@ -128,7 +82,7 @@ GripSolve GripKinematics::pose(const GripLengths& lengths, const GripPose& guess
     for (int halving = 0; halving < 20 && !lowered; ++halving) {
       const GripPose next = moved(out, step);
       Eigen::Matrix<double, kGripStringCount, 1> next_r;
-      const double next_cost = residuals(motors_m_, attachments_m_, next, lengths, next_r);
+      const double next_cost = residuals(*this, next, lengths, next_r);
       if (next_cost <= cost) {
         lowered = true;
         out = next;
@@ -146,7 +100,7 @@ GripSolve GripKinematics::pose(const GripLengths& lengths, const GripPose& guess
   solve.residual_rms_m = std::sqrt(cost / kGripStringCount);
   if (!converged) {
     solve.status = GripSolveStatus::not_converged;
-  } else if (solve.residual_rms_m > kInconsistentCounts * geometry_.metres_per_count) {
+  } else if (solve.residual_rms_m > kInconsistentCounts * geometry().metres_per_count) {
     solve.status = GripSolveStatus::inconsistent;
   }
   return solve;

@@ -25,8 +25,6 @@
 
 namespace impetus {
 
-using GripWrench = Eigen::Matrix<double, 6, 1>;  // force (N), then torque about the grip's centre (N·m), world frame
-
 struct GripTensionSolution {
   std::array<double, kGripStringCount> tension_N{};
   GripWrench achieved = GripWrench::Zero();  // W·t: what the strings put on the grip
