@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// One simulated 8-string grip SPIDAR session (common/spidar/grip_geometry.h): the eight motors and strings, and the
+// hand holding the grip (common/hand/grip_hand.h), advanced one device tick at a time, as DeviceSim (device_sim.h)
+// advances the 4-string device and its finger.
+//
+// Contract of tick(): the commanded tensions, each clamped to the motors' [tension_min_N, tension_max_N] (a string can
+// only pull, and a motor only so hard), are held for dt_s (zero-order hold); within the tick the grip moves in the
+// hand's sub-steps, the strings' wrench W(pose)·t taken again at each; the counts at the end of the tick are returned.
+// The hand aims at the target pose the caller gives, moving with the given velocities over the tick. Time starts at 0
+// with the grip at rest at the start pose. No allocation after construction.
+
+#include "common/hand/grip_hand.h"
+#include "common/spidar/grip_strings.h"
+
+#include <Eigen/Core>
+
+namespace impetus {
+
+class GripSim {
+ public:
+  // Throws std::invalid_argument (from GripHand) if the hand's parameters or the start are unusable, or if the
+  // geometry's tension limits are not 0 <= min <= max.
+  GripSim(const SpidarGripGeometry& geometry, const GripHandParams& hand, const GripPose& start);
+
+  // Advances one tick of dt_s (finite, > 0; else std::invalid_argument) and returns the encoder counts at its end.
+  const GripCounts& tick(const GripTensions& commanded_N, const GripPose& target,
+                         const Eigen::Vector3d& target_velocity_mps,
+                         const Eigen::Vector3d& target_angular_velocity_radps, double dt_s);
+
+  double time_s() const { return time_s_; }
+  GripPose pose() const { return hand_.pose(); }
+  const GripHand& hand() const { return hand_; }
+  const GripStrings& strings() const { return strings_; }
+  const GripCounts& encoder_counts() const { return counts_; }
+  const GripTensions& tensions_N() const { return tensions_N_; }  // as applied: the command clamped
+  // The strings' force and torque on the grip at the end of the last tick (N, N·m about its centre, world frame).
+  GripWrench wrench() const;
+
+ private:
+  GripStrings strings_;
+  GripHand hand_;
+  GripTensions tensions_N_{};
+  GripCounts counts_{};
+  double time_s_ = 0.0;
+};
+
+}  // namespace impetus
