@@ -136,7 +136,11 @@ NumberStatus parse_number(std::string_view text, double& value) {
 // CSV files
 
 constexpr std::string_view kCsvHeader = "t,x,y,z";
-constexpr std::array<std::string_view, 4> kCsvColumns = {"t", "x", "y", "z"};
+constexpr std::string_view kCsvTurningHeader = "t,x,y,z,qw,qx,qy,qz";
+constexpr std::array<std::string_view, 8> kCsvColumns = {"t", "x", "y", "z", "qw", "qx", "qy", "qz"};
+// A quaternion written by hand or by a script to a few digits is unit to 10⁻³; one further off is a column mix-up or
+// a rotation written some other way (Euler angles), not rounding.
+constexpr double kUnitQuaternionTolerance = 1e-3;
 
 [[noreturn]] void csv_error(const std::string& path, int line, std::size_t column, std::string_view column_name,
                             std::string_view reason, std::string_view got) {
@@ -200,7 +204,8 @@ Trajectory::Trajectory(std::vector<TrajectorySegment> segments, std::string desc
   }
 }
 
-Trajectory Trajectory::from_waypoints(const std::vector<Waypoint>& waypoints, std::string description) {
+Trajectory Trajectory::from_waypoints(const std::vector<Waypoint>& waypoints, std::string description,
+                                      bool turning) {
   if (waypoints.empty()) throw TrajectoryError(excerpt(description, 80) + ": no waypoints");
   std::vector<TrajectorySegment> segments;
   const auto line_between = [](const Waypoint& a, const Waypoint& b) {
@@ -220,7 +225,52 @@ Trajectory Trajectory::from_waypoints(const std::vector<Waypoint>& waypoints, st
     }
     segments.push_back(line_between(waypoints[i - 1], waypoints[i]));
   }
-  return Trajectory(std::move(segments), std::move(description));
+  Trajectory trajectory(std::move(segments), std::move(description));
+  if (!turning) return trajectory;
+  for (std::size_t i = 0; i < waypoints.size(); ++i) {
+    const Eigen::Quaterniond& q = waypoints[i].orientation;
+    if (!q.coeffs().allFinite() || !(q.norm() > 0.0)) {
+      throw TrajectoryError(excerpt(trajectory.description_, 80) + ": waypoint " + std::to_string(i) +
+                            ": orientation must be a finite, non-zero quaternion");
+    }
+  }
+  // Each turn from one waypoint's orientation to the next's, the shorter way, at constant angular velocity.
+  Eigen::Quaterniond from = waypoints[0].orientation.normalized();
+  if (waypoints.size() == 1) {
+    trajectory.turns_.push_back({waypoints[0].t_s, waypoints[0].t_s, from, Eigen::Vector3d::Zero()});
+  }
+  for (std::size_t i = 1; i < waypoints.size(); ++i) {
+    Eigen::Quaterniond to = waypoints[i].orientation.normalized();
+    if (from.dot(to) < 0.0) to.coeffs() = -to.coeffs();
+    const Eigen::AngleAxisd turn(to * from.conjugate());
+    const double span_s = waypoints[i].t_s - waypoints[i - 1].t_s;
+    trajectory.turns_.push_back({waypoints[i - 1].t_s, waypoints[i].t_s, from, turn.angle() / span_s * turn.axis()});
+    from = to;
+  }
+  return trajectory;
+}
+
+std::size_t Trajectory::turn_index_at(double t_s) const {
+  const auto it = std::upper_bound(turns_.begin(), turns_.end(), t_s,
+                                   [](double t, const Turn& turn) { return t < turn.end_s; });
+  return it == turns_.end() ? turns_.size() - 1 : static_cast<std::size_t>(it - turns_.begin());
+}
+
+Eigen::Quaterniond Trajectory::orientation_at(double t_s) const {
+  if (turns_.empty()) return Eigen::Quaterniond::Identity();
+  const Turn& turn = turns_[turn_index_at(t_s)];
+  const double along_s = std::clamp(t_s - turn.begin_s, 0.0, turn.end_s - turn.begin_s);
+  const Eigen::Vector3d turned = along_s * turn.angular_velocity_radps;
+  const double angle_rad = turned.norm();
+  if (!(angle_rad > 0.0)) return turn.from;
+  return (Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, turned / angle_rad)) * turn.from).normalized();
+}
+
+Eigen::Vector3d Trajectory::angular_velocity_at(double t_s) const {
+  if (turns_.empty() || !(t_s >= turns_.front().begin_s) || t_s >= turns_.back().end_s) {
+    return Eigen::Vector3d::Zero();
+  }
+  return turns_[turn_index_at(t_s)].angular_velocity_radps;
 }
 
 std::size_t Trajectory::segment_index_at(double t_s, std::size_t hint) const {
@@ -244,7 +294,9 @@ Trajectory Trajectory::held_until(double end_s) const {
   hold.from_m = position_at(duration_s());
   hold.to_m = hold.from_m;
   segments.push_back(hold);
-  return Trajectory(std::move(segments), description_);
+  Trajectory held(std::move(segments), description_);
+  held.turns_ = turns_;  // the last orientation holds after the last turn as after the last point
+  return held;
 }
 
 Vec3 Trajectory::position_at(double t_s) const { return sample_at(t_s).position_m; }
@@ -288,35 +340,44 @@ Trajectory parse_trajectory_csv(std::istream& in, const std::string& path) {
   int previous_line = 0;
   std::string line_text;
   int line_number = 0;
+  bool turning = false;  // the header names the orientation columns
+  std::size_t columns = 4;
+  std::string expected = "expected 4 columns t,x,y,z";
   while (std::getline(in, line_text)) {
     ++line_number;
     std::string_view line = line_text;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);  // files written on Windows
 
     if (line_number == 1) {
+      if (trim(line) == kCsvTurningHeader) {
+        turning = true;
+        columns = kCsvColumns.size();
+        expected = "expected 8 columns t,x,y,z,qw,qx,qy,qz";
+        continue;
+      }
       if (trim(line) != kCsvHeader) {
         // Point at the first character that differs from the expected header.
         const std::size_t lead = std::min(line.find_first_not_of(" \t"), line.size());
         const std::string_view body = trim(line);
         std::size_t i = 0;
         while (i < body.size() && i < kCsvHeader.size() && body[i] == kCsvHeader[i]) ++i;
-        csv_error(path, 1, lead + i + 1, "header", "expected the header 't,x,y,z'", line);
+        csv_error(path, 1, lead + i + 1, "header", "expected the header 't,x,y,z' (or 't,x,y,z,qw,qx,qy,qz')",
+                  line);
       }
       continue;
     }
     if (trim(line).empty()) continue;
 
     const std::vector<CsvField> fields = split_fields(line);
-    if (fields.size() < kCsvColumns.size()) {
-      csv_error(path, line_number, line.size() + 1, kCsvColumns[fields.size()],
-                "missing value: expected 4 columns t,x,y,z", line);
+    if (fields.size() < columns) {
+      csv_error(path, line_number, line.size() + 1, kCsvColumns[fields.size()], "missing value: " + expected, line);
     }
-    if (fields.size() > kCsvColumns.size()) {
-      csv_error(path, line_number, fields[kCsvColumns.size()].column, "extra",
-                "too many columns: expected 4 columns t,x,y,z", fields[kCsvColumns.size()].text);
+    if (fields.size() > columns) {
+      csv_error(path, line_number, fields[columns].column, "extra", "too many columns: " + expected,
+                fields[columns].text);
     }
-    std::array<double, 4> values{};
-    for (std::size_t c = 0; c < kCsvColumns.size(); ++c) {
+    std::array<double, kCsvColumns.size()> values{};
+    for (std::size_t c = 0; c < columns; ++c) {
       switch (parse_number(fields[c].text, values[c])) {
         case NumberStatus::ok: break;
         case NumberStatus::not_a_number:
@@ -336,12 +397,22 @@ Trajectory parse_trajectory_csv(std::istream& in, const std::string& path) {
              << ")";
       csv_error(path, line_number, fields[0].column, "t", reason.str(), fields[0].text);
     }
-    waypoints.push_back({t_s, {values[1], values[2], values[3]}});
+    Waypoint waypoint{t_s, {values[1], values[2], values[3]}};
+    if (turning) {
+      waypoint.orientation = Eigen::Quaterniond(values[4], values[5], values[6], values[7]);
+      const double norm = waypoint.orientation.norm();
+      if (!(std::abs(norm - 1.0) <= kUnitQuaternionTolerance)) {
+        std::ostringstream reason;
+        reason << "the orientation must be a unit quaternion qw,qx,qy,qz (its norm is " << norm << ")";
+        csv_error(path, line_number, fields[4].column, "qw", reason.str(), line.substr(fields[4].column - 1));
+      }
+    }
+    waypoints.push_back(waypoint);
     previous_line = line_number;
   }
   if (line_number == 0) csv_error(path, 1, 1, "header", "empty file: expected the header 't,x,y,z'", "");
   if (waypoints.empty()) csv_error(path, line_number + 1, 1, "t", "no waypoints after the header", "");
-  return Trajectory::from_waypoints(waypoints, path);
+  return Trajectory::from_waypoints(waypoints, path, turning);
 }
 
 // ---------------------------------------------------------------------------------------------------------------

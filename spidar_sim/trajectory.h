@@ -7,9 +7,12 @@
 // allocation-free and safe to call from the device tick; loading allocates and throws `TrajectoryError`.
 //
 // CSV files
-//   The first line is exactly the header `t,x,y,z` (s, m, m, m). Each following line is one waypoint; time must be
-//   non-negative and strictly increasing, every value finite. Blank lines are skipped. Between waypoints the position
-//   is interpolated linearly; before the first waypoint the first is held, after the last the last is held.
+//   The first line is exactly the header `t,x,y,z` (s, m, m, m), or `t,x,y,z,qw,qx,qy,qz` for a hand that also turns
+//   what it holds (the grip SPIDAR's): its orientation, grip → world, as a unit quaternion (to 10⁻³; it is
+//   normalised). Each following line is one waypoint; time must be non-negative and strictly increasing, every value
+//   finite. Blank lines are skipped. Between waypoints the position is interpolated linearly and the orientation
+//   along the shorter great arc (slerp: a turn at constant angular velocity); before the first waypoint the first is
+//   held, after the last the last is held. Without orientation columns the orientation is the identity.
 //   Errors read `FILE:LINE:COLUMN (column name): reason (got 'text')`, LINE and COLUMN 1-based, COLUMN counting
 //   characters, so an editor can jump to the offending field.
 //
@@ -71,6 +74,8 @@
 
 #include "common/contract/vec3.h"
 
+#include <Eigen/Geometry>
+
 #include <istream>
 #include <stdexcept>
 #include <string>
@@ -115,6 +120,7 @@ struct TrajectorySegment {
 struct Waypoint {
   double t_s = 0.0;
   Vec3 position_m{};
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // grip → world, unit (for a hand that turns)
 };
 
 class Trajectory {
@@ -123,8 +129,10 @@ class Trajectory {
   // TrajectoryError if they are empty, overlap, leave gaps, go backwards in time or hold non-finite values.
   Trajectory(std::vector<TrajectorySegment> segments, std::string description);
 
-  // Linear interpolation through waypoints (at least one; times >= 0 and strictly increasing; finite).
-  static Trajectory from_waypoints(const std::vector<Waypoint>& waypoints, std::string description);
+  // Linear interpolation through waypoints (at least one; times >= 0 and strictly increasing; finite), and slerp
+  // through their orientations if `turning` (else the orientation is the identity throughout).
+  static Trajectory from_waypoints(const std::vector<Waypoint>& waypoints, std::string description,
+                                   bool turning = false);
 
   // Target position (m) at session time t_s; holds the first point before the start and the last after the end.
   Vec3 position_at(double t_s) const;
@@ -139,6 +147,11 @@ class Trajectory {
   };
   Sample sample_at(double t_s) const;
   Sample sample_at(double t_s, std::size_t& segment_hint) const;
+  // Target orientation (grip → world) at t_s, and its angular velocity (rad/s, world frame), constant between two
+  // waypoints; the identity and zero for a trajectory that does not turn. Allocation-free.
+  Eigen::Quaterniond orientation_at(double t_s) const;
+  Eigen::Vector3d angular_velocity_at(double t_s) const;
+  bool turns() const { return !turns_.empty(); }
   // Time (s) of the last point; after it the target holds still.
   double duration_s() const { return segments_.back().end_s; }
   // The same path, then holding its last point until end_s (if later than its own end): the fingers of one device
@@ -152,8 +165,19 @@ class Trajectory {
   // Index of the first segment still running at t_s (t_s < its end), the last if none is; `hint` is tried first.
   std::size_t segment_index_at(double t_s, std::size_t hint) const;
 
+  // A turn between two waypoints: from `from` at begin_s at constant angular velocity (world frame).
+  struct Turn {
+    double begin_s = 0.0;
+    double end_s = 0.0;
+    Eigen::Quaterniond from = Eigen::Quaterniond::Identity();
+    Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();
+  };
+  // Index of the turn running at t_s, as segment_index_at; turns_ is not empty.
+  std::size_t turn_index_at(double t_s) const;
+
   std::vector<TrajectorySegment> segments_;
   std::string description_;
+  std::vector<Turn> turns_;  // empty: no orientation
 };
 
 // A built-in spec (see above) if the text before ':' names a built-in and no file of that name exists, otherwise the
