@@ -6,6 +6,7 @@
 // nothing.
 
 #include "spidar_sim/grip_sim.h"
+#include "trajectory_test_util.h"
 #include "tests/support/allocation_counter.h"
 
 #include <catch2/catch.hpp>
@@ -169,3 +170,35 @@ TEST_CASE("grip: a tick allocates nothing") {
   CHECK(sim.pose().position_m.allFinite());
 }
 #endif
+
+TEST_CASE("grip: the hand plays a trajectory that moves and turns, and one that leaves the frame is refused") {
+  SpidarGripGeometry slack;
+  slack.tension_min_N = 0.0;
+  // Two centimetres along x while turning 0.4 rad about z over 1 s, then held for 1 s.
+  const double c = std::cos(0.2), s = std::sin(0.2);
+  const impetus::test::TempFile file("grip.csv", "t,x,y,z,qw,qx,qy,qz\n0,0,0,0.05,1,0,0,0\n1,0.02,0,0.05," +
+                                                     std::to_string(c) + ",0,0," + std::to_string(s) +
+                                                     "\n2,0.02,0,0.05," + std::to_string(c) + ",0,0," +
+                                                     std::to_string(s) + "\n");
+  GripSim sim(slack, GripHandParams{}, load_trajectory(file.path()));
+  double worst_lag_rad = 0.0;
+  while (!sim.finished()) {
+    sim.tick(all(0.0), kTick_s);
+    worst_lag_rad = std::max(worst_lag_rad, GripHand::turn_between(sim.pose().orientation,
+                                                                   Eigen::Quaterniond(Eigen::AngleAxisd(
+                                                                       std::min(sim.time_s(), 1.0) * 0.4,
+                                                                       Vector3d::UnitZ())))
+                                                .norm());
+  }
+  CHECK(sim.time_s() == Approx(2.0).margin(1.5e-3));  // to the tick (a sum of 1 ms steps may fall short of 2 s)
+  CHECK((sim.pose().position_m - Vector3d(0.02, 0.0, 0.05)).norm() < 1e-6);
+  CHECK(Eigen::AngleAxisd(sim.pose().orientation).angle() == Approx(0.4).margin(1e-5));
+  // While turning at 0.4 rad/s the hand follows within its start-up ring: a damped oscillator of frequency ω started
+  // with a velocity v off its target (the target's jump to 0.4 rad/s) never strays more than v/ω = 6 mrad.
+  CHECK(worst_lag_rad < 0.4 / std::sqrt(0.3 / 6e-5));
+
+  const impetus::test::TempFile far("far.csv", "t,x,y,z\n0,0,0,0.05\n1,0.19,0,0.05\n");
+  CHECK_THROWS_WITH(GripSim(slack, GripHandParams{}, load_trajectory(far.path())),
+                    Catch::Contains("at t = 1.000 s the grip's target (0.1900, 0.0000, 0.0500) m"));
+  CHECK_THROWS_AS(GripSim(slack, GripHandParams{}, centre_pose(slack)).tick(all(0.0), kTick_s), std::logic_error);
+}
