@@ -10,10 +10,15 @@ user would try (docs/meshes.md):
   shell.obj   a 1 mm thin dome shell (closed: outer and inner surface joined at the rim), static;
   cube.obj    a 5 cm cube of 12 triangles, to compare with the primitive box.
 Run it again to regenerate them: the output is deterministic.
+
+With --terrain [TRIANGLES] it writes instead a rolling terrain of about that many triangles (default 10^6) as a
+binary STL, 30 x 30 cm with hills of up to 15 mm, static and open, for scenes/terrain.json. At 10^6 triangles the
+file is 50 MB, so it is generated (into out/meshes/ by default), not committed.
 """
 import argparse
 import math
 import pathlib
+import struct
 
 
 def write_obj(path, vertices, triangles, comment):
@@ -134,11 +139,61 @@ def cube():
     return vertices, faces
 
 
+TERRAIN_SIDE_M = 0.3
+
+
+def terrain_height(x, y):
+    """The terrain's height (m) above its mean at (x, y): two waves across and one along the diagonal."""
+    return (0.01 * math.sin(2 * math.pi * x / 0.15) * math.cos(2 * math.pi * y / 0.12) +
+            0.005 * math.sin(2 * math.pi * (x + y) / 0.07))
+
+
+def terrain(triangles):
+    """A square grid of cells over the terrain's side, two triangles a cell, wound upward."""
+    cells = max(1, round(math.sqrt(triangles / 2)))
+    step = TERRAIN_SIDE_M / cells
+    half = TERRAIN_SIDE_M / 2
+    vertices = [(-half + i * step, -half + j * step, terrain_height(-half + i * step, -half + j * step))
+                for i in range(cells + 1) for j in range(cells + 1)]
+
+    def at(i, j):
+        return i * (cells + 1) + j
+    faces = []
+    for i in range(cells):
+        for j in range(cells):
+            faces.append((at(i, j), at(i + 1, j), at(i + 1, j + 1)))
+            faces.append((at(i, j), at(i + 1, j + 1), at(i, j + 1)))
+    return vertices, faces
+
+
+def write_stl_binary(path, vertices, triangles, comment):
+    with open(path, "wb") as out:
+        out.write(comment.encode("ascii")[:80].ljust(80, b" "))
+        out.write(struct.pack("<I", len(triangles)))
+        record = struct.Struct("<12fH")
+        for a, b, c in triangles:
+            out.write(record.pack(0.0, 0.0, 0.0, *vertices[a], *vertices[b], *vertices[c], 0))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", default=str(pathlib.Path(__file__).resolve().parent.parent / "scenes" / "meshes"),
                         help="folder to write into (default: scenes/meshes)")
+    parser.add_argument("--terrain", type=int, nargs="?", const=1_000_000, metavar="TRIANGLES",
+                        help="write only the terrain, of about this many triangles (default 1000000)")
+    parser.add_argument("--terrain-out",
+                        default=str(pathlib.Path(__file__).resolve().parent.parent / "out" / "meshes" / "terrain.stl"),
+                        help="the terrain's file (default: out/meshes/terrain.stl, which scenes/terrain.json reads)")
     args = parser.parse_args()
+    if args.terrain is not None:
+        if not 2 <= args.terrain <= 2_000_000:
+            parser.error(f"--terrain: from 2 to 2000000 triangles (the mesh loader's limit), not {args.terrain}")
+        path = pathlib.Path(args.terrain_out)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        vertices, faces = terrain(args.terrain)
+        write_stl_binary(path, vertices, faces, f"impetus terrain, {len(faces)} triangles, metres")
+        print(f"{path}: {len(faces)} triangles")
+        return
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for name, (vertices, faces), comment in (
