@@ -141,7 +141,7 @@ TEST_CASE("grip: a target moving and turning steadily is followed exactly once t
   CHECK(GripHand::turn_between(sim.pose().orientation, target.orientation).norm() < 1e-4);
 }
 
-TEST_CASE("grip: the motors only pull, and only up to their limit; a broken command is their minimum") {
+TEST_CASE("grip: the motors only pull, and only up to their limit, and a broken command is their minimum") {
   const SpidarGripGeometry geometry;
   GripSim sim(geometry, GripHandParams{}, centre_pose(geometry));
   const double nan = std::nan("");

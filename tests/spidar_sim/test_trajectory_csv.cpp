@@ -140,7 +140,7 @@ TEST_CASE("csv trajectory with orientation turns at constant angular velocity be
   CHECK(trajectory.held_until(3.0).orientation_at(2.5).isApprox(trajectory.orientation_at(1.5)));
 }
 
-TEST_CASE("csv trajectory without orientation columns does not turn; a bad quaternion names its line and column") {
+TEST_CASE("csv trajectory without orientation columns does not turn, and a bad quaternion names its line and column") {
   const TempFile file("still.csv", "t,x,y,z\n0,0,0,0\n1,0.1,0,0\n");
   const auto still = load_trajectory_csv(file.path());
   CHECK_FALSE(still.turns());
