@@ -8,7 +8,9 @@
 // off an edge keeps feeling the face's press until the next frame). So every plane carries its body's shape, centre and
 // axes (moved with the interpolation or the local model), and each tick the shape module takes the plane again under
 // the proxy by its kind's rules (common/shape/shape.h retake_plane; each kind's file says how), as Zilles & Salisbury's
-// god-object follows a curved surface: the proxy walks over a ball, rounds a cap, and leaves a face at its rim.
+// god-object follows a curved surface: the proxy walks over a ball, rounds a cap, and leaves a face at its rim. A mesh
+// whose triangles this process has is not retaken but walked (mesh_walk.h): its planes are the triangles the proxy's
+// way meets, up to three.
 //
 // Allocation-free.
 
