@@ -126,7 +126,7 @@ bool first_entry(std::span<const WalkedMesh> meshes, const MeshWalk& walk, const
 }  // namespace
 
 MeshWalk walk_meshes(std::span<const WalkedMesh> meshes, const Eigen::Vector3d& proxy_m,
-                     const Eigen::Vector3d& finger_m) {
+                     const Eigen::Vector3d& finger_m, const MeshHold* held) {
   MeshWalk walk;
   Eigen::Vector3d x = proxy_m;
   // A proxy inside at the start: a body moved onto it since the last tick. It starts from the surface, held by the
@@ -143,8 +143,25 @@ MeshWalk walk_meshes(std::span<const WalkedMesh> meshes, const Eigen::Vector3d& 
     }
   }
   if (walk.count > 0) {
-    unsigned held = 0;
-    x = nearest_in_front(walk, proxy_m, proxy_m, held);
+    unsigned kept = 0;
+    x = nearest_in_front(walk, proxy_m, proxy_m, kept);
+  } else if (held != nullptr) {
+    // The last walk's triangles that the proxy lies on, with the finger behind: the first step's way would go in
+    // through each at t = 0 (first_entry's rule, to the same tolerance), so they are met already.
+    for (int i = 0; i < held->count; ++i) {
+      const auto s = static_cast<std::size_t>(i);
+      for (std::size_t m = 0; m < meshes.size(); ++m) {
+        const WalkedMesh& placed = meshes[m];
+        if (placed.object_id != held->object_id[s]) continue;
+        MeshEntry on;
+        if (placed.mesh->on_triangle(held->triangle[s], to_body(placed, x), kOnSurface_m, on) &&
+            on.normal.dot(to_body(placed, finger_m) - on.point_m) < -kOnSurface_m) {
+          add(walk, placed.com_m + placed.axes * on.point_m, placed.axes * on.normal, on.triangle,
+              static_cast<int>(m));
+        }
+        break;
+      }
+    }
   }
   for (int step = 0; step < kMaxSteps; ++step) {
     // Head for the point nearest the finger in front of the planes met; those it does not hold are left behind (the
@@ -170,8 +187,20 @@ MeshWalk walk_meshes(std::span<const WalkedMesh> meshes, const Eigen::Vector3d& 
   return walk;
 }
 
+MeshHold held_by(const MeshWalk& walk, std::span<const WalkedMesh> meshes) {
+  MeshHold hold;
+  for (int i = 0; i < walk.count && hold.count < 3; ++i) {
+    const auto s = static_cast<std::size_t>(i);
+    if (walk.triangle[s] == MeshWalk::kNoTriangle) continue;  // a plane, not a triangle: nothing to start from
+    const auto h = static_cast<std::size_t>(hold.count++);
+    hold.object_id[h] = meshes[static_cast<std::size_t>(walk.mesh[s])].object_id;
+    hold.triangle[h] = walk.triangle[s];
+  }
+  return hold;
+}
+
 int walk_mesh_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& finger_m,
-                     std::span<bool> walked) {
+                     std::span<bool> walked, MeshHold* hold) {
   std::array<WalkedMesh, kMaxPlanes> meshes;
   std::array<std::uint32_t, kMaxPlanes> plane_of;  // meshes[m] is planes.planes[plane_of[m]]
   std::size_t count = 0;
@@ -180,12 +209,16 @@ int walk_mesh_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eig
     const MeshGeometry* mesh =
         plane.shape.kind == ShapeKind::mesh ? find_mesh_geometry(plane.shape.mesh_hash) : nullptr;
     if (mesh == nullptr) continue;
-    meshes[count] = {mesh, plane.com_m, plane.axes, plane.dynamic()};
+    meshes[count] = {mesh, plane.com_m, plane.axes, plane.dynamic(), plane.object_id};
     plane_of[count++] = k;
     walked[k] = true;
   }
-  if (count == 0) return 0;
-  const MeshWalk walk = walk_meshes(std::span<const WalkedMesh>(meshes.data(), count), proxy_m, finger_m);
+  if (count == 0) {
+    if (hold != nullptr) hold->count = 0;
+    return 0;
+  }
+  const MeshWalk walk = walk_meshes(std::span<const WalkedMesh>(meshes.data(), count), proxy_m, finger_m, hold);
+  if (hold != nullptr) *hold = held_by(walk, std::span<const WalkedMesh>(meshes.data(), count));
   for (std::size_t m = 0; m < count; ++m) {
     ContactPlane& plane = planes.planes[plane_of[m]];
     bool first = true;

@@ -171,7 +171,7 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
 
   // Planes that carry their shape taken again at the last proxy, or at the finger past a body the way to it does not
   // enter (shape_planes.h).
-  retake_shape_planes(planes_, to_eigen(result_.proxy_m), finger_m);
+  retake_shape_planes(planes_, to_eigen(result_.proxy_m), finger_m, &mesh_hold_);
   // Deformable surfaces yield by the push beyond yield the world has not yet dented them by, elastic ones by this
   // tick's push (local_yield.h).
   const double stiffness_Npm =

@@ -16,6 +16,7 @@
 #include "haptic_controller/impulse_accumulator.h"
 #include "haptic_controller/local_dynamics.h"
 #include "haptic_controller/local_yield.h"
+#include "haptic_controller/mesh_walk.h"
 #include "haptic_controller/plane_motion.h"
 
 #include <array>
@@ -133,6 +134,7 @@ class HapticServo {
   bool have_frame_ = false;
   double frame_arrival_s_ = 0.0;
   PlaneSet planes_{};
+  MeshHold mesh_hold_{};  // the triangles the meshes' walk held last tick (mesh_walk.h)
   GodObject god_object_;
   ForceRenderer renderer_;
   ImpulseAccumulator accumulator_;

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/shape_planes.h"
 
-#include "haptic_controller/mesh_walk.h"
 
 #include <array>
 
@@ -47,7 +46,8 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m) {
   for (std::uint32_t k = 0; k < planes.count; ++k) retake_plane(planes.planes[k], around_m);
 }
 
-void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& finger_m) {
+void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& finger_m,
+                         MeshHold* mesh_hold) {
   // About the proxy, as always. A retake moves only the plane, not the body, so the plane as it came is its point and
   // normal, kept here (uninitialised storage: nothing is built per tick).
   std::array<Eigen::Vector3d, kMaxServoPlanes> sent_point_m, sent_normal;
@@ -62,7 +62,7 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const
   // its plane about where the walk ended; if the walk met nothing, the straight way to the finger goes into no mesh.
   const std::uint32_t sent_count = planes.count;
   std::array<bool, kMaxServoPlanes> walked{};
-  const bool held_by_mesh = walk_mesh_planes(planes, proxy_m, finger_m, walked) > 0;
+  const bool held_by_mesh = walk_mesh_planes(planes, proxy_m, finger_m, walked, mesh_hold) > 0;
   bool finger_held = false;
   for (std::uint32_t k = 0; k < sent_count; ++k) {
     ContactPlane& plane = planes.planes[k];

@@ -15,6 +15,7 @@
 // Allocation-free.
 
 #include "haptic_controller/contact_plane.h"
+#include "haptic_controller/mesh_walk.h"
 
 #include <Eigen/Core>
 
@@ -29,7 +30,9 @@ void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& around_m);
 // the body's plane is taken about the finger instead: its supporting plane at the point nearest the finger, with the
 // body behind it and the finger in front. Taken about the proxy, the plane past an edge or a rim is the edge's
 // tangent plane there; a finger that has left the body over the edge can still be behind it, and the proxy slides
-// along it, off the body, holding the finger for a few more ticks.
-void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& finger_m);
+// along it, off the body, holding the finger for a few more ticks. `mesh_hold`, kept by the caller from tick to
+// tick, lets the meshes' walk start from the triangles it held last (mesh_walk.h).
+void retake_shape_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eigen::Vector3d& finger_m,
+                         MeshHold* mesh_hold = nullptr);
 
 }  // namespace impetus

@@ -39,6 +39,10 @@ class MeshBody final : public MeshGeometry {
                    int skip_count, MeshEntry& out) const override {
     return bvh_.first_entry(a, b, tolerance_m, skip, skip_count, out);
   }
+  bool on_triangle(std::uint32_t triangle, const Eigen::Vector3d& x, double tolerance_m,
+                   MeshEntry& out) const override {
+    return bvh_.on_triangle(triangle, x, tolerance_m, out);
+  }
   Eigen::Vector3d bounds_half(const Eigen::Matrix3d& rotation) const override;
   double volume_m3() const override { return volume_m3_; }
   Eigen::Matrix3d inertia_per_kg() const override { return inertia_per_kg_; }

@@ -264,6 +264,41 @@ double segment_meets_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d
   return inverse * e2.dot(k);
 }
 
+// A way a + t·d, t in [0, 1], ready to be clipped to many boxes by the slab method: 1/d_i is taken once.
+class SegmentSlabs {
+ public:
+  SegmentSlabs(const Eigen::Vector3d& a, const Eigen::Vector3d& d) : a_(a) {
+    for (int i = 0; i < 3; ++i) {
+      along_[i] = d[i] != 0.0;
+      inverse_[i] = along_[i] ? 1.0 / d[i] : 0.0;
+    }
+  }
+  // Whether some t in [0, t_max] puts the way in `box` grown by `margin_m` on every side; `t_enter` is the least.
+  bool enters(const Eigen::AlignedBox3d& box, double margin_m, double t_max, double& t_enter) const {
+    double t0 = 0.0, t1 = t_max;
+    for (int i = 0; i < 3; ++i) {
+      const double low = box.min()[i] - margin_m, high = box.max()[i] + margin_m;
+      if (!along_[i]) {
+        if (a_[i] < low || a_[i] > high) return false;
+        continue;
+      }
+      double near = (low - a_[i]) * inverse_[i];
+      double far = (high - a_[i]) * inverse_[i];
+      if (near > far) std::swap(near, far);
+      t0 = std::max(t0, near);
+      t1 = std::min(t1, far);
+      if (t0 > t1) return false;
+    }
+    t_enter = t0;
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d a_;
+  Eigen::Vector3d inverse_;
+  std::array<bool, 3> along_{};
+};
+
 }  // namespace
 
 bool MeshBvh::segment_crosses(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double t_min) const {
@@ -295,21 +330,42 @@ bool MeshBvh::first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, do
                           const std::uint32_t* skip, int skip_count, MeshEntry& out) const {
   if (nodes_.empty()) return false;
   const Eigen::Vector3d d = b - a;
+  const SegmentSlabs way(a, d);
+  // Nearest box first, and a box the way enters later than the best crossing so far is skipped with all it holds: a
+  // crossing lies within tolerance_m of its triangle, so within that much of every box holding it, and is entered no
+  // earlier than that box. Ties go to the lower leaf position (the order a plain depth-first walk meets them in), so
+  // the answer does not depend on the order the boxes are taken in.
   double best_t = std::numeric_limits<double>::infinity();
-  std::array<std::uint32_t, kMaxDepth + 1> stack{};
+  std::uint32_t best_position = 0;
+  struct Pending {
+    std::uint32_t node;
+    double t_enter;
+  };
+  std::array<Pending, kMaxDepth + 1> stack;
   std::size_t top = 0;
-  stack[top++] = 0;
+  double t_root = 0.0;
+  if (!way.enters(nodes_.front().bounds, tolerance_m, 1.0, t_root)) return false;
+  stack[top++] = {0, t_root};
   while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    // A crossing lies within tolerance_m of its triangle, so within that much of every box holding it.
-    Eigen::AlignedBox3d bounds = node.bounds;
-    bounds.min().array() -= tolerance_m;
-    bounds.max().array() += tolerance_m;
-    if (!segment_meets_box(bounds, a, d)) continue;
+    const Pending pending = stack[--top];
+    if (pending.t_enter > best_t) continue;
+    const Node& node = nodes_[pending.node];
+    const double t_max = std::min(1.0, best_t);
     if (node.count == 0) {
-      const std::uint32_t self = static_cast<std::uint32_t>(&node - nodes_.data());
-      stack[top++] = node.first;  // right
-      stack[top++] = self + 1;    // left
+      const std::uint32_t left = pending.node + 1, right = node.first;
+      double t_left = 0.0, t_right = 0.0;
+      const bool in_left = way.enters(nodes_[left].bounds, tolerance_m, t_max, t_left);
+      const bool in_right = way.enters(nodes_[right].bounds, tolerance_m, t_max, t_right);
+      // Pushed later first, so the earlier is taken next. The depth is below kMaxDepth by construction.
+      if (in_left && in_right) {
+        const bool left_first = t_left <= t_right;
+        stack[top++] = left_first ? Pending{right, t_right} : Pending{left, t_left};
+        stack[top++] = left_first ? Pending{left, t_left} : Pending{right, t_right};
+      } else if (in_left) {
+        stack[top++] = {left, t_left};
+      } else if (in_right) {
+        stack[top++] = {right, t_right};
+      }
       continue;
     }
     for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
@@ -323,18 +379,11 @@ bool MeshBvh::first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, do
       if (height_a_m < -tolerance_m || height_b_m >= -tolerance_m) continue;  // not from in front to behind
       // Where the way meets the plane; a start on it to rounding (slightly behind) meets it at once.
       const double t = height_a_m > 0.0 ? height_a_m / (height_a_m - height_b_m) : 0.0;
-      if (t >= best_t) continue;
+      if (t > best_t || (t == best_t && i > best_position)) continue;
       const Eigen::Vector3d x = a + t * d;
-      // Within the triangle: on the inner side of each edge, or less than tolerance_m outside it. (e × (x − v))·n
-      // is the edge's length times x's distance inside it.
-      bool within = true;
-      for (int k = 0; k < 3 && within; ++k) {
-        const Eigen::Vector3d& from = mesh_.vertices_m[tri[k]];
-        const Eigen::Vector3d edge = mesh_.vertices_m[tri[(k + 1) % 3]] - from;
-        within = edge.cross(x - from).dot(n) >= -tolerance_m * edge.norm();
-      }
-      if (!within) continue;
+      if (!within_edges(triangle, x, tolerance_m)) continue;
       best_t = t;
+      best_position = i;
       out.point_m = x;
       out.normal = n;
       out.t = t;
@@ -342,6 +391,32 @@ bool MeshBvh::first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, do
     }
   }
   return best_t <= 1.0;
+}
+
+bool MeshBvh::within_edges(std::uint32_t triangle, const Eigen::Vector3d& x, double tolerance_m) const {
+  // On the inner side of each edge, or less than tolerance_m outside it: (e × (x − v))·n is the edge's length times
+  // x's distance inside it.
+  const auto& tri = mesh_.triangles[triangle];
+  const Eigen::Vector3d& n = face_normals_[triangle];
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d& from = mesh_.vertices_m[tri[k]];
+    const Eigen::Vector3d edge = mesh_.vertices_m[tri[(k + 1) % 3]] - from;
+    if (edge.cross(x - from).dot(n) < -tolerance_m * edge.norm()) return false;
+  }
+  return true;
+}
+
+bool MeshBvh::on_triangle(std::uint32_t triangle, const Eigen::Vector3d& x, double tolerance_m,
+                          MeshEntry& out) const {
+  if (triangle >= mesh_.triangles.size()) return false;
+  const Eigen::Vector3d& n = face_normals_[triangle];
+  const double height_m = n.dot(x - mesh_.vertices_m[mesh_.triangles[triangle][0]]);
+  if (std::abs(height_m) > tolerance_m || !within_edges(triangle, x, tolerance_m)) return false;
+  out.point_m = x - height_m * n;
+  out.normal = n;
+  out.t = 0.0;
+  out.triangle = triangle;
+  return true;
 }
 
 std::size_t MeshBvh::memory_bytes() const {

@@ -56,6 +56,11 @@ class MeshBvh {
   bool first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double tolerance_m,
                    const std::uint32_t* skip, int skip_count, MeshEntry& out) const;
 
+  // Whether `x` lies on triangle `triangle`: within `tolerance_m` of its plane, and inside its edges or less than
+  // `tolerance_m` outside one (first_entry's test for where a way crosses). `out` is then the foot of `x` on the
+  // plane, with the triangle's normal and t = 0. False for an index out of range.
+  bool on_triangle(std::uint32_t triangle, const Eigen::Vector3d& x, double tolerance_m, MeshEntry& out) const;
+
   const TriangleMesh& mesh() const { return mesh_; }
   const Eigen::AlignedBox3d& bounds() const { return nodes_.front().bounds; }
   std::size_t node_count() const { return nodes_.size(); }
@@ -76,6 +81,7 @@ class MeshBvh {
               std::uint32_t best_triangle, std::uint8_t best_feature, MeshPoint& out) const;
   std::uint32_t build(std::uint32_t begin, std::uint32_t end, std::vector<Eigen::Vector3d>& centroids, int depth);
   void pseudo_normals();
+  bool within_edges(std::uint32_t triangle, const Eigen::Vector3d& x, double tolerance_m) const;
 
   TriangleMesh mesh_;
   std::vector<Node> nodes_;

@@ -45,6 +45,10 @@ class MeshGeometry {
   // god-object's walk over the triangles asks (haptic_controller/mesh_walk.h).
   virtual bool first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double tolerance_m,
                            const std::uint32_t* skip, int skip_count, MeshEntry& out) const = 0;
+  // Whether `x` lies on triangle `triangle` (an index first_entry gave): within `tolerance_m` of its plane and of its
+  // edges. `out` is then the foot of `x` on its plane, with its normal. False for an unknown index.
+  virtual bool on_triangle(std::uint32_t triangle, const Eigen::Vector3d& x, double tolerance_m,
+                           MeshEntry& out) const = 0;
   // Half extents of the smallest world-aligned box centred on the origin that holds the mesh turned by `rotation`:
   // max over the vertices of |(rotation·x)_i| (shape.h's bounds are centred on the body's origin).
   virtual Eigen::Vector3d bounds_half(const Eigen::Matrix3d& rotation) const = 0;

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-// The haptic servo's tick with one body in reach whose plane it takes again at the proxy every tick (docs/meshes.md):
-// a ball of 5 cm radius as the primitive sphere and as icosphere meshes of 1 280 to 1.3 million triangles, and the
-// primitive box beside them. The finger presses 3 mm in and slides around the ball's top (a circle of 2 cm radius,
-// 6 cm/s); the world's plane is renewed every 50 ticks (20 Hz) at the proxy's nearest point. Times the servo's tick
-// alone (planes, god-object, force, accumulation; no device): p50, p99 and max in ns, over 20 000 ticks per body.
-// Also each mesh's load and build time. Prints only; asserts nothing.
+// The haptic servo's tick with one body in reach (docs/meshes.md): a ball of 5 cm radius as the primitive sphere and as
+// icosphere meshes of 1 280 to 1.3 million triangles, whose triangles the proxy walks (haptic_controller/mesh_walk.h),
+// and the primitive box beside them. The finger presses 3 mm in and slides around the ball's top (a circle of 2 cm
+// radius, 6 cm/s); the world's plane is renewed every 50 ticks (20 Hz) at the proxy's nearest point. Times the servo's
+// tick alone (planes, god-object, force, accumulation; no device): p50, p99 and max in ns, over 20 000 ticks a body.
+// Also each mesh's load and build time. Prints only; asserts nothing. --help for the options.
 
 #include "common/mesh/mesh_body.h"
 #include "haptic_controller/servo.h"
@@ -22,7 +22,7 @@ using namespace impetus;
 
 namespace {
 
-constexpr int kTicks = 20000;
+int g_ticks = 20000;  // --ticks
 constexpr int kTicksPerWorldStep = 50;
 constexpr double kRadius_m = 0.05;
 const Eigen::Vector3d kCentre_m(0.0, 0.0, 0.0);
@@ -63,10 +63,11 @@ PlaneFrame frame_for(const Shape& shape, const Eigen::Vector3d& proxy_m, std::ui
 
 void run(const std::string& name, const Shape& shape) {
   HapticServo servo(ServoOptions{}, 1);
-  std::vector<double> ns(kTicks);
+  std::vector<double> ns;  // after the approach's 200 ticks
+  ns.reserve(static_cast<std::size_t>(g_ticks));
   int contact_ticks = 0;
   Eigen::Vector3d proxy_m = finger_at(0);
-  for (int tick = 0; tick < kTicks; ++tick) {
+  for (int tick = 0; tick < g_ticks; ++tick) {
     const double now_s = tick * 1e-3;
     if (tick % kTicksPerWorldStep == 0) servo.on_plane_frame(frame_for(shape, proxy_m, tick / 50), now_s);
     FingerSample finger;
@@ -75,20 +76,35 @@ void run(const std::string& name, const Shape& shape) {
     const auto start = std::chrono::steady_clock::now();
     const TickResult& result = servo.tick(&finger, now_s, 1e-3);
     const auto stop = std::chrono::steady_clock::now();
-    ns[tick] = std::chrono::duration<double, std::nano>(stop - start).count();
+    if (tick >= 200) ns.push_back(std::chrono::duration<double, std::nano>(stop - start).count());
     proxy_m = to_eigen(result.proxy_m);
     contact_ticks += result.active_planes > 0 ? 1 : 0;
   }
-  ns.erase(ns.begin(), ns.begin() + 200);  // the approach
   std::sort(ns.begin(), ns.end());
   const std::size_t n = ns.size();
   std::printf("%-34s tick p50 %7.0f ns  p99 %7.0f ns  max %8.0f ns  (contact ticks %.0f%%)\n", name.c_str(),
-              ns[n / 2], ns[n * 99 / 100], ns.back(), 100.0 * contact_ticks / kTicks);
+              ns[n / 2], ns[n * 99 / 100], ns.back(), 100.0 * contact_ticks / g_ticks);
 }
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  std::vector<int> sizes = {3, 5, 6, 8};  // icosphere subdivisions: 1 280, 20 480, 81 920, 1 310 720 triangles
+  for (int k = 1; k < argc; ++k) {
+    const std::string arg = argv[k];
+    if (arg == "--ticks" && k + 1 < argc && std::atoi(argv[k + 1]) > 400) {
+      g_ticks = std::atoi(argv[++k]);
+    } else if (arg == "--subdivisions" && k + 1 < argc && std::atoi(argv[k + 1]) >= 0 && std::atoi(argv[k + 1]) <= 8) {
+      sizes = {std::atoi(argv[++k])};
+    } else {
+      std::FILE* to = arg == "--help" || arg == "-h" ? stdout : stderr;
+      std::fprintf(to,
+                   "usage: bench_mesh_tick [--ticks N] [--subdivisions S]\n"
+                   "  --ticks N         ticks a body, more than 400 (the first 200 press in; default 20000)\n"
+                   "  --subdivisions S  only the icosphere of 20*4^S triangles, S in 0..8 (default: S = 3, 5, 6, 8)\n");
+      return arg == "--help" || arg == "-h" ? 0 : 2;
+    }
+  }
   Shape box;
   box.kind = ShapeKind::box;
   box.box_size_m = {2 * kRadius_m, 2 * kRadius_m, 2 * kRadius_m};
@@ -99,7 +115,7 @@ int main() {
   run("primitive sphere", sphere);
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "impetus-bench-mesh-tick";
   std::filesystem::create_directories(dir);
-  for (const int subdivisions : {3, 5, 6, 8}) {
+  for (const int subdivisions : sizes) {
     const TriangleMesh mesh = test::icosphere(kRadius_m, subdivisions);
     const std::string file = (dir / ("ball" + std::to_string(subdivisions) + ".stl")).string();
     test::write_stl_binary(mesh, file);

@@ -36,12 +36,17 @@ class TreeGeometry final : public MeshGeometry {
   bool segment_enters(const Vector3d&, const Vector3d&, double) const override { return false; }
   bool first_entry(const Vector3d& a, const Vector3d& b, double tolerance_m, const std::uint32_t* skip,
                    int skip_count, MeshEntry& out) const override {
+    ++segment_queries;
     return tree_.first_entry(a, b, tolerance_m, skip, skip_count, out);
+  }
+  bool on_triangle(std::uint32_t triangle, const Vector3d& x, double tolerance_m, MeshEntry& out) const override {
+    return tree_.on_triangle(triangle, x, tolerance_m, out);
   }
   Vector3d bounds_half(const Eigen::Matrix3d&) const override { return Vector3d::Zero(); }
   double volume_m3() const override { return 0.0; }
   Eigen::Matrix3d inertia_per_kg() const override { return Eigen::Matrix3d::Zero(); }
   const TriangleMesh& mesh() const { return tree_.mesh(); }
+  mutable long segment_queries = 0;  // first_entry calls
 
   // The least height of `x` over every triangle's plane whose triangle its foot point lies on (brute force): < 0 is
   // behind the surface there.
@@ -91,10 +96,15 @@ TriangleMesh inside_corner(double side_m, int n) {
   return mesh;
 }
 
-// The walk over one mesh placed at the world's origin, unturned.
-MeshWalk walk_mesh(const MeshGeometry& mesh, const Vector3d& proxy_m, const Vector3d& finger_m) {
-  const WalkedMesh placed{&mesh, Vector3d::Zero(), Eigen::Matrix3d::Identity(), true};
-  return walk_meshes(std::span<const WalkedMesh>(&placed, 1), proxy_m, finger_m);
+// The walk over one mesh placed at the world's origin, unturned. With `hold`, started from what it holds, as the servo
+// does, and leaving there what this walk held; every tick-by-tick case runs both ways and must give the same answer.
+MeshWalk walk_mesh(const MeshGeometry& mesh, const Vector3d& proxy_m, const Vector3d& finger_m,
+                   MeshHold* hold = nullptr) {
+  const WalkedMesh placed{&mesh, Vector3d::Zero(), Eigen::Matrix3d::Identity(), true, 0};
+  const std::span<const WalkedMesh> meshes(&placed, 1);
+  const MeshWalk walk = walk_meshes(meshes, proxy_m, finger_m, hold);
+  if (hold != nullptr) *hold = held_by(walk, meshes);
+  return walk;
 }
 
 // The walk's planes as the god-object gets them, and its projection of the finger onto them.
@@ -111,6 +121,8 @@ Vector3d projected_on_walk(const MeshWalk& walk, const Vector3d& finger_m) {
 }  // namespace
 
 TEST_CASE("mesh walk: dragged into the inside corner of three faces, the proxy is the finger clamped to the octant") {
+  MeshHold hold;
+  MeshHold* const started_from_last = GENERATE(false, true) ? &hold : nullptr;
   const TreeGeometry corner(inside_corner(0.05, 10), false);
   // The finger comes in from the open side and is dragged along each crease and into the corner, 0.5–3 mm a tick,
   // up to 8 mm behind the faces; the proxy follows from tick to tick.
@@ -125,7 +137,7 @@ TEST_CASE("mesh walk: dragged into the inside corner of three faces, the proxy i
     const int steps = static_cast<int>(std::ceil((to - from).norm() / 0.0017));
     for (int s = 1; s <= steps; ++s) {
       const Vector3d finger = from + (to - from) * (static_cast<double>(s) / steps);
-      const MeshWalk walk = walk_mesh(corner, proxy, finger);
+      const MeshWalk walk = walk_mesh(corner, proxy, finger, started_from_last);
       proxy = walk.proxy_m;
       worst_m = std::max(worst_m, (proxy - finger.cwiseMax(0.0)).norm());
       // The god-object, given the walk's planes, puts the proxy where the walk did.
@@ -142,6 +154,8 @@ TEST_CASE("mesh walk: dragged into the inside corner of three faces, the proxy i
 }
 
 TEST_CASE("mesh walk: pressed 3 mm out of a spherical cavity and slid round it, the proxy stays on its surface") {
+  MeshHold hold;
+  MeshHold* const started_from_last = GENERATE(false, true) ? &hold : nullptr;
   // The inside of a ball of 5 cm radius: an icosphere of 1280 triangles wound inward, a closed cavity whose free space
   // is the polyhedron they bound. The finger circles 3 mm beyond the sphere at 0.1 m/s, crossing many triangles.
   TriangleMesh cavity = test::icosphere(0.05, 3);
@@ -153,7 +167,7 @@ TEST_CASE("mesh walk: pressed 3 mm out of a spherical cavity and slid round it, 
     const double angle = 2.0 * tick * 1e-3;  // 0.1 m/s at 5 cm
     const Vector3d direction = Vector3d(std::cos(angle), std::sin(angle), 0.3 * std::sin(3 * angle)).normalized();
     const Vector3d finger = 0.053 * direction;
-    const MeshWalk walk = walk_mesh(geometry, proxy, finger);
+    const MeshWalk walk = walk_mesh(geometry, proxy, finger, started_from_last);
     proxy = walk.proxy_m;
     deepest_m = std::min(deepest_m, geometry.worst_height_m(proxy));
     // Pressed from the first tick on: on the surface, its distance to the nearest triangle nil.
@@ -166,12 +180,36 @@ TEST_CASE("mesh walk: pressed 3 mm out of a spherical cavity and slid round it, 
   CHECK(worst_solver_m < 1e-12);
 }
 
+TEST_CASE("mesh walk: started from the triangles it held, the walk asks the tree less and ends where it did") {
+  // The cavity of the case above, the finger circling 3 mm beyond it: walked from scratch each tick, and started from
+  // the last tick's triangles.
+  TriangleMesh cavity = test::icosphere(0.05, 3);
+  for (auto& tri : cavity.triangles) std::swap(tri[1], tri[2]);
+  const TreeGeometry scratch(cavity, true), started(std::move(cavity), true);
+  Vector3d proxy_scratch = Vector3d::Zero(), proxy_started = Vector3d::Zero();
+  MeshHold hold;
+  double apart_m = 0.0;
+  for (int tick = 0; tick < 3000; ++tick) {
+    const double angle = 2.0 * tick * 1e-3;
+    const Vector3d finger = 0.053 * Vector3d(std::cos(angle), std::sin(angle), 0.3 * std::sin(3 * angle)).normalized();
+    proxy_scratch = walk_mesh(scratch, proxy_scratch, finger).proxy_m;
+    proxy_started = walk_mesh(started, proxy_started, finger, &hold).proxy_m;
+    apart_m = std::max(apart_m, (proxy_scratch - proxy_started).norm());
+  }
+  INFO("segment queries: " << scratch.segment_queries << " from scratch, " << started.segment_queries << " started");
+  CHECK(apart_m < 1e-12);
+  // Pressed on a face nearly every tick, the started walk skips the first query nearly every tick.
+  CHECK(started.segment_queries < scratch.segment_queries - 2500);
+}
+
 TEST_CASE("mesh walk: a 1 mm slab crossed at 3 m/s holds the proxy on its top face every tick") {
+  MeshHold hold;
+  MeshHold* const started_from_last = GENERATE(false, true) ? &hold : nullptr;
   const TreeGeometry slab(test::box_mesh(Vector3d(0.1, 0.1, 0.001)), true);
   Vector3d proxy(0.01, 0.0, 0.005);
   for (int tick = 1; tick <= 6; ++tick) {
     const Vector3d finger(0.01 + 0.001 * tick, 0.0, 0.005 - 0.003 * tick);  // 3 mm a tick downward
-    const MeshWalk walk = walk_mesh(slab, proxy, finger);
+    const MeshWalk walk = walk_mesh(slab, proxy, finger, started_from_last);
     proxy = walk.proxy_m;
     if (finger.z() < 0.0005) {
       CHECK(walk.count == 1);
@@ -182,12 +220,14 @@ TEST_CASE("mesh walk: a 1 mm slab crossed at 3 m/s holds the proxy on its top fa
 }
 
 TEST_CASE("mesh walk: a finger that slides off a box's edge is let go within a tick of leaving the box") {
+  MeshHold hold;
+  MeshHold* const started_from_last = GENERATE(false, true) ? &hold : nullptr;
   const TreeGeometry box(test::box_mesh(Vector3d(0.04, 0.04, 0.04)), true);  // top face z = 0.02, side x = 0.02
   Vector3d proxy(0.0, 0.0, 0.03);
   int held_outside = 0;
   for (int tick = 0; tick < 40; ++tick) {
     const Vector3d finger(0.015 + 0.0005 * tick, 0.0, 0.017);  // 3 mm into the top face, sliding out past x = 0.02
-    const MeshWalk walk = walk_mesh(box, proxy, finger);
+    const MeshWalk walk = walk_mesh(box, proxy, finger, started_from_last);
     proxy = walk.proxy_m;
     if (finger.x() > 0.02) {
       if (walk.count > 0) ++held_outside;
@@ -225,8 +265,8 @@ TEST_CASE("mesh walk: two bodies, turned and apart: held in the crease where the
   const TreeGeometry wall(test::box_mesh(Vector3d(0.06, 0.1, 0.02)), true);  // 6 cm tall once turned
   const Eigen::Matrix3d quarter = Eigen::AngleAxisd(0.5 * 3.14159265358979323846, Vector3d::UnitY()).toRotationMatrix();
   const Eigen::Matrix3d unturned = Eigen::Matrix3d::Identity();
-  const std::array<WalkedMesh, 2> bodies{WalkedMesh{&slab, Vector3d(0.0, 0.0, -0.01), unturned, false},
-                                         WalkedMesh{&wall, Vector3d(-0.01, 0.0, 0.03), quarter, false}};
+  const std::array<WalkedMesh, 2> bodies{WalkedMesh{&slab, Vector3d(0.0, 0.0, -0.01), unturned, false, 0},
+                                         WalkedMesh{&wall, Vector3d(-0.01, 0.0, 0.03), quarter, false, 1}};
   Vector3d proxy(0.02, 0.0, 0.02);
   double worst_m = 0.0;
   int both = 0;
@@ -242,8 +282,8 @@ TEST_CASE("mesh walk: two bodies, turned and apart: held in the crease where the
   CHECK(both > 5);  // a triangle of each body held the proxy at once
 
   // A finger gone through the slab and on into a second one below: held by the top of the first, never the second.
-  const std::array<WalkedMesh, 2> stacked{WalkedMesh{&slab, Vector3d(0.0, 0.0, -0.01), unturned, false},
-                                          WalkedMesh{&slab, Vector3d(0.0, 0.0, -0.05), unturned, false}};
+  const std::array<WalkedMesh, 2> stacked{WalkedMesh{&slab, Vector3d(0.0, 0.0, -0.01), unturned, false, 0},
+                                          WalkedMesh{&slab, Vector3d(0.0, 0.0, -0.05), unturned, false, 1}};
   const MeshWalk deep = walk_meshes(stacked, Vector3d(0.0, 0.0, 0.001), Vector3d(0.003, 0.0, -0.05));
   REQUIRE(deep.count == 1);
   CHECK(deep.mesh[0] == 0);
@@ -255,10 +295,11 @@ TEST_CASE("mesh walk: a walk allocates nothing") {
   const TreeGeometry corner(inside_corner(0.05, 10), false);
   Vector3d proxy(0.02, 0.02, 0.02);
   int held = 0;
+  MeshHold hold;
   impetus::test::start_counting_allocations();
   for (int tick = 0; tick < 2000; ++tick) {
     const Vector3d finger(0.02 * std::cos(tick * 0.01), 0.02 * std::sin(tick * 0.013), 0.01 * std::sin(tick * 0.007));
-    const MeshWalk walk = walk_mesh(corner, proxy, finger);
+    const MeshWalk walk = walk_mesh(corner, proxy, finger, &hold);
     proxy = walk.proxy_m;
     held += walk.count;
   }
