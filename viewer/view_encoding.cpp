@@ -4,6 +4,7 @@
 #include "common/mesh/mesh_body.h"
 #include "common/shape/mesh_geometry.h"
 #include "common/shape/shape.h"
+#include "viewer/mesh_coarsening.h"
 #include "viewer/view_protocol.h"
 
 #include <nlohmann/json.hpp>
@@ -39,16 +40,13 @@ class Packer {
 };
 
 // A mesh body's form for the page (view_protocol.h §1 "mesh"): its triangles when this process loaded the file (the
-// registry has its hash) and they are few enough to send, else why the page draws its bound instead.
+// registry has its hash), coarsened if they are too many to send; else why the page draws its bound instead.
 nlohmann::json mesh_form(const Shape& shape) {
   const auto* body = dynamic_cast<const MeshBody*>(find_mesh_geometry(shape.mesh_hash));
   if (body == nullptr) return {{"drawn", "bound"}, {"why", "its file was not loaded (viewer --meshes-from SCENE)"}};
-  const TriangleMesh& mesh = body->bvh().mesh();
-  if (mesh.triangles.size() > kMaxViewMeshTriangles) {
-    return {{"drawn", "bound"},
-            {"why", std::to_string(mesh.triangles.size()) + " triangles, more than the " +
-                        std::to_string(kMaxViewMeshTriangles) + " a page is sent"}};
-  }
+  // A finer mesh than a page is sent is sent coarsened to fit (mesh_coarsening.h).
+  const CoarseMesh coarse = coarsened(body->bvh().mesh(), kMaxViewMeshTriangles);
+  const TriangleMesh& mesh = coarse.mesh;
   // Micrometres are finer than a pixel of any view of a desk-sized scene, and keep the numbers short.
   constexpr double kVertexResolution_m = 1e-6;
   std::vector<double> vertices;
@@ -59,7 +57,13 @@ nlohmann::json mesh_form(const Shape& shape) {
   std::vector<std::uint32_t> triangles;
   triangles.reserve(3 * mesh.triangles.size());
   for (const auto& t : mesh.triangles) triangles.insert(triangles.end(), t.begin(), t.end());
-  return {{"drawn", "triangles"}, {"vertices_m", std::move(vertices)}, {"triangles", std::move(triangles)}};
+  nlohmann::json form = {
+      {"drawn", "triangles"}, {"vertices_m", std::move(vertices)}, {"triangles", std::move(triangles)}};
+  if (coarse.cell_m > 0.0) {
+    form["coarsened_from"] = body->bvh().mesh().triangles.size();
+    form["cell_m"] = coarse.cell_m;
+  }
+  return form;
 }
 
 }  // namespace

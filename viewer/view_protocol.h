@@ -13,7 +13,8 @@
 //       a mesh body also has "mesh_hash": "<16 hex digits>" and "mesh": either
 //         {"drawn": "triangles", "vertices_m": [x0, y0, z0, x1, ...], "triangles": [a0, b0, c0, a1, ...]}
 //       (body frame, m, to the micrometre; vertex indices, counter-clockwise seen from outside), when the viewer read
-//       its file (--meshes-from, or a replay's scene) and it has at most kMaxViewMeshTriangles, or
+//       its file (--meshes-from, or a replay's scene); a mesh of more than kMaxViewMeshTriangles is sent coarsened
+//       to at most that many (viewer/mesh_coarsening.h), with "coarsened_from": its own count and "cell_m", or
 //         {"drawn": "bound", "why": "..."}: the page draws a ball of radius_m about its centre instead.
 //       "replay": {"start_s": t0, "end_s": t1, "frame_count": n}}          (replay only)
 //    Body k of every frame below is bodies[k]. A shape's axis of symmetry is its body z.
@@ -63,7 +64,7 @@ inline constexpr std::size_t kPlaneValues = 6;
 inline constexpr std::size_t kDentValues = 8;
 inline constexpr std::size_t kMaxClientMessageBytes = 4096;
 // A mesh of 10^5 triangles is a scene message of about 3 MB, sent to each page as it connects; a finer one (a terrain)
-// is drawn as its bound rather than hold up a page for seconds.
+// is coarsened to that many rather than hold up a page for seconds.
 inline constexpr std::size_t kMaxViewMeshTriangles = 100'000;
 inline constexpr double kMinReplaySpeed = 0.1;
 inline constexpr double kMaxReplaySpeed = 10.0;

@@ -4,6 +4,7 @@
 #include "common/contract/limits.h"
 #include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
+#include "common/mesh/mesh_body.h"
 #include "common/mesh/mesh_object.h"
 #include "world_manager/deform/deformable_surface.h"
 #include "world_manager/engine/engine_registry.h"
@@ -234,6 +235,27 @@ DeformableMaterial parse_deformable(const Node& node, const SceneObject& object)
   return material;
 }
 
+// A mesh's "surface": "facets" (its triangles, as they are; the default) or "smooth" (the surface they stand for, where
+// it touches the floor: common/mesh/smooth_surface.h). Only a moving body's contacts use it, and only a mesh without
+// edges is a smooth body's tessellation.
+bool parse_smooth_surface(const Node& node, const SceneObject& object) {
+  const std::string value = node.string();
+  if (value == "facets") return false;
+  if (value != "smooth") node.fail("must be \"facets\" or \"smooth\", not \"" + value + "\"");
+  if (!object.dynamic) node.fail("only a dynamic mesh can be smooth (its contacts with the floor use the surface)");
+  const auto* body = dynamic_cast<const MeshBody*>(find_mesh_geometry(object.shape.mesh_hash));
+  if (body == nullptr) node.fail("its mesh was not loaded");
+  const SmoothSurface& surface = body->smooth_surface();
+  if (surface.largest_crease_rad() > SmoothSurface::kMaxCrease_rad) {
+    constexpr double kDegrees = 180.0 / 3.14159265358979323846;
+    node.fail("the mesh bends by " + readable(surface.largest_crease_rad() * kDegrees) + " degrees at an edge of " +
+              "triangle " + std::to_string(surface.largest_crease_triangle()) + ", more than a smooth surface's " +
+              readable(SmoothSurface::kMaxCrease_rad * kDegrees) + " from one triangle to the next: it has edges, " +
+              "so leave it \"facets\"");
+  }
+  return true;
+}
+
 SceneObject parse_object(const Node& node, const std::string& scene_dir) {
   node.expect_object();
   SceneObject object;
@@ -244,6 +266,9 @@ SceneObject parse_object(const Node& node, const std::string& scene_dir) {
   object.dynamic = node.required("dynamic").boolean();
   // A mesh's triangles come from a file beside the scene (the shape module cannot read files).
   object.shape = kind == ShapeKind::mesh ? load_mesh_shape(node, scene_dir, object.dynamic) : parse_shape(node, kind);
+  if (kind == ShapeKind::mesh && node.has("surface")) {
+    object.smooth_surface = parse_smooth_surface(node.child("surface"), object);
+  }
 
   if (object.dynamic) {
     const bool has_mass = node.has("mass_kg");

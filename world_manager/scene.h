@@ -83,6 +83,9 @@ struct SceneObject {
   Vec3 linear_velocity_mps{};
   Vec3 angular_velocity_radps{};  // world frame
   Material material;
+  // A dynamic mesh that touches the floor with the smooth surface its triangles stand for ("surface": "smooth"):
+  // common/mesh/smooth_surface.h.
+  bool smooth_surface = false;
   // A static box whose top face yields where it is pressed (world_manager/deform/deformable_surface.h); the scene's
   // "deformable" block.
   std::optional<DeformableMaterial> deformable;

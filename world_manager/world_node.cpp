@@ -94,6 +94,16 @@ std::vector<std::string> WorldNode::warnings() const {
       out.emplace_back(text);
     }
   }
+  if (scene_.physics.engine != "ode") {
+    for (const SceneObject& object : scene_.objects) {
+      if (!object.smooth_surface) continue;
+      std::snprintf(text, sizeof text,
+                    "'%s' has a smooth surface, but the %s engine collides its triangles (only ode touches the floor "
+                    "with the smooth surface): it rolls as a polygon does",
+                    object.name.c_str(), scene_.physics.engine.c_str());
+      out.emplace_back(text);
+    }
+  }
   const std::size_t floor_id = scene_.objects.size();
   for (const RigidBodyEngine::Overlap& overlap : world_.start_overlaps()) {
     const std::string other = overlap.b == floor_id ? "the floor" : "'" + scene_.objects[overlap.b].name + "'";

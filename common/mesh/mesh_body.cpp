@@ -104,4 +104,9 @@ Eigen::Vector3d MeshBody::bounds_half(const Eigen::Matrix3d& rotation) const {
   return half;
 }
 
+const SmoothSurface& MeshBody::smooth_surface() const {
+  std::call_once(smooth_built_, [this] { smooth_ = std::make_unique<SmoothSurface>(bvh_.mesh()); });
+  return *smooth_;
+}
+
 }  // namespace impetus

@@ -8,11 +8,14 @@
 // A MeshBody is immutable and lives until the process ends (the registry hands out plain pointers to it).
 
 #include "common/mesh/mesh_bvh.h"
+#include "common/mesh/smooth_surface.h"
 #include "common/shape/mesh_geometry.h"
 
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <string>
 
 namespace impetus {
@@ -31,6 +34,8 @@ class MeshBody final : public MeshGeometry {
   bool closed() const override { return closed_; }
   bool winding_flipped() const { return flipped_; }
   const MeshBvh& bvh() const { return bvh_; }
+  // The smooth surface the triangles stand for (smooth_surface.h), built on the first call (any thread; O(n)).
+  const SmoothSurface& smooth_surface() const;
 
   SurfacePoint nearest(const Eigen::Vector3d& query_m) const override;
   double support(const Eigen::Vector3d& normal) const override;
@@ -57,6 +62,8 @@ class MeshBody final : public MeshGeometry {
   double volume_m3_ = 0.0;
   Eigen::Matrix3d inertia_per_kg_ = Eigen::Matrix3d::Zero();
   MeshBvh bvh_;
+  mutable std::once_flag smooth_built_;
+  mutable std::unique_ptr<SmoothSurface> smooth_;
 };
 
 }  // namespace impetus

@@ -102,28 +102,9 @@ std::uint32_t MeshBvh::build(std::uint32_t begin, std::uint32_t end, std::vector
 
 void MeshBvh::pseudo_normals() {
   const std::size_t n = mesh_.triangles.size();
-  face_normals_.resize(n);
+  face_normals_ = face_normals(mesh_);
   edge_normals_.assign(n, {});
-  vertex_normals_.assign(mesh_.vertices_m.size(), Eigen::Vector3d::Zero());
-  for (std::size_t t = 0; t < n; ++t) {
-    const auto& tri = mesh_.triangles[t];
-    const Eigen::Vector3d& a = mesh_.vertices_m[tri[0]];
-    const Eigen::Vector3d& b = mesh_.vertices_m[tri[1]];
-    const Eigen::Vector3d& c = mesh_.vertices_m[tri[2]];
-    const Eigen::Vector3d normal = (b - a).cross(c - a);
-    face_normals_[t] = normal.norm() > 0.0 ? Eigen::Vector3d(normal.normalized()) : Eigen::Vector3d::UnitZ();
-    // The angle-weighted vertex normal: each face adds its normal times its angle at the vertex.
-    const Eigen::Vector3d* corner[3] = {&a, &b, &c};
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d u = *corner[(k + 1) % 3] - *corner[k];
-      const Eigen::Vector3d w = *corner[(k + 2) % 3] - *corner[k];
-      const double angle = std::atan2(u.cross(w).norm(), u.dot(w));
-      vertex_normals_[tri[k]] += angle * face_normals_[t];
-    }
-  }
-  for (Eigen::Vector3d& normal : vertex_normals_) {
-    if (normal.norm() > 0.0) normal.normalize();
-  }
+  vertex_normals_ = angle_weighted_normals(mesh_, face_normals_);
   // An edge's pseudo-normal is the sum of its two faces' normals (one face's at an open edge): the edges are matched
   // by their sorted vertex pair.
   struct Use {

@@ -32,4 +32,11 @@ struct MeshLimits {
 // hash (as the SPIDAR geometry's, common/spidar/geometry.h).
 std::uint64_t mesh_hash(const TriangleMesh& mesh);
 
+// Each triangle's unit normal, (b − a) × (c − a) normalised (+z for a degenerate one, which check_mesh refuses).
+std::vector<Eigen::Vector3d> face_normals(const TriangleMesh& mesh);
+// Each vertex's angle-weighted normal (Thürmer and Wüthrich 1998): the sum of its triangles' normals, each times the
+// triangle's angle at the vertex, normalised. It does not depend on how the faces around it are cut into triangles.
+std::vector<Eigen::Vector3d> angle_weighted_normals(const TriangleMesh& mesh,
+                                                    const std::vector<Eigen::Vector3d>& face_normals);
+
 }  // namespace impetus

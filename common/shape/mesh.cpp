@@ -67,8 +67,9 @@ void retake(ShapePlane& plane, const Eigen::Vector3d& around_m) {
 // No two points of the mesh are farther apart than the diameter of the ball about its centre of mass that holds it.
 double plane_extent(const Shape& shape) { return 2.0 * shape.radius_m; }
 
-// Read from a scene by the world manager and the haptic controller, which load the file (common/mesh/mesh_object.h).
-constexpr std::string_view kKeys[] = {"file", "scale"};
+// Read from a scene by the world manager and the haptic controller, which load the file (common/mesh/mesh_object.h);
+// "surface" by the world manager alone (world_manager/scene.cpp).
+constexpr std::string_view kKeys[] = {"file", "scale", "surface"};
 
 }  // namespace
 

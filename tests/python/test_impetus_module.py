@@ -339,6 +339,16 @@ class Arguments(unittest.TestCase):
             warnings.simplefilter("always")
             impetus.run_trial(self.scene(), "tap", "local", logs=False)
         self.assertEqual([str(w.message) for w in caught], [])  # the shipped tap, local coupling: nothing to warn
+        # A smooth mesh on an engine that collides its facets.
+        pebble = {"name": "pebble", "shape": "mesh", "file": str(ROOT / "scenes" / "meshes" / "pebble.obj"),
+                  "surface": "smooth", "dynamic": True, "density_kgpm3": 2600, "position_m": [0.1, 0.1, 0.03]}
+        scene.write_text(json.dumps({"physics": {"engine": "bullet"}, "objects": [pebble]}))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            impetus.run_trial(scene, "tap", "local", logs=False, duration_s=0.2)
+        messages = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+        self.assertTrue(any("'pebble' has a smooth surface, but the bullet engine collides its triangles" in m
+                            for m in messages), messages)
 
     def test_the_public_names_and_their_types(self):
         # __all__ names what exists; the stub (PEP 561) declares each of them and every argument of run_trial.

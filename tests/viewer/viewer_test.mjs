@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The viewer in a real browser (headless Chromium driven by Playwright), against the project's own binaries.
-//   node tests/viewer/viewer_test.mjs --build BUILD_DIR --case live|replay|bodies|kill|bad-input|clay|meshes
+//   node tests/viewer/viewer_test.mjs --build BUILD_DIR --case live|replay|bodies|kill|bad-input|clay|meshes|terrain
 //     [--picture FILE]
 // --picture (replay only): also saves the page at the tap's hardest push as FILE (the README's picture;
 // scripts/make_figures.sh).
@@ -445,5 +445,29 @@ async function meshes(procs, browser) {
     `no message rejected by the page (${withFiles.rejectedMessages} text, ${withFiles.rejectedFrames} frames)`);
 }
 
-const cases = { live, replay, bodies, kill, "bad-input": badInput, clay, meshes };
+// The terrain of 10^6 triangles (scripts/make_meshes.py --terrain writes it; not run by CTest, which does not make it):
+// more triangles than a page is sent, so the page gets it coarsened, and draws it as triangles, not as its bound.
+async function terrain(procs, browser) {
+  const scene = path.join(source, "scenes", "terrain.json");
+  const file = path.join(source, "out", "meshes", "terrain.stl");
+  if (!fs.existsSync(file)) throw new Failure(`${file} is missing: /usr/bin/python3 scripts/make_meshes.py --terrain`);
+  const world = procs.start("world", "world_manager", ["--scene", scene, "--clock", "realtime", "--shm", shm]);
+  const started = Date.now();
+  const viewer = await procs.viewer(["--shm", shm, "--meshes-from", scene]);
+  const page = await openPage(browser, viewer.url);
+  await waitFor("the page's first frames", async () => (await view(page))?.framesReceived > 5, 60000);
+  console.log(`  the page drew its first frames ${((Date.now() - started) / 1000).toFixed(1)} s after the viewer started`);
+  await page.evaluate(() => window.impetusView.lookAt([0.0, 0.0, 0.0], 0.5));
+  await sleep(500);
+  await page.screenshot({ path: path.join(outDir, "terrain.png") });
+  const drawn = await view(page);
+  await procs.stop(viewer);
+  await procs.stop(world);
+  const ground = drawn.meshes.find((m) => m.name === "terrain");
+  check(ground?.drawn === "triangles" && ground.triangles > 10000 && ground.triangles <= 100000,
+    `the terrain drawn as ${ground?.triangles} triangles (${ground?.drawn}), coarsened from 10^6 to fit a page`);
+  check(drawn.rejectedMessages === 0 && drawn.rejectedFrames === 0, "no message rejected by the page");
+}
+
+const cases = { live, replay, bodies, kill, "bad-input": badInput, clay, meshes, terrain };
 await runCase("viewer_test", cases, which, build, outDir, shm);

@@ -287,7 +287,7 @@ TEST_CASE("the scene message carries a loaded mesh's triangles in its body frame
   CHECK_FALSE(bodies.back()["mesh"].contains("vertices_m"));
 }
 
-TEST_CASE("a mesh of more triangles than a page is sent is drawn as its bound, and the message says so") {
+TEST_CASE("a mesh of more triangles than a page is sent is sent coarsened to fit, its shape kept to a cell") {
   // A flat sheet of 2·225² = 101 250 triangles, just over the limit.
   constexpr int kCells = 225;
   static_assert(2 * kCells * kCells > static_cast<int>(view::kMaxViewMeshTriangles));
@@ -312,8 +312,32 @@ TEST_CASE("a mesh of more triangles than a page is sent is drawn as its bound, a
   described->bodies[0].shape = sheet.shape();
   const nlohmann::json message = nlohmann::json::parse(view::scene_message(*described, "test", std::nullopt));
   const auto& form = message["bodies"][0]["mesh"];
-  CHECK(form["drawn"] == "bound");
-  CHECK(form["why"].get<std::string>().find("101250 triangles") != std::string::npos);
+  REQUIRE(form["drawn"] == "triangles");
+  CHECK(form["coarsened_from"] == 101250);
+  const std::size_t triangles = form["triangles"].size() / 3;
+  CHECK(triangles <= view::kMaxViewMeshTriangles);
+  CHECK(triangles > view::kMaxViewMeshTriangles / 4);  // coarsened as little as it must be, cells grown by 1.25
+  // The sheet stays flat and in its square, and covers it but for the half cell lost along each border.
+  const double cell_m = form["cell_m"].get<double>();
+  const auto& v = form["vertices_m"];
+  double area_m2 = 0.0, off_m = 0.0;
+  for (std::size_t t = 0; t < triangles; ++t) {
+    Eigen::Vector3d corner[3];
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t index = form["triangles"][3 * t + static_cast<std::size_t>(k)].get<std::size_t>();
+      corner[k] = Eigen::Vector3d(v[3 * index].get<double>(), v[3 * index + 1].get<double>(),
+                                  v[3 * index + 2].get<double>());
+      // Body frame: centred on the sheet's bounding box.
+      off_m = std::max({off_m, std::abs(corner[k].z()), std::abs(corner[k].x()) - 0.5 * kCells * 1e-3,
+                        std::abs(corner[k].y()) - 0.5 * kCells * 1e-3});
+    }
+    area_m2 += 0.5 * (corner[1] - corner[0]).cross(corner[2] - corner[0]).z();  // + if wound as the sheet
+  }
+  const double side_m = kCells * 1e-3;
+  INFO(triangles << " triangles on cells of " << cell_m << " m, area " << area_m2 << " m² of " << side_m * side_m);
+  CHECK(off_m < 1e-12);
+  CHECK(area_m2 <= side_m * side_m * (1.0 + 1e-9));
+  CHECK(area_m2 > (side_m - 2.0 * cell_m) * (side_m - 2.0 * cell_m));
 }
 
 TEST_CASE("a frame message is the header, 7 values per body, and per endpoint 12 plus 6 per plane") {

@@ -3,6 +3,7 @@
 
 #include "world_manager/engine/escape_guard.h"
 #include "world_manager/engine/sleeping_bodies.h"
+#include "world_manager/engine/smooth_floor.h"
 #include "world_manager/engine/speculative_contacts.h"
 
 #include "common/mesh/mesh_body.h"
@@ -10,8 +11,10 @@
 #include <ode/ode.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -89,6 +92,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
   std::vector<dMass> masses;              // per object, to rebuild a body that wakes
   std::vector<std::size_t> nearby;        // scratch
   std::vector<dTriMeshDataID> mesh_data;  // one per mesh geom; ODE reads the MeshBody's arrays, it copies nothing
+  std::vector<std::unique_ptr<SmoothFloor>> smooth_floor;  // per object: a smooth mesh's touches of the floor, or null
   // Dented tops (dent_top), per object: the heightfield geom beside the object's box (nullptr: none), the grid it
   // reads (its address is ODE's user data, so the vector is sized once) and ODE's data for it.
   std::vector<dGeomID> tops;
@@ -112,7 +116,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
   }
   bool reaches(std::size_t id, std::size_t other) override {
     dContactGeom touch;
-    if (dCollide(geoms[id], geoms[other], 1, &touch, sizeof(dContactGeom)) > 0) return true;
+    if (collide(geoms[id], geoms[other], 1, &touch, sizeof(dContactGeom)) > 0) return true;
     return speculative && speculative->meets(id, other, *this);
   }
   bool rested(std::size_t id) const override { return dBodyIsEnabled(bodies[id]) == 0; }
@@ -166,7 +170,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
     const dReal start[3] = {p[0], p[1], p[2]};
     dBodySetPosition(body, start[0] + displacement_m.x(), start[1] + displacement_m.y(), start[2] + displacement_m.z());
     dContactGeom found[kMaxContactsPerPair];
-    const int count = dCollide(geoms[id], geom_of(other), kMaxContactsPerPair, found, sizeof(dContactGeom));
+    const int count = collide(geoms[id], geom_of(other), kMaxContactsPerPair, found, sizeof(dContactGeom));
     dBodySetPosition(body, start[0], start[1], start[2]);
     for (int i = 0; i < count; ++i) out[i] = point_of(found[i]);
     return count;
@@ -192,7 +196,53 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
     dGeomID ga = geom_of(a);
     dGeomID gb = geom_of(b);
     dContact found[kMaxContactsPerPair];
-    add_contacts(found, dCollide(ga, gb, kMaxContactsPerPair, &found[0].geom, sizeof(dContact)), ga, gb);
+    add_contacts(found, collide(ga, gb, kMaxContactsPerPair, &found[0].geom, sizeof(dContact)), ga, gb);
+  }
+
+  // ODE's contacts of two geoms (dCollide), but a smooth mesh touches the floor with its smooth surface
+  // (smooth_floor.h): the facets' contacts are where to look from, and the surface's replace them.
+  int collide(dGeomID a, dGeomID b, int max, dContactGeom* out, int stride) {
+    const int count = dCollide(a, b, max, out, stride);
+    if (floor == nullptr || (a != floor && b != floor)) return count;
+    const dGeomID mesh = a == floor ? b : a;
+    const std::size_t id = data_to_id(dGeomGetData(mesh));
+    if (id >= smooth_floor.size() || smooth_floor[id] == nullptr) return count;
+    // Far above the floor (farther than the surface ever lies below the facets' box): nothing to climb for.
+    dReal box[6];
+    dGeomGetAABB(mesh, box);
+    if (box[4] > scene->floor.height_m + smooth_floor[id]->reach_m()) return count;
+    const auto at = [&](int i) {
+      return reinterpret_cast<dContactGeom*>(reinterpret_cast<char*>(out) + static_cast<std::ptrdiff_t>(i) * stride);
+    };
+    std::array<Eigen::Vector3d, kMaxContactsPerPair> facets;
+    const int facet_count = std::min(count, kMaxContactsPerPair);
+    for (int i = 0; i < facet_count; ++i) facets[i] = Eigen::Vector3d(at(i)->pos[0], at(i)->pos[1], at(i)->pos[2]);
+    const dReal* p = dGeomGetPosition(mesh);
+    const dReal* r = dGeomGetRotation(mesh);  // 3×4, row-major
+    Eigen::Matrix3d rotation;
+    rotation << r[0], r[1], r[2], r[4], r[5], r[6], r[8], r[9], r[10];
+    std::array<FloorTouch, kMaxContactsPerPair> touches;
+    const int touch_count = smooth_floor[id]->touches(
+        Eigen::Vector3d(p[0], p[1], p[2]), rotation, scene->floor.height_m,
+        std::span<const Eigen::Vector3d>(facets.data(), static_cast<std::size_t>(facet_count)),
+        std::span<FloorTouch>(touches.data(), static_cast<std::size_t>(std::min(max, kMaxContactsPerPair))));
+    if (touch_count == SmoothFloor::kUseFacets) return count;
+    const double up = a == mesh ? 1.0 : -1.0;  // ODE's normal points into geom 1: the floor pushes the mesh up
+    for (int i = 0; i < touch_count; ++i) {
+      dContactGeom& contact = *at(i);
+      for (int k = 0; k < 3; ++k) contact.pos[k] = touches[static_cast<std::size_t>(i)].point_m[k];
+      contact.pos[3] = 0.0;
+      contact.normal[0] = 0.0;
+      contact.normal[1] = 0.0;
+      contact.normal[2] = up;
+      contact.normal[3] = 0.0;
+      contact.depth = touches[static_cast<std::size_t>(i)].depth_m;
+      contact.g1 = a;
+      contact.g2 = b;
+      contact.side1 = -1;
+      contact.side2 = -1;
+    }
+    return touch_count;
   }
 
   static Point point_of(const dContactGeom& geom) {
@@ -315,7 +365,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
     auto* self = static_cast<Handles*>(data);
     if (dGeomGetBody(a) == nullptr && dGeomGetBody(b) == nullptr) return;  // static against static never moves
     dContact found[kMaxContactsPerPair];
-    const int count = dCollide(a, b, kMaxContactsPerPair, &found[0].geom, sizeof(dContact));
+    const int count = self->collide(a, b, kMaxContactsPerPair, &found[0].geom, sizeof(dContact));
     if (count == 0) return;
     if (self->speculative &&
         self->speculative->defer_touching(data_to_id(dGeomGetData(a)), data_to_id(dGeomGetData(b)),
@@ -421,6 +471,10 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
                                     static_cast<int>(3 * mesh.triangles.size()), sizeof(mesh.triangles[0]));
         ode.mesh_data.push_back(data);
         geom = dCreateTriMesh(home, data, nullptr, nullptr, nullptr);
+        if (object.smooth_surface) {
+          ode.smooth_floor.resize(scene.objects.size());
+          ode.smooth_floor[id] = std::make_unique<SmoothFloor>(*body);
+        }
         if (object.dynamic) {
           const Eigen::Matrix3d inertia = object.mass_kg * body->inertia_per_kg();
           dMassSetParameters(&mass, object.mass_kg, 0.0, 0.0, 0.0, inertia(0, 0), inertia(1, 1), inertia(2, 2),
