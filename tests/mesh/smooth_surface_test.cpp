@@ -47,10 +47,10 @@ TEST_CASE("smooth surface: a tessellated ball's farthest point is nearly the sph
     last_vertex = ball.vertices_m[point.vertex];
   }
   const double step_m = radius_m * 2.0 * 3.14159265358979323846 / kSteps;  // the sphere's arc a step
-  INFO(ball.triangles.size() << " triangles: support height off the radius by " << worst_radius_m << " m (the facets' by "
-       << worst_facets_m << " m), normal by "
-       << worst_normal << ", largest step " << worst_step_m << " m (the sphere's " << step_m << ", the vertices' "
-       << worst_vertex_step_m << ")");
+  INFO(ball.triangles.size() << " triangles: support height off the radius by " << worst_radius_m
+                             << " m (the facets' by " << worst_facets_m << " m), normal by " << worst_normal
+                             << ", largest step " << worst_step_m << " m (the sphere's " << step_m
+                             << ", the vertices' " << worst_vertex_step_m << ")");
   // Nearer the sphere than the facets are. Not exact: angle-weighted normals at the icosphere's uneven vertices are
   // not quite radial, and the surface follows them.
   CHECK(worst_radius_m < worst_facets_m);

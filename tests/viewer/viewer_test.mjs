@@ -456,7 +456,8 @@ async function terrain(procs, browser) {
   const viewer = await procs.viewer(["--shm", shm, "--meshes-from", scene]);
   const page = await openPage(browser, viewer.url);
   await waitFor("the page's first frames", async () => (await view(page))?.framesReceived > 5, 60000);
-  console.log(`  the page drew its first frames ${((Date.now() - started) / 1000).toFixed(1)} s after the viewer started`);
+  const waited = ((Date.now() - started) / 1000).toFixed(1);
+  console.log(`  the page drew its first frames ${waited} s after the viewer started`);
   await page.evaluate(() => window.impetusView.lookAt([0.0, 0.0, 0.0], 0.5));
   await sleep(500);
   await page.screenshot({ path: path.join(outDir, "terrain.png") });
