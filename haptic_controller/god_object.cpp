@@ -74,11 +74,19 @@ const PlaneSet& GodObject::armed_planes(const PlaneSet& planes, const Eigen::Vec
   return armed_;
 }
 
-const GodObjectResult& GodObject::solve(const PlaneSet& planes, const Eigen::Vector3d& finger_m, double dt_s) {
+const GodObjectResult& GodObject::solve(const PlaneSet& planes, const Eigen::Vector3d& finger_m, double dt_s,
+                                        const MeshHold* walked) {
   const PlaneSet& armed = armed_planes(planes, finger_m);
   result_.contact = project_outside_planes(armed, finger_m);
   const FrictionResult friction = apply_friction(armed, result_.contact, finger_m, dt_s, anchor_);
-  result_.contact.proxy_m = friction.proxy_m;
+  // The move from a point outside every mesh stops where it would go into one. Less than the surface tolerance cannot
+  // go in deeper than that (and is what the frictionless proxy differs from the walk's end by, in rounding).
+  const bool from_walk = walked != nullptr && walked->walked;
+  const Eigen::Vector3d& from_m = from_walk ? walked->end_m : result_.contact.proxy_m;
+  result_.contact.proxy_m = (friction.proxy_m - from_m).squaredNorm() > kOnSurface_m * kOnSurface_m
+                                ? stop_at_meshes(armed, from_m, friction.proxy_m, from_walk ? walked : nullptr)
+                                : friction.proxy_m;
+  if (anchor_.valid) anchor_.point_m = result_.contact.proxy_m;
   result_.sticking = friction.sticking;
   // What the finger presses and how deep: what end_finger_session keeps if the finger vanishes after this tick.
   pressed_count_ = 0;

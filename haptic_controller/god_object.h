@@ -4,8 +4,11 @@
 // represents the finger on the surface, outside every interpolated plane, with friction (paper §6.2).
 //
 // GodObject::solve = project_outside_planes (the frictionless proxy and the contact's multipliers) followed by
-// apply_friction (stick/slip of the proxy on the surface). The reported active constraints and multipliers are the
-// frictionless ones: the normal load each plane carries, by which the reaction is shared among objects (§3.4).
+// apply_friction (stick/slip of the proxy on the surface). The proxy is not left inside a mesh: its move from where
+// the walk over the meshes ended stops where it would go into one (mesh_walk.h stop_at_meshes; a held triangle's
+// plane runs on behind a concave neighbour, and a primitive's plane knows nothing of the meshes). The reported active
+// constraints and multipliers are the frictionless ones: the normal load each plane carries, by which the reaction is
+// shared among objects (§3.4).
 // Owned by the servo thread; allocation-free.
 //
 // A finger that starts inside an object (the device attaches, or the finger reappears, with the fingertip already
@@ -25,6 +28,7 @@
 
 #include "haptic_controller/contact_plane.h"
 #include "haptic_controller/friction.h"
+#include "haptic_controller/mesh_walk.h"
 #include "haptic_controller/proxy_projection.h"
 
 #include <Eigen/Core>
@@ -38,8 +42,12 @@ struct GodObjectResult {
 
 class GodObject {
  public:
-  // `dt_s` is the real time since the previous solve: how far the anchor's object moved.
-  const GodObjectResult& solve(const PlaneSet& planes, const Eigen::Vector3d& finger_m, double dt_s);
+  // `dt_s` is the real time since the previous solve: how far the anchor's object moved. `walked`, if given, is this
+  // tick's walk over the meshes of `planes` (mesh_walk.h: its end, outside every mesh, and the triangles it held): the
+  // proxy's move from that end, which friction and the primitives' planes make and the walk did not know of, stops
+  // where it would go into a mesh. Without it, friction's move from the frictionless proxy does.
+  const GodObjectResult& solve(const PlaneSet& planes, const Eigen::Vector3d& finger_m, double dt_s,
+                               const MeshHold* walked = nullptr);
 
   // No contact memory (device detached, session restart).
   void reset();

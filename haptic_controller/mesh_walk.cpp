@@ -187,6 +187,42 @@ MeshWalk walk_meshes(std::span<const WalkedMesh> meshes, const Eigen::Vector3d& 
   return walk;
 }
 
+Eigen::Vector3d stop_at_meshes(const PlaneSet& planes, const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m,
+                               const MeshHold* held) {
+  std::array<WalkedMesh, kMaxPlanes> meshes;
+  std::size_t count = 0;
+  for (std::uint32_t k = 0; k < planes.count && count < meshes.size(); ++k) {
+    const ContactPlane& plane = planes.planes[k];
+    const MeshGeometry* mesh =
+        plane.shape.kind == ShapeKind::mesh ? find_mesh_geometry(plane.shape.mesh_hash) : nullptr;
+    if (mesh == nullptr) continue;
+    // A convex body lies behind each of its planes the god-object holds (a triangle's, or the tangent plane of one the
+    // walk held nothing of), and the proxy is in front of them: only a mesh with a concave bend can be gone into.
+    if (mesh->convex()) continue;
+    bool listed = false;  // a mesh the walk held several triangles of has a plane for each
+    for (std::size_t m = 0; m < count && !listed; ++m) listed = meshes[m].object_id == plane.object_id;
+    if (!listed) meshes[count++] = {mesh, plane.com_m, plane.axes, plane.dynamic(), plane.object_id};
+  }
+  // Both ends on one held triangle: the way between them is on it too (a triangle is convex).
+  for (int i = 0; held != nullptr && i < held->count; ++i) {
+    const auto s = static_cast<std::size_t>(i);
+    for (std::size_t m = 0; m < count; ++m) {
+      if (meshes[m].object_id != held->object_id[s]) continue;
+      MeshEntry on;
+      if (meshes[m].mesh->on_triangle(held->triangle[s], to_body(meshes[m], from_m), kOnSurface_m, on) &&
+          meshes[m].mesh->on_triangle(held->triangle[s], to_body(meshes[m], to_m), kOnSurface_m, on)) {
+        return to_m;
+      }
+    }
+  }
+  MeshEntry entry;
+  int mesh = 0;
+  const MeshWalk none;
+  return count > 0 && first_entry(std::span<const WalkedMesh>(meshes.data(), count), none, from_m, to_m, entry, mesh)
+             ? entry.point_m
+             : to_m;
+}
+
 MeshHold held_by(const MeshWalk& walk, std::span<const WalkedMesh> meshes) {
   MeshHold hold;
   for (int i = 0; i < walk.count && hold.count < 3; ++i) {
@@ -214,11 +250,15 @@ int walk_mesh_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eig
     walked[k] = true;
   }
   if (count == 0) {
-    if (hold != nullptr) hold->count = 0;
+    if (hold != nullptr) *hold = MeshHold{};
     return 0;
   }
   const MeshWalk walk = walk_meshes(std::span<const WalkedMesh>(meshes.data(), count), proxy_m, finger_m, hold);
-  if (hold != nullptr) *hold = held_by(walk, std::span<const WalkedMesh>(meshes.data(), count));
+  if (hold != nullptr) {
+    *hold = held_by(walk, std::span<const WalkedMesh>(meshes.data(), count));
+    hold->end_m = walk.proxy_m;
+    hold->walked = true;
+  }
   for (std::size_t m = 0; m < count; ++m) {
     ContactPlane& plane = planes.planes[plane_of[m]];
     bool first = true;

@@ -43,11 +43,14 @@ struct WalkedMesh {
   std::int32_t object_id;  // the scene object it is (two objects may share one mesh's triangles)
 };
 
-// The triangles a walk held at its end, by object and triangle: where the next tick's walk may start from.
+// The triangles a walk held at its end, by object and triangle: where the next tick's walk may start from. And where
+// it ended, a point outside every mesh walked (`walked` false: no mesh was in reach this tick).
 struct MeshHold {
   std::array<std::int32_t, 3> object_id{};
   std::array<std::uint32_t, 3> triangle{};
   int count = 0;
+  Eigen::Vector3d end_m = Eigen::Vector3d::Zero();
+  bool walked = false;
 };
 
 // The triangles the walk holds at its end (their planes, world frame: a point on each and its outward unit normal,
@@ -68,6 +71,14 @@ struct MeshWalk {
 // the proxy still lies on (none if null).
 MeshWalk walk_meshes(std::span<const WalkedMesh> meshes, const Eigen::Vector3d& proxy_m,
                      const Eigen::Vector3d& finger_m, const MeshHold* held = nullptr);
+
+// Where the way from `from_m` (outside every mesh) toward `to_m` first goes into a mesh of `planes` whose triangles
+// this process has, or `to_m` if into none. Friction moves the proxy off the walk's end along the planes of the
+// triangles held, and a triangle's plane runs on past its edge: beyond a concave crease, behind the neighbour. The
+// god-object walks that move too (god_object.h). With `held` (the walk's, from_m its end), a move from one point of a
+// held triangle to another stays on it and asks no tree.
+Eigen::Vector3d stop_at_meshes(const PlaneSet& planes, const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m,
+                               const MeshHold* held = nullptr);
 
 // What `walk` holds at its end, for the next tick's walk over the same `meshes`.
 MeshHold held_by(const MeshWalk& walk, std::span<const WalkedMesh> meshes);

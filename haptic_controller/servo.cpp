@@ -185,7 +185,8 @@ const TickResult& HapticServo::tick(const FingerSample* finger, double now_s, do
   // 3. Proxy D_j (god-object with friction).
   planes_.valid_within_m =
       current_frame_.reach_radius_m > 0.0 ? current_frame_.reach_radius_m : std::numeric_limits<double>::infinity();
-  const GodObjectResult& contact = god_object_.solve(planes_, finger_m, dt_s);
+  const GodObjectResult& contact =
+      god_object_.solve(planes_, finger_m, dt_s, &mesh_hold_);
   if (!contact.contact.proxy_m.allFinite()) {  // only a non-finite plane could do this; frames are validated upstream
     ++counters_.faults;
     god_object_.reset();

@@ -32,6 +32,7 @@ class MeshBody final : public MeshGeometry {
   // Where the body's origin lies in the (scaled) file's frame: a scene's position_m puts this point there.
   const Eigen::Vector3d& origin_in_file_m() const { return origin_in_file_m_; }
   bool closed() const override { return closed_; }
+  bool convex() const override { return closed_ && bvh_.locally_convex(); }
   bool winding_flipped() const { return flipped_; }
   const MeshBvh& bvh() const { return bvh_; }
   // The smooth surface the triangles stand for (smooth_surface.h), built on the first call (any thread; O(n)).

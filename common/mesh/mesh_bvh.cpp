@@ -122,6 +122,9 @@ void MeshBvh::pseudo_normals() {
     }
   }
   std::sort(uses.begin(), uses.end(), [](const Use& x, const Use& y) { return x.key < y.key; });
+  // Rounding in a plane's height at a corner: far below any bend a mesh is built with.
+  const double flat_m = 1e-12 * nodes_.front().bounds.diagonal().norm();
+  locally_convex_ = n > 0;
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -129,6 +132,17 @@ void MeshBvh::pseudo_normals() {
     if (sum.norm() > 0.0) sum.normalize();
     for (std::size_t k = i; k < j; ++k) {
       edge_normals_[uses[k].triangle][uses[k].edge] = sum.norm() > 0.0 ? sum : face_normals_[uses[k].triangle];
+    }
+    // Convex at this edge: the second face's far corner is behind (or on, to rounding) the first face's plane. An
+    // edge of one face (open) or of more than two is not.
+    if (j - i != 2) {
+      locally_convex_ = false;
+    } else {
+      const Use& first = uses[i];
+      const Use& second = uses[i + 1];
+      const Eigen::Vector3d& far_m = mesh_.vertices_m[mesh_.triangles[second.triangle][(second.edge + 2) % 3]];
+      const Eigen::Vector3d& on_first_m = mesh_.vertices_m[mesh_.triangles[first.triangle][0]];
+      if (face_normals_[first.triangle].dot(far_m - on_first_m) > flat_m) locally_convex_ = false;
     }
     i = j;
   }

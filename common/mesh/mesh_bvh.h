@@ -61,6 +61,9 @@ class MeshBvh {
   // plane, with the triangle's normal and t = 0. False for an index out of range.
   bool on_triangle(std::uint32_t triangle, const Eigen::Vector3d& x, double tolerance_m, MeshEntry& out) const;
 
+  // Whether every edge joins two triangles at a convex bend (or flat): a closed mesh that is, is a convex body.
+  bool locally_convex() const { return locally_convex_; }
+
   const TriangleMesh& mesh() const { return mesh_; }
   const Eigen::AlignedBox3d& bounds() const { return nodes_.front().bounds; }
   std::size_t node_count() const { return nodes_.size(); }
@@ -89,6 +92,7 @@ class MeshBvh {
   std::vector<Eigen::Vector3d> face_normals_;             // unit
   std::vector<std::array<Eigen::Vector3d, 3>> edge_normals_;  // per triangle, edges ab, bc, ca (unit)
   std::vector<Eigen::Vector3d> vertex_normals_;           // unit, angle-weighted
+  bool locally_convex_ = false;
 };
 
 // The point of triangle abc nearest p, and which feature it lies on (MeshPoint::feature's numbering).

@@ -55,6 +55,9 @@ class MeshGeometry {
   // Whether every edge has two triangles (a body with an inside; the pseudo-normals' side is exact). An open mesh's
   // side is that of its triangles' winding only near them.
   virtual bool closed() const = 0;
+  // Whether the mesh bounds a convex body (closed, every edge bent outward or flat). Then the body lies behind every
+  // triangle's plane: a point on or in front of any of them is outside it.
+  virtual bool convex() const = 0;
   virtual double volume_m3() const = 0;
   virtual Eigen::Matrix3d inertia_per_kg() const = 0;  // m², about the centre of mass, body frame
 };

@@ -6,6 +6,7 @@
 // way.
 
 #include "common/mesh/mesh_bvh.h"
+#include "haptic_controller/god_object.h"
 #include "haptic_controller/mesh_walk.h"
 #include "haptic_controller/proxy_projection.h"
 #include "tests/support/allocation_counter.h"
@@ -27,6 +28,7 @@ class TreeGeometry final : public MeshGeometry {
  public:
   TreeGeometry(TriangleMesh mesh, bool closed) : tree_(std::move(mesh)), closed_(closed) {}
   bool closed() const override { return closed_; }
+  bool convex() const override { return closed_ && tree_.locally_convex(); }
   SurfacePoint nearest(const Vector3d& query_m) const override {
     MeshPoint point;
     tree_.nearest(query_m, point);
@@ -288,6 +290,53 @@ TEST_CASE("mesh walk: two bodies, turned and apart: held in the crease where the
   REQUIRE(deep.count == 1);
   CHECK(deep.mesh[0] == 0);
   CHECK(deep.proxy_m.isApprox(Vector3d(0.003, 0.0, 0.0), 1e-12));
+}
+
+TEST_CASE("mesh walk: a proxy stuck by friction on one side of a valley is not left behind the other side") {
+  // A valley along y: a face rising to each side at 1:2 (z = |x|/2). The proxy sticks (μ = 2) on the left face 1 mm
+  // from the crease; then the finger is far down to the right, pressing the right face only. The stick point, kept on
+  // the active plane, is the old proxy projected onto the right face's plane: below the left face.
+  TriangleMesh valley;
+  valley.vertices_m = {{-0.05, -0.05, 0.025}, {-0.05, 0.05, 0.025}, {0.0, -0.05, 0.0},
+                       {0.0, 0.05, 0.0},      {0.05, -0.05, 0.025}, {0.05, 0.05, 0.025}};
+  valley.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};  // wound up, out of the ground
+  const TreeGeometry geometry(valley, false);
+  constexpr std::uint64_t kHash = 0x5a11e7000000c0deull;  // this test's own
+  register_mesh_geometry(kHash, &geometry);
+  const auto below_faces_m = [](const Vector3d& x) {  // how far behind the nearer face, positive if behind
+    const Vector3d left = Vector3d(0.5, 0.0, 1.0).normalized(), right = Vector3d(-0.5, 0.0, 1.0).normalized();
+    return std::max(-(x.x() <= 0.0 ? left : right).dot(x), 0.0);
+  };
+  PlaneSet sent;
+  ContactPlane& plane = sent.planes[sent.count++];
+  plane.shape.kind = ShapeKind::mesh;
+  plane.shape.mesh_hash = kHash;
+  plane.shape.radius_m = 0.08;
+  plane.object_id = 0;
+  plane.com_m = Vector3d::Zero();
+  plane.axes = Eigen::Matrix3d::Identity();
+  plane.point_m = Vector3d::Zero();
+  plane.normal = Vector3d::UnitZ();
+  plane.static_friction = 2.0;
+  plane.dynamic_friction = 1.5;
+  GodObject god;
+  MeshHold hold;
+  Vector3d proxy(-0.001, 0.0, 0.002);
+  const Vector3d fingers[] = {{-0.001, 0.0, -0.0015}, {-0.001, 0.0, -0.0015}, {0.003, 0.0, -0.004}};
+  double deepest_m = 0.0;
+  bool stuck = false;
+  for (const Vector3d& finger : fingers) {
+    PlaneSet planes = sent;
+    std::array<bool, kMaxServoPlanes> walked{};
+    walk_mesh_planes(planes, proxy, finger, walked, &hold);
+    const GodObjectResult& solved = god.solve(planes, finger, 1e-3, &hold);
+    proxy = solved.contact.proxy_m;
+    stuck = solved.sticking;
+    deepest_m = std::max(deepest_m, below_faces_m(proxy));
+  }
+  INFO("proxy " << proxy.transpose() << ", deepest " << deepest_m << " m behind a face");
+  CHECK(stuck);  // the last tick stuck: the case is the one meant
+  CHECK(deepest_m < 1e-12);
 }
 
 #if IMPETUS_COUNT_ALLOCATIONS

@@ -178,7 +178,7 @@ TEST_CASE("a terrain of a million triangles: a finger circling through its hills
   nlohmann::json scene = nlohmann::json::parse(test::read_text(kSceneDir + "/terrain.json"));
   scene["objects"][0]["file"] = stl;
   // Frictionless, as the ghost-force scorer's surfaces: a stuck proxy is friction's, not the walk's (with the shipped
-  // friction it sticks up to 3 µm behind a neighbouring facet: docs/meshes.md).
+  // friction the proxy was 0.2 µm behind the surface on two ticks: docs/meshes.md).
   scene["objects"][0]["static_friction"] = 0.0;
   scene["objects"][0]["dynamic_friction"] = 0.0;
   InProcessTrialOptions options;

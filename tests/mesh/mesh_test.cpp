@@ -267,3 +267,19 @@ TEST_CASE("mesh: a segment crosses the surface where it does, and enters a body 
   CHECK(body.segment_enters(above, cavity - above, 1e-9));            // from outside through it
   CHECK(body.segment_enters(above, Eigen::Vector3d(0.0, 0.0, 0.01) - above, 1e-9));  // into the wall's middle
 }
+
+TEST_CASE("mesh: a box and a tessellated ball are convex, a dented ball, a box with a face open and a valley are not") {
+  CHECK(MeshBvh(test::box_mesh(Eigen::Vector3d(0.04, 0.02, 0.01))).locally_convex());
+  CHECK(MeshBvh(test::icosphere(0.02, 4)).locally_convex());
+  TriangleMesh dented = test::icosphere(0.02, 3);
+  dented.vertices_m[0] *= 0.9;  // one vertex pushed in: the edges around it bend inward
+  CHECK_FALSE(MeshBvh(dented).locally_convex());
+  TriangleMesh open = test::box_mesh(Eigen::Vector3d(0.02, 0.02, 0.02));
+  open.triangles.pop_back();
+  CHECK_FALSE(MeshBvh(open).locally_convex());
+  TriangleMesh valley;
+  valley.vertices_m = {{-0.05, -0.05, 0.025}, {-0.05, 0.05, 0.025}, {0.0, -0.05, 0.0},
+                       {0.0, 0.05, 0.0},      {0.05, -0.05, 0.025}, {0.05, 0.05, 0.025}};
+  valley.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
+  CHECK_FALSE(MeshBvh(valley).locally_convex());
+}
