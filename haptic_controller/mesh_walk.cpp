@@ -89,6 +89,11 @@ void keep(MeshWalk& walk, unsigned held) {
   walk.count = kept;
 }
 
+// The triangles of a plane's mesh if this process has them, else null (not a mesh, or not loaded here).
+const MeshGeometry* geometry_of(const ContactPlane& plane) {
+  return plane.shape.kind == ShapeKind::mesh ? find_mesh_geometry(plane.shape.mesh_hash) : nullptr;
+}
+
 Eigen::Vector3d to_body(const WalkedMesh& placed, const Eigen::Vector3d& x_m) {
   return placed.axes.transpose() * (x_m - placed.com_m);
 }
@@ -193,8 +198,7 @@ Eigen::Vector3d stop_at_meshes(const PlaneSet& planes, const Eigen::Vector3d& fr
   std::size_t count = 0;
   for (std::uint32_t k = 0; k < planes.count && count < meshes.size(); ++k) {
     const ContactPlane& plane = planes.planes[k];
-    const MeshGeometry* mesh =
-        plane.shape.kind == ShapeKind::mesh ? find_mesh_geometry(plane.shape.mesh_hash) : nullptr;
+    const MeshGeometry* mesh = geometry_of(plane);
     if (mesh == nullptr) continue;
     // A convex body lies behind each of its planes the god-object holds (a triangle's, or the tangent plane of one the
     // walk held nothing of), and the proxy is in front of them: only a mesh with a concave bend can be gone into.
@@ -242,8 +246,7 @@ int walk_mesh_planes(PlaneSet& planes, const Eigen::Vector3d& proxy_m, const Eig
   std::size_t count = 0;
   for (std::uint32_t k = 0; k < planes.count && count < meshes.size(); ++k) {
     const ContactPlane& plane = planes.planes[k];
-    const MeshGeometry* mesh =
-        plane.shape.kind == ShapeKind::mesh ? find_mesh_geometry(plane.shape.mesh_hash) : nullptr;
+    const MeshGeometry* mesh = geometry_of(plane);
     if (mesh == nullptr) continue;
     meshes[count] = {mesh, plane.com_m, plane.axes, plane.dynamic(), plane.object_id};
     plane_of[count++] = k;

@@ -209,16 +209,71 @@ bool MeshBvh::search(const Eigen::Vector3d& query_m, double best_squared, bool s
     }
   }
   if (!found) return false;
-  const Eigen::Vector3d& normal = best_feature == 0   ? face_normals_[best_triangle]
-                                  : best_feature <= 3 ? edge_normals_[best_triangle][best_feature - 1]
-                                                      : vertex_normals_[mesh_.triangles[best_triangle][best_feature - 4]];
-  const double distance_m = std::sqrt(best_squared);
-  out.point_m = best_point;
-  out.normal = normal;
-  out.signed_distance_m = (query_m - best_point).dot(normal) < 0.0 ? -distance_m : distance_m;
-  out.triangle = best_triangle;
-  out.feature = best_feature;
+  out = answer(query_m, best_point, best_squared, best_triangle, best_feature);
   return true;
+}
+
+MeshPoint MeshBvh::answer(const Eigen::Vector3d& query_m, const Eigen::Vector3d& point, double squared,
+                          std::uint32_t triangle, std::uint8_t feature) const {
+  const Eigen::Vector3d& normal = feature == 0   ? face_normals_[triangle]
+                                  : feature <= 3 ? edge_normals_[triangle][feature - 1]
+                                                 : vertex_normals_[mesh_.triangles[triangle][feature - 4]];
+  const double distance_m = std::sqrt(squared);
+  MeshPoint out;
+  out.point_m = point;
+  out.normal = normal;
+  out.signed_distance_m = (query_m - point).dot(normal) < 0.0 ? -distance_m : distance_m;
+  out.triangle = triangle;
+  out.feature = feature;
+  return out;
+}
+
+int MeshBvh::within(const Eigen::Vector3d& query_m, double radius_m, std::span<MeshPoint> out) const {
+  if (mesh_.triangles.empty() || out.empty()) return 0;
+  const double radius_squared = radius_m * radius_m;
+  std::array<double, 64> kept_squared{};  // out's points' squared distances, for replacing the farthest
+  const std::size_t capacity = std::min(out.size(), kept_squared.size());
+  std::size_t count = 0;
+  std::array<std::uint32_t, kMaxDepth + 1> stack{};
+  std::size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const std::uint32_t self = stack[--top];
+    const Node& node = nodes_[self];
+    if (node.bounds.squaredExteriorDistance(query_m) > radius_squared) continue;
+    if (node.count == 0) {
+      stack[top++] = node.first;
+      stack[top++] = self + 1;
+      continue;
+    }
+    for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+      const std::uint32_t t = order_[i];
+      const auto& tri = mesh_.triangles[t];
+      std::uint8_t feature = 0;
+      const Eigen::Vector3d p = closest_point_on_triangle(query_m, mesh_.vertices_m[tri[0]], mesh_.vertices_m[tri[1]],
+                                                         mesh_.vertices_m[tri[2]], feature);
+      const double squared = (query_m - p).squaredNorm();
+      if (squared > radius_squared) continue;
+      std::size_t slot = count;
+      if (count == capacity) {  // full: in place of the farthest, if nearer
+        slot = static_cast<std::size_t>(std::max_element(kept_squared.begin(), kept_squared.begin() + count) -
+                                        kept_squared.begin());
+        if (squared >= kept_squared[slot]) continue;
+      } else {
+        ++count;
+      }
+      kept_squared[slot] = squared;
+      out[slot] = answer(query_m, p, squared, t, feature);
+    }
+  }
+  // Nearest first (insertion: a handful of points).
+  for (std::size_t i = 1; i < count; ++i) {
+    for (std::size_t j = i; j > 0 && kept_squared[j] < kept_squared[j - 1]; --j) {
+      std::swap(kept_squared[j], kept_squared[j - 1]);
+      std::swap(out[j], out[j - 1]);
+    }
+  }
+  return static_cast<int>(count);
 }
 
 namespace {

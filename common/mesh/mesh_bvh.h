@@ -19,6 +19,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <span>
 #include <cstdint>
 #include <vector>
 
@@ -45,6 +46,11 @@ class MeshBvh {
   // The same answer as nearest(), started from the triangle of `hint` (the last tick's answer): a point that moved
   // little since has its nearest point on or beside that triangle, so the walk skips nearly every box at once.
   bool nearest_from(const Eigen::Vector3d& query_m, const MeshPoint& hint, MeshPoint& out) const;
+
+  // The points of the mesh within `radius_m` of `query_m`, one per triangle that comes that near (its nearest point,
+  // with the pseudo-normal of the feature it lies on and the side, as nearest() gives them), nearest first, at most
+  // `out.size()` of them (the nearest). Returns how many. What a ball touching the mesh touches.
+  int within(const Eigen::Vector3d& query_m, double radius_m, std::span<MeshPoint> out) const;
 
   // Whether the segment from `a` to `b` crosses a triangle at a parameter t in (t_min, 1] (t = 0 at `a`): the
   // triangle's plane between its two ends, within its edges (Möller and Trumbore's test). Both sides count.
@@ -82,6 +88,9 @@ class MeshBvh {
   // The walk: from a best squared distance (and, if `seeded`, the point, triangle and feature that give it).
   bool search(const Eigen::Vector3d& query_m, double best_squared, bool seeded, Eigen::Vector3d best_point,
               std::uint32_t best_triangle, std::uint8_t best_feature, MeshPoint& out) const;
+  // The answer for `query_m` at `point` on `triangle`'s `feature`, `squared` away.
+  MeshPoint answer(const Eigen::Vector3d& query_m, const Eigen::Vector3d& point, double squared, std::uint32_t triangle,
+                   std::uint8_t feature) const;
   std::uint32_t build(std::uint32_t begin, std::uint32_t end, std::vector<Eigen::Vector3d>& centroids, int depth);
   void pseudo_normals();
   bool within_edges(std::uint32_t triangle, const Eigen::Vector3d& x, double tolerance_m) const;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/engine/ode_engine.h"
 
+#include "world_manager/engine/ball_mesh_contacts.h"
 #include "world_manager/engine/escape_guard.h"
 #include "world_manager/engine/sleeping_bodies.h"
 #include "world_manager/engine/smooth_floor.h"
@@ -93,6 +94,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
   std::vector<std::size_t> nearby;        // scratch
   std::vector<dTriMeshDataID> mesh_data;  // one per mesh geom; ODE reads the MeshBody's arrays, it copies nothing
   std::vector<std::unique_ptr<SmoothFloor>> smooth_floor;  // per object: a smooth mesh's touches of the floor, or null
+  std::vector<const MeshBody*> mesh_bodies;                 // per object: a mesh object's triangles, or null
   // Dented tops (dent_top), per object: the heightfield geom beside the object's box (nullptr: none), the grid it
   // reads (its address is ODE's user data, so the vector is sized once) and ODE's data for it.
   std::vector<dGeomID> tops;
@@ -202,6 +204,7 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
   // ODE's contacts of two geoms (dCollide), but a smooth mesh touches the floor with its smooth surface
   // (smooth_floor.h): the facets' contacts are where to look from, and the surface's replace them.
   int collide(dGeomID a, dGeomID b, int max, dContactGeom* out, int stride) {
+    if (const int on_mesh = ball_on_mesh(a, b, max, out, stride); on_mesh >= 0) return on_mesh;
     const int count = dCollide(a, b, max, out, stride);
     if (floor == nullptr || (a != floor && b != floor)) return count;
     const dGeomID mesh = a == floor ? b : a;
@@ -243,6 +246,46 @@ struct OdeEngine::Handles final : EscapeGuard::Engine, SleepingBodies::Engine, S
       contact.side2 = -1;
     }
     return touch_count;
+  }
+
+  // A ball against a mesh object: the contacts from the mesh's own tree (ball_mesh_contacts.h), which hold a ball on
+  // triangles of any size, where ODE's sphere–trimesh test lets it through small ones. −1: not such a pair.
+  int ball_on_mesh(dGeomID a, dGeomID b, int max, dContactGeom* out, int stride) {
+    const bool a_ball = dGeomGetClass(a) == dSphereClass;
+    if (a_ball == (dGeomGetClass(b) == dSphereClass)) return -1;
+    const dGeomID ball = a_ball ? a : b;
+    const dGeomID mesh = a_ball ? b : a;
+    if (dGeomGetClass(mesh) != dTriMeshClass) return -1;
+    const std::size_t id = data_to_id(dGeomGetData(mesh));
+    if (id >= mesh_bodies.size() || mesh_bodies[id] == nullptr) return -1;
+    const dReal* centre = dGeomGetPosition(ball);
+    const dReal* p = dGeomGetPosition(mesh);
+    const dReal* r = dGeomGetRotation(mesh);  // 3×4, row-major
+    Eigen::Matrix3d rotation;
+    rotation << r[0], r[1], r[2], r[4], r[5], r[6], r[8], r[9], r[10];
+    std::array<BallContact, kMaxContactsPerPair> contacts;
+    const int count = ball_mesh_contacts(
+        Eigen::Vector3d(centre[0], centre[1], centre[2]), dGeomSphereGetRadius(ball), *mesh_bodies[id],
+        Eigen::Vector3d(p[0], p[1], p[2]), rotation,
+        std::span<BallContact>(contacts.data(), static_cast<std::size_t>(std::min(max, kMaxContactsPerPair))));
+    const double sign = a_ball ? 1.0 : -1.0;  // ODE's normal points into geom 1: the mesh pushes the ball out
+    for (int i = 0; i < count; ++i) {
+      const BallContact& found = contacts[static_cast<std::size_t>(i)];
+      auto* contact =
+          reinterpret_cast<dContactGeom*>(reinterpret_cast<char*>(out) + static_cast<std::ptrdiff_t>(i) * stride);
+      for (int k = 0; k < 3; ++k) {
+        contact->pos[k] = found.point_m[k];
+        contact->normal[k] = sign * found.normal[k];
+      }
+      contact->pos[3] = 0.0;
+      contact->normal[3] = 0.0;
+      contact->depth = found.depth_m;
+      contact->g1 = a;
+      contact->g2 = b;
+      contact->side1 = -1;
+      contact->side2 = -1;
+    }
+    return count;
   }
 
   static Point point_of(const dContactGeom& geom) {
@@ -471,6 +514,8 @@ OdeEngine::OdeEngine(const Scene& scene) : ode_(std::make_unique<Handles>()) {
                                     static_cast<int>(3 * mesh.triangles.size()), sizeof(mesh.triangles[0]));
         ode.mesh_data.push_back(data);
         geom = dCreateTriMesh(home, data, nullptr, nullptr, nullptr);
+        ode.mesh_bodies.resize(scene.objects.size(), nullptr);
+        ode.mesh_bodies[id] = body;
         if (object.smooth_surface) {
           ode.smooth_floor.resize(scene.objects.size());
           ode.smooth_floor[id] = std::make_unique<SmoothFloor>(*body);
