@@ -26,7 +26,9 @@ TriangleMesh grid(double side_m, int cells) {
   TriangleMesh mesh;
   const double cell_m = side_m / cells;
   for (int j = 0; j <= cells; ++j) {
-    for (int i = 0; i <= cells; ++i) mesh.vertices_m.emplace_back(i * cell_m - side_m / 2, j * cell_m - side_m / 2, 0.0);
+    for (int i = 0; i <= cells; ++i) {
+      mesh.vertices_m.emplace_back(i * cell_m - side_m / 2, j * cell_m - side_m / 2, 0.0);
+    }
   }
   const auto at = [&](int i, int j) { return static_cast<std::uint32_t>(j * (cells + 1) + i); };
   for (int j = 0; j < cells; ++j) {
