@@ -94,8 +94,22 @@ const MeshGeometry* geometry_of(const ContactPlane& plane) {
   return plane.shape.kind == ShapeKind::mesh ? find_mesh_geometry(plane.shape.mesh_hash) : nullptr;
 }
 
+// Which of `meshes` is scene object `object_id`, or −1.
+int index_of_object(std::span<const WalkedMesh> meshes, std::int32_t object_id) {
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
+    if (meshes[m].object_id == object_id) return static_cast<int>(m);
+  }
+  return -1;
+}
+
 Eigen::Vector3d to_body(const WalkedMesh& placed, const Eigen::Vector3d& x_m) {
   return placed.axes.transpose() * (x_m - placed.com_m);
+}
+
+// Whether `x_m` (world frame) lies on triangle `triangle` of `placed`, to the walk's tolerance; `on` gets the
+// triangle's plane there, in the body frame.
+bool on_triangle(const WalkedMesh& placed, std::uint32_t triangle, const Eigen::Vector3d& x_m, MeshEntry& on) {
+  return placed.mesh->on_triangle(triangle, to_body(placed, x_m), kOnSurface_m, on);
 }
 
 // The first triangle of any mesh that the way from `from_m` to `to_m` goes in through (the held ones of each mesh
@@ -155,16 +169,13 @@ MeshWalk walk_meshes(std::span<const WalkedMesh> meshes, const Eigen::Vector3d& 
     // through each at t = 0 (first_entry's rule, to the same tolerance), so they are met already.
     for (int i = 0; i < held->count; ++i) {
       const auto s = static_cast<std::size_t>(i);
-      for (std::size_t m = 0; m < meshes.size(); ++m) {
-        const WalkedMesh& placed = meshes[m];
-        if (placed.object_id != held->object_id[s]) continue;
-        MeshEntry on;
-        if (placed.mesh->on_triangle(held->triangle[s], to_body(placed, x), kOnSurface_m, on) &&
-            on.normal.dot(to_body(placed, finger_m) - on.point_m) < -kOnSurface_m) {
-          add(walk, placed.com_m + placed.axes * on.point_m, placed.axes * on.normal, on.triangle,
-              static_cast<int>(m));
-        }
-        break;
+      const int m = index_of_object(meshes, held->object_id[s]);
+      if (m < 0) continue;
+      const WalkedMesh& placed = meshes[static_cast<std::size_t>(m)];
+      MeshEntry on;
+      if (on_triangle(placed, held->triangle[s], x, on) &&
+          on.normal.dot(to_body(placed, finger_m) - on.point_m) < -kOnSurface_m) {
+        add(walk, placed.com_m + placed.axes * on.point_m, placed.axes * on.normal, on.triangle, m);
       }
     }
   }
@@ -203,28 +214,26 @@ Eigen::Vector3d stop_at_meshes(const PlaneSet& planes, const Eigen::Vector3d& fr
     // A convex body lies behind each of its planes the god-object holds (a triangle's, or the tangent plane of one the
     // walk held nothing of), and the proxy is in front of them: only a mesh with a concave bend can be gone into.
     if (mesh->convex()) continue;
-    bool listed = false;  // a mesh the walk held several triangles of has a plane for each
-    for (std::size_t m = 0; m < count && !listed; ++m) listed = meshes[m].object_id == plane.object_id;
-    if (!listed) meshes[count++] = {mesh, plane.com_m, plane.axes, plane.dynamic(), plane.object_id};
+    // A mesh the walk held several triangles of has a plane for each: listed once.
+    if (index_of_object(std::span<const WalkedMesh>(meshes.data(), count), plane.object_id) < 0) {
+      meshes[count++] = {mesh, plane.com_m, plane.axes, plane.dynamic(), plane.object_id};
+    }
   }
+  const std::span<const WalkedMesh> listed(meshes.data(), count);
   // Both ends on one held triangle: the way between them is on it too (a triangle is convex).
   for (int i = 0; held != nullptr && i < held->count; ++i) {
     const auto s = static_cast<std::size_t>(i);
-    for (std::size_t m = 0; m < count; ++m) {
-      if (meshes[m].object_id != held->object_id[s]) continue;
-      MeshEntry on;
-      if (meshes[m].mesh->on_triangle(held->triangle[s], to_body(meshes[m], from_m), kOnSurface_m, on) &&
-          meshes[m].mesh->on_triangle(held->triangle[s], to_body(meshes[m], to_m), kOnSurface_m, on)) {
-        return to_m;
-      }
+    const int m = index_of_object(listed, held->object_id[s]);
+    MeshEntry on;
+    if (m >= 0 && on_triangle(listed[static_cast<std::size_t>(m)], held->triangle[s], from_m, on) &&
+        on_triangle(listed[static_cast<std::size_t>(m)], held->triangle[s], to_m, on)) {
+      return to_m;
     }
   }
   MeshEntry entry;
   int mesh = 0;
   const MeshWalk none;
-  return count > 0 && first_entry(std::span<const WalkedMesh>(meshes.data(), count), none, from_m, to_m, entry, mesh)
-             ? entry.point_m
-             : to_m;
+  return count > 0 && first_entry(listed, none, from_m, to_m, entry, mesh) ? entry.point_m : to_m;
 }
 
 MeshHold held_by(const MeshWalk& walk, std::span<const WalkedMesh> meshes) {
