@@ -373,16 +373,25 @@ async function clay(procs, browser) {
   // Until the press is over: the device ends its trajectory and exits.
   await waitFor("the press to end", () => device.exitCode !== null, 20000, 50);
   await procs.stop(haptic);
-  // The world's last step may still apply the last report: compare with world.csv's newest row each time.
+  // The world's next step may still apply the last report the controller sent: compare with world.csv's newest row
+  // each time, and only once that row has held for 200 ms (four world steps at 20 Hz), so the dent is final.
   let dentM = 0;
   let seen = null;
+  let dentSince = Date.now();
+  const newestDent = () => {
+    const { columns, row } = lastRow(worldCsv);
+    return row[columns.indexOf("clay.dent_m")];
+  };
   try {
     await waitFor("the page's dent", async () => {
-      const { columns, row } = lastRow(worldCsv);
-      dentM = row[columns.indexOf("clay.dent_m")];
+      const newest = newestDent();
+      if (newest !== dentM) {
+        dentM = newest;
+        dentSince = Date.now();
+      }
       seen = await view(page);
       const shown = seen?.dent;
-      return shown && Math.abs(shown.deepest_m - dentM) <= 1e-6 * dentM;
+      return Date.now() - dentSince >= 200 && shown && Math.abs(shown.deepest_m - dentM) <= 1e-6 * dentM;
     }, 5000, 50);
   } catch (error) {
     throw new Failure(`${error.message}: world.csv has ${dentM} m, the page ${JSON.stringify(seen?.dent)} ` +
@@ -395,6 +404,7 @@ async function clay(procs, browser) {
   state.pressedAt = await page.evaluate(() => window.impetusView.projectPoint([0, 0, 0.027]));
   await procs.stop(viewer);
   await procs.stop(world);
+  dentM = newestDent();
 
   check(dentM > 0.002, `the press dented the clay (${(1e3 * dentM).toFixed(2)} mm in world.csv)`);
   check(state.dent.body === 0 && Math.abs(state.dent.deepest_m - dentM) <= 1e-6 * dentM,
