@@ -154,25 +154,9 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
         plane.deformable() ? std::max(0.0, -impulse_Ns.dot(plane.normal) - plane.yield_force_N * dt_s) : 0.0;
     ImpulseShare& share = last_shares_[static_cast<std::size_t>(last_share_count_++)];
     share = {plane.object_id, plane.dynamic(), impulse_Ns, angular_Nms, press_Ns};
-    if (!plane.dynamic() && !plane.deformable()) {
-      add_to(report_.static_impulse_Ns, impulse_Ns);
-      continue;
-    }
-    ObjectImpulse* entry = entry_for(plane.object_id);
-    if (!entry) {
-      dropped_Ns_ += impulse_Ns;
-      ++dropped_shares_;
-      continue;
-    }
-    add_to(entry->impulse_Ns, impulse_Ns);
-    add_to(entry->angular_impulse_Nms, angular_Nms);
-    // First moments in time (common/contract/frames.h ObjectImpulse): where in the world period this impulse belongs.
-    add_to(entry->impulse_moment_Nss, impulse_Ns * report_.haptic_time_s);
-    add_to(entry->angular_impulse_moment_Nmss, angular_Nms * report_.haptic_time_s);
     share.credit_J = std::max(0.0, impulse_Ns.dot(finger_velocity_mps));
-    share.entry = entry;
-    entry->hand_input_J += share.credit_J;
-    if (press_Ns > 0.0) {
+    ObjectImpulse* entry = book(share, plane.deformable(), tick);
+    if (entry && press_Ns > 0.0) {
       const Eigen::Vector3d& x_m = contact.proxy_m;
       entry->press_Ns += press_Ns;
       add_to(entry->press_point_Nsm, press_Ns * x_m);
@@ -184,7 +168,44 @@ void ImpulseAccumulator::add(const PlaneSet& planes, const ProxySolution& contac
       point2[4] += press_Ns * x_m.y() * x_m.z();
       point2[5] += press_Ns * x_m.z() * x_m.z();
     }
-    entry->last_tick = tick;
+  }
+}
+
+ObjectImpulse* ImpulseAccumulator::book(ImpulseShare& share, bool deformable, std::uint64_t tick) {
+  ObjectImpulse* entry = share.dynamic || deformable ? entry_for(share.object_id) : nullptr;
+  if (!entry) {
+    if (share.dynamic || deformable) {
+      dropped_Ns_ += share.impulse_Ns;
+      ++dropped_shares_;
+    } else {
+      add_to(report_.static_impulse_Ns, share.impulse_Ns);
+    }
+    share.credit_J = 0.0;
+    share.entry = nullptr;
+    return nullptr;
+  }
+  add_to(entry->impulse_Ns, share.impulse_Ns);
+  add_to(entry->angular_impulse_Nms, share.angular_impulse_Nms);
+  // First moments in time (common/contract/frames.h ObjectImpulse): where in the world period this impulse belongs.
+  add_to(entry->impulse_moment_Nss, share.impulse_Ns * report_.haptic_time_s);
+  add_to(entry->angular_impulse_moment_Nmss, share.angular_impulse_Nms * report_.haptic_time_s);
+  share.entry = entry;
+  entry->hand_input_J += share.credit_J;
+  entry->last_tick = tick;
+  return entry;
+}
+
+void ImpulseAccumulator::add_shares(const ImpulseShare* shares, int count, std::uint64_t tick) {
+  hand_tick_ = tick;
+  last_share_count_ = 0;
+  for (int k = 0; k < count; ++k) {
+    ImpulseShare share = shares[k];
+    share.yielding_Ns = 0.0;
+    total_Ns_ += share.impulse_Ns;
+    book(share, false, tick);
+    if (last_share_count_ < static_cast<int>(last_shares_.size())) {
+      last_shares_[static_cast<std::size_t>(last_share_count_++)] = share;
+    }
   }
 }
 

@@ -75,6 +75,11 @@ class ImpulseAccumulator {
   void add(const PlaneSet& planes, const ProxySolution& contact, const Eigen::Vector3d& force_on_finger_N, double dt_s,
            std::uint64_t tick);
 
+  // Adds the reaction of one tick already shared out (a tool's contacts, tool/tool_proxy.h): each share's impulse and
+  // angular impulse about its object's centre, its credit_J the hand's work behind it, booked as add() books its own
+  // (no press: a tool does not dent a deformable surface yet, whose share goes to the static total).
+  void add_shares(const ImpulseShare* shares, int count, std::uint64_t tick);
+
   HapticReport& report() { return report_; }
   const HapticReport& report() const { return report_; }
 
@@ -98,6 +103,10 @@ class ImpulseAccumulator {
 
  private:
   ObjectImpulse* entry_for(std::int32_t object_id);
+  // Books a share into the report: its object's entry (impulse, angular impulse, their first moments in time, the
+  // hand's credit, the tick), or the static total for a body neither dynamic nor `deformable`; dropped and counted
+  // when no entry is left. Sets share.entry (nullptr unless booked) and zeroes the credit of an unbooked share.
+  ObjectImpulse* book(ImpulseShare& share, bool deformable, std::uint64_t tick);
 
   HapticReport report_{};
   std::uint64_t applied_tick_ = 0;
@@ -108,7 +117,7 @@ class ImpulseAccumulator {
   Eigen::Vector3d dropped_Ns_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d abandoned_Ns_ = Eigen::Vector3d::Zero();
   std::uint64_t dropped_shares_ = 0;
-  std::array<ImpulseShare, kMaxActiveConstraints + 1> last_shares_{};
+  std::array<ImpulseShare, kMaxServoPlanes> last_shares_{};
   int last_share_count_ = 0;
   // The tick and finger position of the last add(): the next add() pairs its force with the displacement since.
   std::uint64_t hand_tick_ = 0;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "common/hand/grip_hand.h"
 
+#include "common/contract/rotation.h"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -21,13 +23,6 @@ FingerParams linear_part(const GripHandParams& params) {
   return linear;
 }
 
-// exp of a rotation vector, as a unit quaternion.
-Eigen::Quaterniond turn_of(const Eigen::Vector3d& rotation_vector) {
-  const double angle = rotation_vector.norm();
-  if (!(angle > 0.0)) return Eigen::Quaterniond::Identity();
-  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, rotation_vector / angle));
-}
-
 }  // namespace
 
 GripHand::GripHand(const GripHandParams& params, const GripPose& start)
@@ -42,11 +37,7 @@ GripHand::GripHand(const GripHandParams& params, const GripPose& start)
 }
 
 Eigen::Vector3d GripHand::turn_between(const Eigen::Quaterniond& from, const Eigen::Quaterniond& to) {
-  Eigen::Quaterniond turn = to * from.conjugate();
-  if (turn.w() < 0.0) turn.coeffs() = -turn.coeffs();  // q and −q are one turn: the one of angle ≤ π
-  const double sine = turn.vec().norm();
-  if (!(sine > 0.0)) return Eigen::Vector3d::Zero();
-  return 2.0 * std::atan2(sine, turn.w()) * (turn.vec() / sine);
+  return impetus::turn_between(from, to);
 }
 
 void GripHand::step(const GripPose& target, const Eigen::Vector3d& target_velocity_mps,
@@ -59,7 +50,7 @@ void GripHand::step(const GripPose& target, const Eigen::Vector3d& target_veloci
       params_.rotational_damping_Nmsprad * (target_angular_velocity_radps - angular_velocity_radps_);
   const Eigen::Vector3d torque_Nm = spring_Nm + damper_Nm + device.tail<3>();
   angular_velocity_radps_ += (h_s / params_.inertia_kgm2) * torque_Nm;
-  orientation_ = (turn_of(h_s * angular_velocity_radps_) * orientation_).normalized();
+  orientation_ = turned(orientation_, h_s * angular_velocity_radps_);
 }
 
 }  // namespace impetus

@@ -178,6 +178,40 @@ int support_corners(const Shape& shape, const Eigen::Matrix3d& axes, const Eigen
   return 4;
 }
 
+// The eight corners (its edges are edges).
+int contact_samples(const Shape& shape, ContactSamples& samples) {
+  const Eigen::Vector3d half_m = half_sizes(shape);
+  for (int c = 0; c < 8; ++c) {
+    samples[static_cast<std::size_t>(c)] = {
+        Eigen::Vector3d((c & 1) ? half_m.x() : -half_m.x(), (c & 2) ? half_m.y() : -half_m.y(),
+                        (c & 4) ? half_m.z() : -half_m.z()),
+        0.0};
+  }
+  return 8;
+}
+
+// The twelve edges, four along each axis, with the normals of the two faces that meet at each.
+int contact_edges(const Shape& shape, ContactEdges& edges) {
+  const Eigen::Vector3d half_m = half_sizes(shape);
+  int count = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+    for (int edge = 0; edge < 4; ++edge) {
+      Eigen::Vector3d from_m;
+      from_m[axis] = -half_m[axis];
+      from_m[a] = (edge & 1) ? half_m[a] : -half_m[a];
+      from_m[b] = (edge & 2) ? half_m[b] : -half_m[b];
+      Eigen::Vector3d to_m = from_m;
+      to_m[axis] = half_m[axis];
+      Eigen::Vector3d face_a = Eigen::Vector3d::Zero(), face_b = Eigen::Vector3d::Zero();
+      face_a[a] = (edge & 1) ? 1.0 : -1.0;
+      face_b[b] = (edge & 2) ? 1.0 : -1.0;
+      edges[static_cast<std::size_t>(count++)] = {from_m, to_m, 0.0, face_a, face_b};
+    }
+  }
+  return count;
+}
+
 constexpr std::string_view kKeys[] = {"size_m"};
 
 }  // namespace
@@ -199,6 +233,8 @@ const ShapeKindOps kBoxOps{
     .retake = retake,
     .nearest_faces = nearest_faces,
     .support_corners = support_corners,
+    .contact_samples = contact_samples,
+    .contact_edges = contact_edges,
 };
 
 }  // namespace impetus::shape_detail

@@ -102,6 +102,20 @@ void retake(ShapePlane& plane, const Eigen::Vector3d& around_m) {
   retake_about_centre(plane, plane.com_m + along_m * axis, plane.shape.radius_m, around_m);
 }
 
+// Its two cap centres at its radius (its side is its axis, an edge).
+int contact_samples(const Shape& shape, ContactSamples& samples) {
+  samples[0] = {Eigen::Vector3d(0.0, 0.0, -0.5 * shape.length_m), shape.radius_m};
+  samples[1] = {Eigen::Vector3d(0.0, 0.0, 0.5 * shape.length_m), shape.radius_m};
+  return 2;
+}
+
+// The axis, cap centre to cap centre, swept by the radius: the whole capsule.
+int contact_edges(const Shape& shape, ContactEdges& edges) {
+  edges[0] = {Eigen::Vector3d(0.0, 0.0, -0.5 * shape.length_m), Eigen::Vector3d(0.0, 0.0, 0.5 * shape.length_m),
+              shape.radius_m};
+  return 1;
+}
+
 constexpr std::string_view kKeys[] = {"radius_m", "length_m"};
 
 }  // namespace
@@ -123,6 +137,8 @@ const ShapeKindOps kCapsuleOps{
     .retake = retake,
     .nearest_faces = nullptr,
     .support_corners = nullptr,
+    .contact_samples = contact_samples,
+    .contact_edges = contact_edges,
 };
 
 }  // namespace impetus::shape_detail

@@ -149,6 +149,28 @@ void retake(ShapePlane& plane, const Eigen::Vector3d& around_m) {
   plane.point_m = plane.com_m + plane.axes * nearest_local_m;
 }
 
+// Points around both rims, 16 each: against a plane a cylinder's deepest points are on a rim.
+int contact_samples(const Shape& shape, ContactSamples& samples) {
+  constexpr int kPerRim = 16;
+  static_assert(2 * kPerRim <= kMaxContactSamples);
+  int count = 0;
+  for (const double z_m : {-0.5 * shape.length_m, 0.5 * shape.length_m}) {
+    for (int k = 0; k < kPerRim; ++k) {
+      const double angle = 2.0 * std::numbers::pi * k / kPerRim;
+      samples[static_cast<std::size_t>(count++)] = {
+          Eigen::Vector3d(shape.radius_m * std::cos(angle), shape.radius_m * std::sin(angle), z_m), 0.0};
+    }
+  }
+  return count;
+}
+
+// The axis, end to end, swept by the radius: the side, where another body's edge crosses it.
+int contact_edges(const Shape& shape, ContactEdges& edges) {
+  edges[0] = {Eigen::Vector3d(0.0, 0.0, -0.5 * shape.length_m), Eigen::Vector3d(0.0, 0.0, 0.5 * shape.length_m),
+              shape.radius_m};
+  return 1;
+}
+
 constexpr std::string_view kKeys[] = {"radius_m", "length_m"};
 
 }  // namespace
@@ -170,6 +192,8 @@ const ShapeKindOps kCylinderOps{
     .retake = retake,
     .nearest_faces = nullptr,
     .support_corners = nullptr,
+    .contact_samples = contact_samples,
+    .contact_edges = contact_edges,
 };
 
 }  // namespace impetus::shape_detail

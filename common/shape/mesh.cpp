@@ -91,6 +91,8 @@ const ShapeKindOps kMeshOps{
     .retake = retake,
     .nearest_faces = nullptr,
     .support_corners = nullptr,
+    .contact_samples = nullptr,
+    .contact_edges = nullptr,
 };
 
 }  // namespace impetus::shape_detail

@@ -32,6 +32,8 @@ const ShapeKindOps kNoneOps{
     .retake = nullptr,
     .nearest_faces = nullptr,
     .support_corners = nullptr,
+    .contact_samples = nullptr,
+    .contact_edges = nullptr,
 };
 
 // Indexed by ShapeKind's value.
@@ -188,6 +190,16 @@ int support_corners(const Shape& shape, const Eigen::Matrix3d& axes, const Eigen
                     std::array<Eigen::Vector3d, 4>& corners) {
   const ShapeKindOps& kind = ops(shape.kind);
   return kind.support_corners != nullptr ? kind.support_corners(shape, axes, n, corners) : 0;
+}
+
+int contact_edges(const Shape& shape, ContactEdges& edges) {
+  const ShapeKindOps& kind = ops(shape.kind);
+  return kind.contact_edges != nullptr ? kind.contact_edges(shape, edges) : 0;
+}
+
+int contact_samples(const Shape& shape, ContactSamples& samples) {
+  const ShapeKindOps& kind = ops(shape.kind);
+  return kind.contact_samples != nullptr ? kind.contact_samples(shape, samples) : 0;
 }
 
 }  // namespace impetus

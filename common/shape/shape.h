@@ -157,4 +157,38 @@ bool segment_enters(const ShapePlane& plane, const Eigen::Vector3d& from_m, cons
 int support_corners(const Shape& shape, const Eigen::Matrix3d& axes, const Eigen::Vector3d& n,
                     std::array<Eigen::Vector3d, 4>& corners);
 
+// --- Contact features (a rigid tool's contacts, docs/tool.md) ---------------------------------------------------
+
+// Where two convex bodies touch, a corner of one meets the other's surface, or an edge of each crosses the other
+// (the features of polyhedral contact, as the separating-axis test names them); a round part touches as its core
+// swept by its radius. So a shape's contacts are stood for by its samples (balls: its corners, or the cores of its
+// round parts), each tested against the other body's exact surface, and its edges (segments swept by balls), each
+// tested against the other body's edges where they cross.
+struct ContactSample {
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  // body frame, within the shape
+  double radius_m = 0.0;
+};
+inline constexpr int kMaxContactSamples = 32;
+using ContactSamples = std::array<ContactSample, kMaxContactSamples>;
+// The kind's samples: a box's eight corners; a ball's centre and a capsule's two cap centres (radius r); a
+// cylinder's two rims, 16 points each (a chord of 22.5° lies within r·(1 − cos 11.25°) = 0.019·r of the rim). Returns
+// the count (0: the kind has none yet — a mesh).
+int contact_samples(const Shape& shape, ContactSamples& samples);
+
+struct ContactEdge {
+  Eigen::Vector3d from_m = Eigen::Vector3d::Zero();  // body frame
+  Eigen::Vector3d to_m = Eigen::Vector3d::Zero();
+  double radius_m = 0.0;
+  // A sharp edge's two faces' outward normals (body frame): the directions the edge can push along lie between them
+  // (its normal cone). Zero for a round edge, which pushes along any direction across it.
+  Eigen::Vector3d face_a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d face_b = Eigen::Vector3d::Zero();
+};
+inline constexpr int kMaxContactEdges = 12;
+using ContactEdges = std::array<ContactEdge, kMaxContactEdges>;
+// The kind's edges: a box's twelve (radius 0, with their faces); the axis of a capsule or a cylinder, cap centre to
+// cap centre, swept by r (a cylinder's side; its flat caps are met by the other body's samples, its rims by its own).
+// None for a ball or a mesh. Returns the count.
+int contact_edges(const Shape& shape, ContactEdges& edges);
+
 }  // namespace impetus

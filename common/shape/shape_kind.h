@@ -35,6 +35,8 @@ struct ShapeKindOps {
                        std::array<Eigen::Vector3d, 3>& normals);
   int (*support_corners)(const Shape& shape, const Eigen::Matrix3d& axes, const Eigen::Vector3d& n,
                          std::array<Eigen::Vector3d, 4>& corners);
+  int (*contact_samples)(const Shape& shape, ContactSamples& samples);
+  int (*contact_edges)(const Shape& shape, ContactEdges& edges);
 };
 
 extern const ShapeKindOps kBoxOps;

@@ -50,6 +50,12 @@ void retake(ShapePlane& plane, const Eigen::Vector3d& around_m) {
   retake_about_centre(plane, plane.point_m - plane.shape.radius_m * plane.normal, plane.shape.radius_m, around_m);
 }
 
+// A ball is its centre at its radius: exact against any other body.
+int contact_samples(const Shape& shape, ContactSamples& samples) {
+  samples[0] = {Eigen::Vector3d::Zero(), shape.radius_m};
+  return 1;
+}
+
 constexpr std::string_view kKeys[] = {"radius_m"};
 
 }  // namespace
@@ -71,6 +77,8 @@ const ShapeKindOps kSphereOps{
     .retake = retake,
     .nearest_faces = nullptr,
     .support_corners = nullptr,
+    .contact_samples = contact_samples,
+    .contact_edges = nullptr,
 };
 
 }  // namespace impetus::shape_detail

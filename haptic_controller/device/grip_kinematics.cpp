@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "haptic_controller/device/grip_kinematics.h"
 
+#include "common/contract/rotation.h"
+
 #include <Eigen/Cholesky>
 
 #include <cmath>
@@ -29,11 +31,7 @@ double residuals(const GripStrings& strings, const GripPose& pose, const GripLen
 GripPose moved(const GripPose& pose, const Eigen::Matrix<double, 6, 1>& step) {
   GripPose next;
   next.position_m = pose.position_m + step.head<3>();
-  const Eigen::Vector3d turn = step.tail<3>();
-  const double angle = turn.norm();
-  next.orientation = angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, turn / angle)) * pose.orientation
-                                 : pose.orientation;
-  next.orientation.normalize();
+  next.orientation = turned(pose.orientation, step.tail<3>());
   return next;
 }
 

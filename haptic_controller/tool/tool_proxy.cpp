@@ -1,0 +1,305 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "haptic_controller/tool/tool_proxy.h"
+
+#include "common/contract/rotation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace impetus {
+namespace {
+
+static_assert(kMaxToolConstraints == kMaxContactRows);
+
+// Rounding room for the reach of a pass: the bound itself is exact (below), this only keeps a contact exactly at it.
+constexpr double kReachRounding_m = 1e-9;
+
+void require(bool ok, const char* field, const char* rule) {
+  if (!ok) throw std::invalid_argument(std::string("tool coupling: ") + field + " " + rule);
+}
+
+bool finite(const BodyPose& pose) {
+  return pose.position_m.allFinite() && pose.orientation.coeffs().allFinite() && pose.orientation.norm() > 0.0;
+}
+
+// e = (x_p − x_d, θ): the proxy's displacement from the grip, θ the turn that takes the grip's orientation to the
+// proxy's.
+Vector6d displacement(const BodyPose& proxy, const BodyPose& grip) {
+  Vector6d e;
+  e.head<3>() = proxy.position_m - grip.position_m;
+  e.tail<3>() = turn_between(grip.orientation, proxy.orientation);
+  return e;
+}
+
+}  // namespace
+
+ToolProxy::ToolProxy(const ToolShape& tool, const ToolCoupling& coupling) : contacts_(tool), coupling_(coupling) {
+  const ToolCoupling& c = coupling;
+  require(std::isfinite(c.stiffness_Npm) && c.stiffness_Npm > 0.0, "stiffness_Npm", "must be > 0");
+  require(std::isfinite(c.rotational_stiffness_Nmprad) && c.rotational_stiffness_Nmprad > 0.0,
+          "rotational_stiffness_Nmprad", "must be > 0");
+  require(std::isfinite(c.damping_Nspm) && c.damping_Nspm >= 0.0, "damping_Nspm", "must be >= 0");
+  require(std::isfinite(c.rotational_damping_Nmsprad) && c.rotational_damping_Nmsprad >= 0.0,
+          "rotational_damping_Nmsprad", "must be >= 0");
+  require(c.max_force_N > 0.0 && !std::isnan(c.max_force_N), "max_force_N", "must be > 0");
+  require(c.max_torque_Nm > 0.0 && !std::isnan(c.max_torque_Nm), "max_torque_Nm", "must be > 0");
+}
+
+void ToolProxy::reset(const BodyPose& grip) {
+  proxy_ = {grip.position_m, grip.orientation.normalized()};
+  grip_ = proxy_;
+  started_ = finite(proxy_);
+  previous_displacement_.setZero();
+  session_start_ = true;
+  sunk_count_ = 0;
+  grip_velocity_mps_.setZero();
+  grip_angular_velocity_radps_.setZero();
+  zero_output();
+}
+
+void ToolProxy::zero_output() {
+  force_count_ = 0;
+  share_count_ = 0;
+  result_ = ToolResult{};
+  result_.proxy = proxy_;
+}
+
+const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_in, double dt_s) {
+  ++counters_.solves;
+  const BodyPose grip{grip_in.position_m, grip_in.orientation.normalized()};
+  if (!finite(grip) || !(dt_s > 0.0) || !std::isfinite(dt_s)) {
+    ++counters_.faults;
+    zero_output();
+    result_.fault = true;
+    return result_;
+  }
+  if (!started_) reset(grip);
+  const bool session_start = session_start_;
+  session_start_ = false;
+  grip_velocity_mps_ = (grip.position_m - grip_.position_m) / dt_s;
+  grip_angular_velocity_radps_ = turn_between(grip_.orientation, grip.orientation) / dt_s;
+  grip_ = grip;
+
+  // Nothing in the way: the proxy is the grip, and there is no wrench (a tool that leaves a surface lets go at once).
+  if (contacts_.path_clear(planes, proxy_, grip)) {
+    proxy_ = grip;
+    previous_displacement_.setZero();
+    sunk_count_ = 0;
+    zero_output();
+    return result_;
+  }
+  const BodyPose proxy_before = proxy_;
+  result_ = ToolResult{};
+  // The god-object: the pose nearest the grip in the springs' metric that the contacts allow; again from where a
+  // pass put it while a contact acts and the pass still moved the tool (the linearised turn and curved surfaces are
+  // exact only for a move that vanishes). The first pass gathers the contacts within its reach; a later one measures
+  // the same ones again where the tool now is, unless the passes together have moved the tool farther than that
+  // reach (then some other contact may have come within it, and the pass is made again from a new gathering).
+  double travelled_m = 0.0, turned_rad = 0.0;
+  for (int p = 0; p < kMaxToolPasses; ++p) {
+    const Vector6d target = -displacement(proxy_, grip);
+    const BodyPose before = proxy_;
+    Vector6d q;
+    if (p > 0) {
+      contacts_.refresh(planes, proxy_, gathered_);
+      q = pass(planes, target, false, false);
+      travelled_m += q.head<3>().norm();
+      turned_rad += q.tail<3>().norm();
+    }
+    if (p == 0 || travelled_m > gathered_.linear_m || turned_rad > gathered_.angular_rad) {
+      proxy_ = before;
+      q = pass(planes, target, true, session_start && p == 0);
+      travelled_m = q.head<3>().norm();
+      turned_rad = q.tail<3>().norm();
+    }
+    const double moved_m = q.head<3>().norm() + q.tail<3>().norm() * contacts_.bounding_radius_m();
+    if (result_.active == 0 || moved_m <= kToolSettled_m) break;
+  }
+  release_sunk();
+  const Vector6d e = displacement(proxy_, grip);
+  damp(e, dt_s);
+  previous_displacement_ = e;
+
+  // The wrench on the grip is the contacts' pushes, carried by the massless proxy: their sum, and their moments about
+  // the grip's centre at the points where the objects receive them (the tool's and the object's points of a contact
+  // differ only along its normal, so the world's torque and the hand's cancel exactly).
+  Eigen::Vector3d force_N = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque_Nm = Eigen::Vector3d::Zero();
+  for (int k = 0; k < force_count_; ++k) {
+    const ToolContactForce& f = forces_[static_cast<std::size_t>(k)];
+    force_N += f.force_N * f.normal;
+    torque_Nm += (f.tool_point_m - grip.position_m).cross(f.force_N * f.normal);
+  }
+  if (!force_N.allFinite() || !torque_Nm.allFinite() || !finite(proxy_)) {
+    ++counters_.faults;
+    proxy_ = proxy_before;
+    zero_output();
+    result_.fault = true;
+    return result_;
+  }
+  double scale = 1.0;
+  if (force_N.norm() > coupling_.max_force_N) scale = coupling_.max_force_N / force_N.norm();
+  if (scale * torque_Nm.norm() > coupling_.max_torque_Nm) scale = coupling_.max_torque_Nm / torque_Nm.norm();
+  if (scale < 1.0) {
+    ++counters_.clamps;
+    for (int k = 0; k < force_count_; ++k) forces_[static_cast<std::size_t>(k)].force_N *= scale;
+  }
+  result_.force_N = scale * force_N;
+  result_.torque_Nm = scale * torque_Nm;
+  result_.scale = scale;
+  result_.proxy = proxy_;
+  share_reaction(planes, grip, dt_s);
+  return result_;
+}
+
+void ToolProxy::damp(const Vector6d& displacement_now, double dt_s) {
+  // The spring's wrench K·e is Σ λ_i·a_i (the pass's multipliers). The damper adds B·(e − e_prev)/Δt; the sum is
+  // projected onto the cone of the acting contacts' pushes {Σ μ_i·a_i : μ_i ≥ 0}: a contact pushes, it never pulls,
+  // so the damper brakes an approach but does not drag the tool after a surface it leaves (force_renderer.h in 3 DoF).
+  // The projection is the polar decomposition w = Σ μ_i·a_i + u with a_iᵀu ≤ 0 (Moreau), solved as the QP of
+  // contact_qp.h for u, in units scaled by the stiffnesses (force/√k, torque/√k_r) so force and torque weigh alike.
+  Vector6d spring = Vector6d::Zero();
+  int acting = 0;
+  for (int k = 0; k < contacts_.count(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    if (!(lambda_[i] > 0.0)) continue;
+    spring += lambda_[i] * rows_[i].a;
+    acting_[static_cast<std::size_t>(acting++)] = k;
+  }
+  const Vector6d rate = (displacement_now - previous_displacement_) / dt_s;
+  Vector6d wrench = spring;
+  wrench.head<3>() += coupling_.damping_Nspm * rate.head<3>();
+  wrench.tail<3>() += coupling_.rotational_damping_Nmsprad * rate.tail<3>();
+  Vector6d unit_scale;
+  const double force_scale = 1.0 / std::sqrt(coupling_.stiffness_Npm);
+  const double torque_scale = 1.0 / std::sqrt(coupling_.rotational_stiffness_Nmprad);
+  unit_scale << force_scale, force_scale, force_scale, torque_scale, torque_scale, torque_scale;
+  for (int j = 0; j < acting; ++j) {
+    ContactQpRow& row = cone_rows_[static_cast<std::size_t>(j)];
+    row.a = -rows_[static_cast<std::size_t>(acting_[static_cast<std::size_t>(j)])].a.cwiseProduct(unit_scale);
+    row.gap_m = 0.0;
+  }
+  const ContactQpResult projected =
+      solve_contact_qp(cone_rows_, acting, Vector6d::Ones(), wrench.cwiseProduct(unit_scale), mu_);
+  if (!projected.converged) ++counters_.unconverged;
+  force_count_ = 0;
+  for (int j = 0; j < acting; ++j) {
+    const double mu_N = mu_[static_cast<std::size_t>(j)];
+    if (!(mu_N > 0.0)) continue;
+    const ToolConstraint& c = contacts_[acting_[static_cast<std::size_t>(j)]];
+    forces_[static_cast<std::size_t>(force_count_++)] = {c.plane, c.object_id, c.normal, c.tool_point_m,
+                                                         c.object_point_m, mu_N};
+  }
+}
+
+Vector6d ToolProxy::pass(const PlaneSet& planes, const Vector6d& target, bool gather, bool mark_sunk) {
+  const double k_Npm = coupling_.stiffness_Npm;
+  const double k_r_Nmprad = coupling_.rotational_stiffness_Nmprad;
+  // The move q minimises ½(q − q*)ᵀK(q − q*) over a convex set that holds q = 0 (every gap is kept ≥ 0), so
+  // |q|_K ≤ |q*|_K (projection onto it does not lengthen): the proxy moves at most |q*|_K/√k and turns at most
+  // |q*|_K/√k_r, and a contact farther than that cannot act in this pass.
+  const double reach_K =
+      std::sqrt(k_Npm * target.head<3>().squaredNorm() + k_r_Nmprad * target.tail<3>().squaredNorm());
+  int count = contacts_.count();
+  if (gather) {
+    ToolReach reach{reach_K / std::sqrt(k_Npm) + kReachRounding_m, reach_K / std::sqrt(k_r_Nmprad)};
+    count = contacts_.gather(planes, proxy_, reach);
+    if (mark_sunk) {
+      for (int k = 0; k < count; ++k) {
+        if (contacts_[k].gap_m < 0.0) sink(contacts_[k].object_id);
+      }
+    }
+    // A body the proxy is inside that it did not start in (one that came onto the tool, or the last pass's
+    // linearised turn) pushes it out: the move may then be longer by the depth (twice it, for a push-out between
+    // oblique faces).
+    double deepest_m = 0.0;
+    for (int k = 0; k < count; ++k) {
+      if (!sunk(contacts_[k].object_id)) deepest_m = std::max(deepest_m, -contacts_[k].gap_m);
+    }
+    if (deepest_m > 0.0) {
+      reach.linear_m += 2.0 * deepest_m;
+      count = contacts_.gather(planes, proxy_, reach);
+    }
+    gathered_ = reach;
+    ++result_.gathers;
+  }
+
+  // Rows a = [n; r × n]. A body the tool started inside keeps its gap ≥ 0: the proxy may not go deeper into it, but
+  // is not thrown out (its energy nobody put in).
+  for (int k = 0; k < count; ++k) {
+    const ToolConstraint& c = contacts_[k];
+    ContactQpRow& row = rows_[static_cast<std::size_t>(k)];
+    row.a.head<3>() = c.normal;
+    row.a.tail<3>() = (c.tool_point_m - proxy_.position_m).cross(c.normal);
+    const bool started_inside = sunk(c.object_id);
+    row.gap_m = started_inside ? std::max(c.gap_m, 0.0) : c.gap_m;
+  }
+  Vector6d metric;
+  metric << k_Npm, k_Npm, k_Npm, k_r_Nmprad, k_r_Nmprad, k_r_Nmprad;
+  const ContactQpResult solved = solve_contact_qp(rows_, count, metric, target, lambda_);
+  if (!solved.converged) ++counters_.unconverged;
+  proxy_.position_m += solved.q.head<3>();
+  proxy_.orientation = turned(proxy_.orientation, solved.q.tail<3>());
+
+  result_.constraints = count;
+  result_.active = solved.active;
+  result_.passes += 1;
+  result_.iterations += solved.iterations;
+  result_.converged = result_.converged && solved.converged;
+  return solved.q;
+}
+
+bool ToolProxy::sunk(std::int32_t object_id) const {
+  for (int k = 0; k < sunk_count_; ++k) {
+    if (sunk_[static_cast<std::size_t>(k)] == object_id) return true;
+  }
+  return false;
+}
+
+void ToolProxy::sink(std::int32_t object_id) {
+  if (sunk(object_id) || sunk_count_ == static_cast<int>(sunk_.size())) return;
+  sunk_[static_cast<std::size_t>(sunk_count_++)] = object_id;
+}
+
+void ToolProxy::release_sunk() {
+  // An object the tool started in is released once the last pass found the tool inside it nowhere.
+  for (int s = sunk_count_ - 1; s >= 0; --s) {
+    bool inside = false;
+    for (int k = 0; k < contacts_.count() && !inside; ++k) {
+      inside = contacts_[k].gap_m < 0.0 && contacts_[k].object_id == sunk_[static_cast<std::size_t>(s)];
+    }
+    if (!inside) sunk_[static_cast<std::size_t>(s)] = sunk_[static_cast<std::size_t>(--sunk_count_)];
+  }
+}
+
+void ToolProxy::share_reaction(const PlaneSet& planes, const BodyPose& grip, double dt_s) {
+  share_count_ = 0;
+  for (int k = 0; k < force_count_; ++k) {
+    const ToolContactForce& f = forces_[static_cast<std::size_t>(k)];
+    const ContactPlane& plane = planes.planes[static_cast<std::size_t>(f.plane)];
+    const Eigen::Vector3d impulse_Ns = -f.force_N * dt_s * f.normal;  // the user's push on the object (§3.4)
+    const Eigen::Vector3d centre_m = object_centre(plane);
+    const Eigen::Vector3d angular_Nms = (f.object_point_m - centre_m).cross(impulse_Ns);
+    // The hand's work behind the push: the grip's velocity at the contact, over the tick.
+    const Eigen::Vector3d hand_velocity_mps =
+        grip_velocity_mps_ + grip_angular_velocity_radps_.cross(f.tool_point_m - grip.position_m);
+    const double credit_J = std::max(0.0, impulse_Ns.dot(hand_velocity_mps));
+    int s = 0;
+    while (s < share_count_ && shares_[static_cast<std::size_t>(s)].object_id != f.object_id) ++s;
+    if (s == share_count_) {
+      if (share_count_ == static_cast<int>(shares_.size())) continue;  // cannot happen: one object per plane at most
+      ImpulseShare& fresh = shares_[static_cast<std::size_t>(share_count_++)];
+      fresh = ImpulseShare{};
+      fresh.object_id = f.object_id;
+      fresh.dynamic = plane.dynamic();
+    }
+    ImpulseShare& share = shares_[static_cast<std::size_t>(s)];
+    share.impulse_Ns += impulse_Ns;
+    share.angular_impulse_Nms += angular_Nms;
+    share.credit_J += credit_J;
+  }
+}
+
+}  // namespace impetus

@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// The 6-DoF god-object (docs/tool.md): the tool's proxy is a massless copy of the tool, held outside every object by
+// the contacts of tool_contacts.h and pulled toward the device's grip by a 6-DoF spring–damper, the coupling. The
+// wrench the coupling puts on the grip is what the hand feels; its reaction, contact by contact, is what the objects
+// receive, integrated tick by tick (paper §3.4 in 6 DoF).
+//
+// Each tick, with e = (x_p − x_d, θ) the proxy's displacement from the grip (θ the rotation vector of the turn from
+// the grip to the proxy):
+//  1. Where the tool can go straight from the proxy to the grip touching nothing (ToolContacts::path_clear), the
+//     proxy is the grip and there is no wrench.
+//  2. Else the proxy moves to the pose nearest the grip that the contacts allow, in the springs' metric
+//     K = diag(k·I, k_r·I): the move q minimises ½(q − q*)ᵀK(q − q*), q* = −e, under the linearised contacts
+//     gap_i + a_i·q ≥ 0, a_i = [n_i; r_i × n_i] for a contact pushing the tool along n_i at lever r_i from the proxy's
+//     centre; a small convex QP solved exactly (contact_qp.h), again from the moved pose while a contact acts and the
+//     pass moved the tool (the turn and curved surfaces are linearised). Its multipliers λ_i ≥ 0 carry the spring's
+//     wrench: K·e = Σ λ_i·a_i.
+//  3. The damper B = diag(b·I, b_r·I) adds B·(e − e_prev)/Δt, and the sum is projected onto the cone of the acting
+//     contacts' pushes, Σ μ_i·a_i with μ_i ≥ 0: a contact pushes, it never pulls.
+// The wrench on the grip is Σ μ_i·a_i (its torque carried to the grip's centre), exactly the sum of the contacts'
+// pushes, so what the world receives equals what the hand feels.
+//
+// Stability (docs/tool.md): a massless proxy held by rigid unilateral constraints is passive, and the sampled
+// coupling then needs the device's physical damping above K·T/2 per DoF (Colgate & Schenkel; Adams & Hannaford's
+// virtual coupling): b > k·T/2 and b_r > k_r·T/2. The virtual damper B adds the damping a hand's grip lacks in turning.
+//
+// Frames: world, SI; a pose is the grip's (its centre and orientation); torques about the grip's centre. Owned by
+// the servo thread; allocation-free, no exceptions after construction.
+
+#include "common/contract/frames.h"
+#include "common/shape/shape.h"
+#include "haptic_controller/contact_plane.h"
+#include "haptic_controller/impulse_accumulator.h"
+#include "haptic_controller/tool/contact_qp.h"
+#include "haptic_controller/tool/tool_contacts.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+
+namespace impetus {
+
+struct ToolCoupling {
+  double stiffness_Npm = 2000.0;               // k
+  double damping_Nspm = 2.0;                   // b: k·T at 1 kHz, as the point finger's default (force_renderer.h)
+  double rotational_stiffness_Nmprad = 20.0;   // k_r
+  double rotational_damping_Nmsprad = 0.02;    // b_r: k_r·T at 1 kHz
+  // The device's limits: a wrench beyond either is scaled down whole (its direction kept), and its reaction with it.
+  double max_force_N = 10.0;
+  double max_torque_Nm = 0.5;
+};
+
+struct ToolResult {
+  BodyPose proxy;  // the proxy's grip pose
+  Eigen::Vector3d force_N = Eigen::Vector3d::Zero();    // on the grip, after the limits
+  Eigen::Vector3d torque_Nm = Eigen::Vector3d::Zero();  // on the grip about its centre, after the limits
+  double scale = 1.0;        // the limits' scale of the wrench (1: within them)
+  int constraints = 0;       // contacts the last pass considered
+  int active = 0;            // of them, pushing (λ > 0)
+  int passes = 0;            // QP solves this tick (0: the way was clear)
+  int gathers = 0;           // of them, those that gathered the contacts afresh (tool_contacts.h)
+  int iterations = 0;        // the QP's contacts added and dropped, summed over the passes
+  bool converged = true;     // every pass solved its QP (contact_qp.h)
+  bool fault = false;        // a non-finite grip or result: no wrench, the proxy kept
+};
+
+// A contact's push on the tool in the last solve (after the limits' scale).
+struct ToolContactForce {
+  std::int32_t plane = -1;
+  std::int32_t object_id = -1;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // the push on the tool
+  Eigen::Vector3d tool_point_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d object_point_m = Eigen::Vector3d::Zero();
+  double force_N = 0.0;  // λ ≥ 0
+};
+
+// Passes a tick makes at most, and the move below which a pass is the last (m): the next would change the proxy by
+// the move's square over the surfaces' radius of curvature, far below it.
+inline constexpr int kMaxToolPasses = 4;
+inline constexpr double kToolSettled_m = 1e-7;
+
+struct ToolCounters {
+  std::uint64_t solves = 0;
+  std::uint64_t faults = 0;
+  std::uint64_t clamps = 0;          // wrenches scaled to the limits
+  std::uint64_t unconverged = 0;     // passes whose QP did not converge (contact_qp.h)
+};
+
+class ToolProxy {
+ public:
+  // Throws std::invalid_argument for an unusable tool shape (ToolContacts) or coupling (stiffnesses > 0, dampings and
+  // limits ≥ 0 / > 0, all finite), naming the field.
+  ToolProxy(const ToolShape& tool, const ToolCoupling& coupling);
+
+  // Puts the proxy on the grip, with no history (the device attached, a session restart).
+  void reset(const BodyPose& grip);
+
+  // One tick: the grip at `grip`, dt_s (> 0) after the last; `planes` the objects near the tool this tick.
+  const ToolResult& solve(const PlaneSet& planes, const BodyPose& grip, double dt_s);
+
+  const ToolResult& result() const { return result_; }
+  const ToolContactForce* contact_forces() const { return forces_.data(); }
+  int contact_force_count() const { return force_count_; }
+
+  // The reaction of the last solve per object, as impulses over its dt_s: linear, and angular about the object's
+  // centre of mass accumulated contact by contact ((object point − centre) × J). Each share's credit_J is the hand's
+  // work behind it: J·v at each contact, v the grip's velocity there over the tick, where positive.
+  const ImpulseShare* shares() const { return shares_.data(); }
+  int share_count() const { return share_count_; }
+
+  const ToolContacts& contacts() const { return contacts_; }
+  const ToolCoupling& coupling() const { return coupling_; }
+  const ToolCounters& counters() const { return counters_; }
+
+ private:
+  // One pass: gathers the contacts at the proxy now, solves the QP toward `target` and moves the proxy.
+  // One solve of the QP toward `target` from the proxy now, which it moves; returns the move (δx, δθ). `gather`:
+  // gathers the contacts within the move's reach first (else uses those gathered or refreshed last); `mark_sunk`:
+  // the first pass of a session, whose overlapped objects the tool started in.
+  Vector6d pass(const PlaneSet& planes, const Vector6d& target, bool gather, bool mark_sunk);
+  bool sunk(std::int32_t object_id) const;
+  void sink(std::int32_t object_id);
+  void release_sunk();
+  // The damper's part, and the pushes (forces_) that carry the wrench: step 3 of the header.
+  void damp(const Vector6d& displacement_now, double dt_s);
+  void share_reaction(const PlaneSet& planes, const BodyPose& grip, double dt_s);
+  void zero_output();
+
+  ToolContacts contacts_;
+  ToolCoupling coupling_;
+  BodyPose proxy_;
+  BodyPose grip_;  // at the last solve
+  bool started_ = false;
+  bool session_start_ = true;
+  // Objects the tool started inside (at reset): the proxy may not go deeper into them but is not pushed out, until
+  // it has left them (as the point finger's god-object, god_object.h).
+  std::array<std::int32_t, kMaxServoPlanes> sunk_{};
+  int sunk_count_ = 0;
+  Vector6d previous_displacement_ = Vector6d::Zero();
+  Eigen::Vector3d grip_velocity_mps_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d grip_angular_velocity_radps_ = Eigen::Vector3d::Zero();
+  ToolReach gathered_{};  // the reach the contacts were last gathered for
+  std::array<ContactQpRow, kMaxToolConstraints> rows_{};
+  std::array<double, kMaxToolConstraints> lambda_{};
+  std::array<ContactQpRow, kMaxToolConstraints> cone_rows_{};  // the acting contacts' pushes, for the damper's part
+  std::array<double, kMaxToolConstraints> mu_{};
+  std::array<int, kMaxToolConstraints> acting_{};
+  std::array<ToolContactForce, kMaxToolConstraints> forces_{};
+  int force_count_ = 0;
+  std::array<ImpulseShare, kMaxServoPlanes> shares_{};
+  int share_count_ = 0;
+  ToolResult result_{};
+  ToolCounters counters_{};
+};
+
+}  // namespace impetus

@@ -1,0 +1,225 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tick cost of a rigid tool's 6-DoF god-object (haptic_controller/tool/tool_proxy.h) among 16 objects (boxes, balls,
+// capsules, a cylinder and the floor), the grip wandering and turning through them, for a box peg and a capsule probe:
+// p50 / p99 / max in ns, how often it touched, the contacts and passes a tick. Beside it, in the same run, the point
+// finger's servo tick (HapticServo::tick) at the peg's tip on the hand's target path among the same 16 objects. Then the closed loop's stability
+// (the hand pressing the cube tool into a corner through lagging motors, tests/support/tool_scenes.h): the loop's
+// energy at the end over at the start, and its largest rise in a tick, over coupling stiffness, motor lag and the
+// dampers. Prints only; no assertions. `--ticks N` sets the ticks per tool (default 20000).
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "haptic_controller/servo.h"
+#include "haptic_controller/tool/tool_proxy.h"
+#include "tests/support/tool_scenes.h"
+
+using namespace impetus;
+using impetus::test::pose_at;
+
+namespace {
+
+constexpr int kTicksPerWorldStep = 50;  // 1 kHz servo, 20 Hz world
+
+Shape round_body(ShapeKind kind, double radius_m, double length_m = 0.0) {
+  Shape shape;
+  shape.kind = kind;
+  shape.radius_m = radius_m;
+  shape.length_m = length_m;
+  return shape;
+}
+
+// Sixteen objects within 7 cm of the origin, static, some turned: the planes the servo would carry for them.
+PlaneSet clutter() {
+  PlaneSet set;
+  set.planes[set.count++] = impetus::test::floor_plane(0);
+  set.planes[0].point_m = Eigen::Vector3d(0.0, 0.0, -0.06);
+  for (int k = 1; k < 16; ++k) {
+    const double a = 2.399963 * k;  // golden-angle spiral
+    const double z = 1.0 - 2.0 * (k + 0.5) / 16.0;
+    const double r = std::sqrt(1.0 - z * z);
+    const Eigen::Vector3d centre_m = (0.045 + 0.01 * (k % 3)) * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), z);
+    const Eigen::Matrix3d axes = turn_quaternion(Eigen::Vector3d(0.3 * k, 0.7 * k, 0.1 * k)).toRotationMatrix();
+    ContactPlane plane = impetus::test::box_object(k, centre_m, Eigen::Vector3d(0.012, 0.008, 0.01), false, axes);
+    if (k % 4 == 1) plane.shape = round_body(ShapeKind::sphere, 0.012);
+    if (k % 4 == 2) plane.shape = round_body(ShapeKind::capsule, 0.006, 0.02);
+    if (k == 7) plane.shape = round_body(ShapeKind::cylinder, 0.01, 0.015);
+    if (plane.shape.kind == ShapeKind::sphere) {
+      plane.point_m = centre_m + 0.012 * Eigen::Vector3d::UnitZ();
+      plane.normal = Eigen::Vector3d::UnitZ();
+    }
+    set.planes[set.count++] = plane;
+  }
+  return set;
+}
+
+// The hand's target wanders within 4 cm of `offset_m`, turning up to 0.6 rad about a wandering axis; the hand
+// (common/hand/grip_hand.h) holds the grip and feels the rendered wrench, so the grip stops at surfaces as a user's
+// would, a few millimetres in.
+GripPose target_at(int tick, const Eigen::Vector3d& offset_m) {
+  const double t = tick * 1e-3;
+  const BodyPose pose =
+      pose_at(offset_m + 0.04 * Eigen::Vector3d(std::sin(3.1 * t), std::sin(2.3 * t + 1.0), std::sin(1.7 * t)),
+              0.6 * Eigen::Vector3d(std::sin(1.3 * t), std::sin(0.9 * t + 2.0), std::sin(0.7 * t + 1.0)));
+  return {pose.position_m, pose.orientation};
+}
+
+// Plays the hand against the tool among the clutter.
+void run_tool(const char* name, const ToolShape& tool, const Eigen::Vector3d& offset_m, int ticks) {
+  const PlaneSet planes = clutter();
+  ToolProxy proxy(tool, ToolCoupling{});
+  GripHand hand(GripHandParams{}, target_at(0, offset_m));
+  std::vector<double> ns(static_cast<std::size_t>(ticks));
+  int contact_ticks = 0, active_sum = 0, active_max = 0, passes_max = 0, constraints_max = 0;
+  for (int tick = 0; tick < ticks; ++tick) {
+    const GripPose now = hand.pose();
+    const BodyPose grip{now.position_m, now.orientation};
+    const auto start = std::chrono::steady_clock::now();
+    const ToolResult& result = proxy.solve(planes, grip, 1e-3);
+    const auto stop = std::chrono::steady_clock::now();
+    GripWrench wrench;
+    wrench << result.force_N, result.torque_Nm;
+    for (int k = 0; k < 10; ++k) {
+      hand.step(target_at(tick, offset_m), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), wrench, 1e-4);
+    }
+    ns[static_cast<std::size_t>(tick)] = std::chrono::duration<double, std::nano>(stop - start).count();
+    if (result.active > 0) {
+      ++contact_ticks;
+      active_sum += result.active;
+    }
+    active_max = std::max(active_max, result.active);
+    passes_max = std::max(passes_max, result.passes);
+    constraints_max = std::max(constraints_max, result.constraints);
+  }
+  std::sort(ns.begin(), ns.end());
+  std::printf("tool %-15s 16 objects  tick p50 %6.0f ns  p99 %6.0f ns  max %8.0f ns  (contact %4.1f%% of ticks, "
+              "%.1f acting contacts on average, at most %d; at most %d passes, %d constraints; %llu unconverged)\n",
+              name, ns[ns.size() / 2], ns[ns.size() * 99 / 100], ns.back(), 100.0 * contact_ticks / ticks,
+              contact_ticks > 0 ? static_cast<double>(active_sum) / contact_ticks : 0.0, active_max, passes_max,
+              constraints_max, static_cast<unsigned long long>(proxy.counters().unconverged));
+}
+
+// The world's frame for a point finger at `finger_m`: each object's plane at its point nearest the finger.
+PlaneFrame frame_for(const PlaneSet& planes, const Eigen::Vector3d& finger_m, std::uint64_t index) {
+  PlaneFrame frame;
+  frame.frame_index = index;
+  frame.world_session = 1;
+  frame.world_period_s = kTicksPerWorldStep * 1e-3;
+  frame.stiffness_Npm = 2000.0;
+  for (std::uint32_t j = 0; j < planes.count; ++j) {
+    const ContactPlane& object = planes.planes[j];
+    Plane& plane = frame.planes[frame.plane_count++];
+    plane.object_id = object.object_id;
+    plane.com_m = to_vec3(object.com_m);
+    if (!object.shaped()) {
+      plane.point_m = to_vec3(object.point_m);
+      plane.normal = to_vec3(object.normal);
+      continue;
+    }
+    const BodyPose pose = impetus::test::pose_at(object.com_m);
+    const BodyPose turned{object.com_m, Eigen::Quaterniond(object.axes)};
+    const SurfacePoint surface =
+        nearest_surface_point(object.shape, object.shape_traits().round ? pose : turned, finger_m);
+    plane.point_m = to_vec3(surface.point_m);
+    plane.normal = to_vec3(surface.normal);
+    plane.shape = object.shape;
+    plane.extent_m = plane_extent_m(object.shape);
+    plane.body_axis_x = to_vec3(object.axes.col(0));
+    plane.body_axis_y = to_vec3(object.axes.col(1));
+  }
+  return frame;
+}
+
+// The point finger's servo where the peg's tip would be on the hand's target (into the objects: the god-object
+// holds its proxy on their surfaces).
+void run_point(const Eigen::Vector3d& offset_m, int ticks) {
+  const PlaneSet planes = clutter();
+  HapticServo servo(ServoOptions{}, 1);
+  std::vector<double> ns(static_cast<std::size_t>(ticks));
+  int contact_ticks = 0;
+  for (int tick = 0; tick < ticks; ++tick) {
+    const GripPose grip = target_at(tick, offset_m);
+    FingerSample sample;
+    sample.valid = true;
+    sample.position_m = grip.position_m + grip.orientation * Eigen::Vector3d(0.0, 0.0, -0.05);  // the peg's tip
+    const double now_s = tick * 1e-3;
+    if (tick % kTicksPerWorldStep == 0) {
+      servo.on_plane_frame(frame_for(planes, sample.position_m, static_cast<std::uint64_t>(tick / kTicksPerWorldStep)),
+                           now_s);
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const TickResult& result = servo.tick(&sample, now_s, 1e-3);
+    const auto stop = std::chrono::steady_clock::now();
+    ns[static_cast<std::size_t>(tick)] = std::chrono::duration<double, std::nano>(stop - start).count();
+    contact_ticks += result.active_planes > 0 ? 1 : 0;
+  }
+  std::sort(ns.begin(), ns.end());
+  std::printf("point finger         16 objects  tick p50 %6.0f ns  p99 %6.0f ns  max %8.0f ns  (contact %4.1f%% of "
+              "ticks; the servo's whole tick at the peg's tip on the hand's target)\n",
+              ns[ns.size() / 2], ns[ns.size() * 99 / 100], ns.back(), 100.0 * contact_ticks / ticks);
+}
+
+void run_stability() {
+  std::printf("\nclosed loop, cube pressed into a corner (hand 0.15 kg, 8 N·s/m, 6e-3 N·m·s/rad), 1.5 s:\n");
+  std::printf("%9s %11s %8s %-8s %13s %16s\n", "k (N/m)", "k_r (N·m/rad)", "lag (ms)", "dampers", "E end / start",
+              "largest rise (J)");
+  for (const double k : {2000.0, 5000.0, 10000.0}) {
+    for (const double k_r : {20.0, 100.0}) {
+      for (const double lag_s : {0.0, 1e-3, 3e-3}) {
+        for (const bool damped : {true, false}) {
+          ToolCoupling coupling;
+          coupling.stiffness_Npm = k;
+          coupling.rotational_stiffness_Nmprad = k_r;
+          coupling.damping_Nspm = damped ? k * 1e-3 : 0.0;
+          coupling.rotational_damping_Nmsprad = damped ? k_r * 1e-3 : 0.0;
+          coupling.max_force_N = 100.0;
+          coupling.max_torque_Nm = 10.0;
+          const std::vector<double> energy_J = impetus::test::corner_press_energy(coupling, lag_s, 1.5);
+          double rise_J = 0.0;
+          for (std::size_t q = 1; q < energy_J.size(); ++q) rise_J = std::max(rise_J, energy_J[q] - energy_J[q - 1]);
+          std::printf("%9.0f %11.0f %8.0f %-8s %13.3f %16.2e\n", k, k_r, 1e3 * lag_s, damped ? "k·T" : "none",
+                      energy_J.back() / energy_J.front(), rise_J);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int ticks = 20000;
+  for (int k = 1; k < argc; ++k) {
+    if (std::strcmp(argv[k], "--help") == 0) {
+      std::printf("usage: bench_tool_tick [--ticks N]\n"
+                  "Times the tool's 6-DoF god-object beside the point finger's servo tick among 16 objects, then\n"
+                  "prints the closed loop's energy over coupling stiffness, motor lag and dampers.\n");
+      return 0;
+    }
+    if (std::strcmp(argv[k], "--ticks") == 0 && k + 1 < argc) {
+      ticks = std::atoi(argv[++k]);
+    } else {
+      std::fprintf(stderr, "bench_tool_tick: unknown argument '%s' (--help)\n", argv[k]);
+      return 2;
+    }
+  }
+  if (ticks < 100) {
+    std::fprintf(stderr, "bench_tool_tick: --ticks must be at least 100, not %d\n", ticks);
+    return 2;
+  }
+  // The grip wanders 5 cm above the clutter's middle, so the tools' tips reach into it.
+  const Eigen::Vector3d offset_m(0.0, 0.0, 0.05);
+  run_tool("peg (box)", impetus::test::peg_tool(), offset_m, ticks);
+  ToolShape probe{round_body(ShapeKind::capsule, 0.003, 0.06), BodyPose{}};
+  probe.placement.position_m = Eigen::Vector3d(0.0, 0.0, -0.02);
+  run_tool("probe (capsule)", probe, offset_m, ticks);
+  run_point(offset_m, ticks);
+  run_stability();
+  return 0;
+}
