@@ -10,8 +10,10 @@ namespace impetus {
 namespace {
 
 // A contact normal whose part outside the active normals' span is below this fraction of its length lies in that
-// span (it depends on them): the method then only shifts load, it does not step.
-constexpr double kDependent = 1e-10;
+// span (it depends on them): the method then only shifts load, it does not step. A step along so small a part would
+// be the residual over its square, 10¹⁴ times the residual at 10⁻⁷, where the geometry's own rounding (10⁻¹⁶ of a
+// length, in normals and levers) has already decided the part's size.
+constexpr double kDependent = 1e-7;
 
 }  // namespace
 

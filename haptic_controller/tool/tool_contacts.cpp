@@ -199,12 +199,16 @@ bool edge_pair(std::int32_t index, const ContactPlane& plane, const PlacedBody& 
       !in_cone(-normal, tool.rotation * tool_edge.face_a, tool.rotation * tool_edge.face_b)) {
     return false;
   }
+  const double gap_m = normal.dot(on_tool_m - on_object_m) - tool_edge.radius_m - object_edge.radius_m;
+  // Edges that overlap are in each other's body: a pair whose tool edge (its ball, for a round one) does not reach into
+  // the object has the object between the two lines, or beside them, and is no edge contact, whatever its lines do.
+  if (gap_m < 0.0 && object.nearest(on_tool_m).signed_distance_m > tool_edge.radius_m + kOnSurface_m) return false;
   out = {index,
          plane.object_id,
          normal,
          on_tool_m - tool_edge.radius_m * normal,
          on_object_m + object_edge.radius_m * normal,
-         normal.dot(on_tool_m - on_object_m) - tool_edge.radius_m - object_edge.radius_m,
+         gap_m,
          Kind::edges,
          static_cast<std::int16_t>(i),
          static_cast<std::int16_t>(j)};

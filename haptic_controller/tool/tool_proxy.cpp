@@ -15,6 +15,8 @@ static_assert(kMaxToolConstraints == kMaxContactRows);
 
 // Rounding room for the reach of a pass: the bound itself is exact (below), this only keeps a contact exactly at it.
 constexpr double kReachRounding_m = 1e-9;
+// A contact within this of the proxy touches it (kOnSurface_m, common/shape/shape.h).
+constexpr double kTouching_m = kOnSurface_m;
 
 void require(bool ok, const char* field, const char* rule) {
   if (!ok) throw std::invalid_argument(std::string("tool coupling: ") + field + " " + rule);
@@ -92,6 +94,7 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
   }
   const BodyPose proxy_before = proxy_;
   result_ = ToolResult{};
+  failed_ = false;
   // The god-object: the pose nearest the grip in the springs' metric that the contacts allow; again from where a
   // pass put it while a contact acts and the pass still moved the tool (the linearised turn and curved surfaces are
   // exact only for a move that vanishes). The first pass gathers the contacts within its reach; a later one measures
@@ -115,7 +118,7 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
       turned_rad = q.tail<3>().norm();
     }
     const double moved_m = q.head<3>().norm() + q.tail<3>().norm() * contacts_.bounding_radius_m();
-    if (result_.active == 0 || moved_m <= kToolSettled_m) break;
+    if (failed_ || result_.active == 0 || moved_m <= kToolSettled_m) break;
   }
   release_sunk();
   const Vector6d e = displacement(proxy_, grip);
@@ -160,13 +163,19 @@ void ToolProxy::damp(const Vector6d& displacement_now, double dt_s) {
   // so the damper brakes an approach but does not drag the tool after a surface it leaves (force_renderer.h in 3 DoF).
   // The projection is the polar decomposition w = Σ μ_i·a_i + u with a_iᵀu ≤ 0 (Moreau), solved as the QP of
   // contact_qp.h for u, in units scaled by the stiffnesses (force/√k, torque/√k_r) so force and torque weigh alike.
+  // After a pass that failed (pass()), the spring's wrench is K·e at the unmoved proxy, and the acting contacts are
+  // those it touches.
   Vector6d spring = Vector6d::Zero();
   int acting = 0;
   for (int k = 0; k < contacts_.count(); ++k) {
     const auto i = static_cast<std::size_t>(k);
-    if (!(lambda_[i] > 0.0)) continue;
+    if (failed_ ? rows_[i].gap_m > kTouching_m : !(lambda_[i] > 0.0)) continue;
     spring += lambda_[i] * rows_[i].a;
     acting_[static_cast<std::size_t>(acting++)] = k;
+  }
+  if (failed_) {
+    spring.head<3>() = coupling_.stiffness_Npm * displacement_now.head<3>();
+    spring.tail<3>() = coupling_.rotational_stiffness_Nmprad * displacement_now.tail<3>();
   }
   const Vector6d rate = (displacement_now - previous_displacement_) / dt_s;
   Vector6d wrench = spring;
@@ -238,16 +247,36 @@ Vector6d ToolProxy::pass(const PlaneSet& planes, const Vector6d& target, bool ga
   }
   Vector6d metric;
   metric << k_Npm, k_Npm, k_Npm, k_r_Nmprad, k_r_Nmprad, k_r_Nmprad;
-  const ContactQpResult solved = solve_contact_qp(rows_, count, metric, target, lambda_);
-  if (!solved.converged) ++counters_.unconverged;
+  ContactQpResult solved = solve_contact_qp(rows_, count, metric, target, lambda_);
+  result_.constraints = count;
+  result_.passes += 1;
+  result_.iterations += solved.iterations;
+  if (!solved.converged) {
+    // No move satisfies the contacts as linearised: the proxy is in a pinch, inside contacts that face each other
+    // (a curved surface's linearisation left it a little inside two). Taken with every gap kept ≥ 0 the problem has
+    // q = 0 and so an answer: the proxy goes no deeper into any of them this tick.
+    for (int k = 0; k < count; ++k) {
+      ContactQpRow& row = rows_[static_cast<std::size_t>(k)];
+      row.gap_m = std::max(row.gap_m, 0.0);
+    }
+    solved = solve_contact_qp(rows_, count, metric, target, lambda_);
+    result_.iterations += solved.iterations;
+    ++counters_.pinches;
+  }
+  if (!solved.converged) {
+    // Rounding stalled the method: the proxy stays where it was, outside, and the contacts it touches there carry
+    // the wrench (damp()).
+    ++counters_.unconverged;
+    result_.converged = false;
+    failed_ = true;
+    for (int k = 0; k < count; ++k) lambda_[static_cast<std::size_t>(k)] = 0.0;
+    result_.active = 0;
+    return Vector6d::Zero();
+  }
   proxy_.position_m += solved.q.head<3>();
   proxy_.orientation = turned(proxy_.orientation, solved.q.tail<3>());
 
-  result_.constraints = count;
   result_.active = solved.active;
-  result_.passes += 1;
-  result_.iterations += solved.iterations;
-  result_.converged = result_.converged && solved.converged;
   return solved.q;
 }
 

@@ -85,7 +85,8 @@ struct ToolCounters {
   std::uint64_t solves = 0;
   std::uint64_t faults = 0;
   std::uint64_t clamps = 0;          // wrenches scaled to the limits
-  std::uint64_t unconverged = 0;     // passes whose QP did not converge (contact_qp.h)
+  std::uint64_t pinches = 0;         // passes whose contacts, as linearised, no move satisfied: solved going no deeper
+  std::uint64_t unconverged = 0;     // passes whose QP did not converge even so (contact_qp.h): the proxy stayed
 };
 
 class ToolProxy {
@@ -133,6 +134,7 @@ class ToolProxy {
   BodyPose proxy_;
   BodyPose grip_;  // at the last solve
   bool started_ = false;
+  bool failed_ = false;  // a pass of this solve found no move (pass())
   bool session_start_ = true;
   // Objects the tool started inside (at reset): the proxy may not go deeper into them but is not pushed out, until
   // it has left them (as the point finger's god-object, god_object.h).

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tick cost of a rigid tool's 6-DoF god-object (haptic_controller/tool/tool_proxy.h) among 16 objects (boxes, balls,
-// capsules, a cylinder and the floor), the grip wandering and turning through them, for a box peg and a capsule probe:
-// p50 / p99 / max in ns, how often it touched, the contacts and passes a tick. Beside it, in the same run, the point
-// finger's servo tick (HapticServo::tick) at the peg's tip on the hand's target path among the same 16 objects. Then the closed loop's stability
-// (the hand pressing the cube tool into a corner through lagging motors, tests/support/tool_scenes.h): the loop's
-// energy at the end over at the start, and its largest rise in a tick, over coupling stiffness, motor lag and the
-// dampers. Prints only; no assertions. `--ticks N` sets the ticks per tool (default 20000).
+// capsules, a cylinder and the floor), the hand holding the grip while its target wanders and turns through them,
+// for a box peg and a capsule probe: p50 / p99 / max in ns, how often it touched, the contacts and passes a tick.
+// Beside it, in the same run, the point finger's servo tick (HapticServo::tick) at the peg's tip on the hand's target
+// among the same objects. Then the closed loop's stability (the hand pressing the cube tool into a corner through
+// lagging motors, tests/support/tool_scenes.h): the loop's energy at the end over at the start, and its largest rise
+// in a tick, over coupling stiffness, motor lag and the dampers. Prints only; no assertions. `--ticks N` sets the
+// ticks per tool (default 20000).
 
 #include <algorithm>
 #include <chrono>
@@ -99,10 +100,12 @@ void run_tool(const char* name, const ToolShape& tool, const Eigen::Vector3d& of
   }
   std::sort(ns.begin(), ns.end());
   std::printf("tool %-15s 16 objects  tick p50 %6.0f ns  p99 %6.0f ns  max %8.0f ns  (contact %4.1f%% of ticks, "
-              "%.1f acting contacts on average, at most %d; at most %d passes, %d constraints; %llu unconverged)\n",
+              "%.1f acting contacts on average, at most %d; at most %d passes, %d constraints; %llu pinches, %llu "
+              "unconverged)\n",
               name, ns[ns.size() / 2], ns[ns.size() * 99 / 100], ns.back(), 100.0 * contact_ticks / ticks,
               contact_ticks > 0 ? static_cast<double>(active_sum) / contact_ticks : 0.0, active_max, passes_max,
-              constraints_max, static_cast<unsigned long long>(proxy.counters().unconverged));
+              constraints_max, static_cast<unsigned long long>(proxy.counters().pinches),
+              static_cast<unsigned long long>(proxy.counters().unconverged));
 }
 
 // The world's frame for a point finger at `finger_m`: each object's plane at its point nearest the finger.
