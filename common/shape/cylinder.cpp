@@ -149,26 +149,41 @@ void retake(ShapePlane& plane, const Eigen::Vector3d& around_m) {
   plane.point_m = plane.com_m + plane.axes * nearest_local_m;
 }
 
-// Points around both rims, 16 each: against a plane a cylinder's deepest points are on a rim.
+// Its rims as 16-gons: the points (against a plane a cylinder's deepest points are on a rim), and the chords between
+// them (an edge of another body crossing a rim).
+constexpr int kPerRim = 16;
+
+Eigen::Vector3d rim_point(const Shape& shape, int k, double z_m) {
+  const double angle = 2.0 * std::numbers::pi * k / kPerRim;
+  return {shape.radius_m * std::cos(angle), shape.radius_m * std::sin(angle), z_m};
+}
+
 int contact_samples(const Shape& shape, ContactSamples& samples) {
-  constexpr int kPerRim = 16;
   static_assert(2 * kPerRim <= kMaxContactSamples);
   int count = 0;
   for (const double z_m : {-0.5 * shape.length_m, 0.5 * shape.length_m}) {
-    for (int k = 0; k < kPerRim; ++k) {
-      const double angle = 2.0 * std::numbers::pi * k / kPerRim;
-      samples[static_cast<std::size_t>(count++)] = {
-          Eigen::Vector3d(shape.radius_m * std::cos(angle), shape.radius_m * std::sin(angle), z_m), 0.0};
-    }
+    for (int k = 0; k < kPerRim; ++k) samples[static_cast<std::size_t>(count++)] = {rim_point(shape, k, z_m), 0.0};
   }
   return count;
 }
 
-// The axis, end to end, swept by the radius: the side, where another body's edge crosses it.
+// The axis, end to end, swept by the radius: the side, where another body's edge crosses it; and the rims' chords,
+// each with the cap's normal and the side's at its middle as its faces.
 int contact_edges(const Shape& shape, ContactEdges& edges) {
+  static_assert(1 + 2 * kPerRim <= kMaxContactEdges);
   edges[0] = {Eigen::Vector3d(0.0, 0.0, -0.5 * shape.length_m), Eigen::Vector3d(0.0, 0.0, 0.5 * shape.length_m),
               shape.radius_m};
-  return 1;
+  int count = 1;
+  for (const double side : {-1.0, 1.0}) {
+    const double z_m = 0.5 * side * shape.length_m;
+    for (int k = 0; k < kPerRim; ++k) {
+      const double middle = 2.0 * std::numbers::pi * (k + 0.5) / kPerRim;
+      edges[static_cast<std::size_t>(count++)] = {rim_point(shape, k, z_m), rim_point(shape, k + 1, z_m), 0.0,
+                                                  Eigen::Vector3d(0.0, 0.0, side),
+                                                  Eigen::Vector3d(std::cos(middle), std::sin(middle), 0.0)};
+    }
+  }
+  return count;
 }
 
 constexpr std::string_view kKeys[] = {"radius_m", "length_m"};

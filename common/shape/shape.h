@@ -184,11 +184,12 @@ struct ContactEdge {
   Eigen::Vector3d face_a = Eigen::Vector3d::Zero();
   Eigen::Vector3d face_b = Eigen::Vector3d::Zero();
 };
-inline constexpr int kMaxContactEdges = 12;
+inline constexpr int kMaxContactEdges = 33;
 using ContactEdges = std::array<ContactEdge, kMaxContactEdges>;
 // The kind's edges: a box's twelve (radius 0, with their faces); the axis of a capsule or a cylinder, cap centre to
-// cap centre, swept by r (a cylinder's side; its flat caps are met by the other body's samples, its rims by its own).
-// None for a ball or a mesh. Returns the count.
+// cap centre, swept by r (a cylinder's side), and a cylinder's rims as 16 chords each (with the cap's and the
+// side's normals as their faces; its flat caps are met by the other body's samples). None for a ball or a mesh.
+// Returns the count.
 int contact_edges(const Shape& shape, ContactEdges& edges);
 
 }  // namespace impetus

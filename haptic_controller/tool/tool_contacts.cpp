@@ -51,7 +51,11 @@ double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& d, cons
 // Whether `direction` lies in a sharp edge's normal cone (between its faces' outward normals, world frame); any
 // direction does for a round edge.
 bool in_cone(const Eigen::Vector3d& direction, const Eigen::Vector3d& face_a, const Eigen::Vector3d& face_b) {
-  constexpr double kSlack = 1e-12;  // an edge pushes along a face's own normal too
+  // An edge pushes along its faces' own normals too, and a milliradian beyond them: an edge lying on the other's face
+  // (a capsule along a box's top, over its rim) tilts the normal across the face's normal, back and forth between one
+  // pass and the next, and a cone without room drops and takes the pair back each time. A plane tilted by 1 mrad at
+  // the edge cuts 1 µm into the room above the face 1 mm away from it.
+  constexpr double kSlack = 1e-3;
   return direction.dot(face_a) >= -kSlack && direction.dot(face_b) >= -kSlack;
 }
 
@@ -119,12 +123,20 @@ namespace {
 using tool_detail::PlacedBody;
 using Kind = ToolConstraint::Kind;
 
+// A contact's point on the object is its point on the tool moved back by the gap along the normal: the two differ
+// only along the normal, so the torque the world receives and the torque the hand feels cancel to rounding (the
+// nearest points already do; a crossing clamped onto an edge's end is put in line).
+ToolConstraint in_line(ToolConstraint constraint) {
+  constraint.object_point_m = constraint.tool_point_m - constraint.gap_m * constraint.normal;
+  return constraint;
+}
+
 // The tool's sample k against a plane taken as the half-space it is.
 ToolConstraint tool_sample_on_plane(std::int32_t index, const ContactPlane& plane, const PlacedBody& tool, int k) {
   const ContactSample& sample = (*tool.samples)[static_cast<std::size_t>(k)];
   const Eigen::Vector3d p_m = tool.point(sample.point_m);
   const double distance_m = plane.normal.dot(p_m - plane.point_m);
-  return {index,
+  return in_line({index,
           plane.object_id,
           plane.normal,
           p_m - sample.radius_m * plane.normal,
@@ -132,7 +144,7 @@ ToolConstraint tool_sample_on_plane(std::int32_t index, const ContactPlane& plan
           distance_m - sample.radius_m,
           Kind::tool_sample,
           static_cast<std::int16_t>(k),
-          -1};
+          -1});
 }
 
 // The tool's sample k against the object's surface: the tangent plane at the point nearest it.
@@ -141,7 +153,7 @@ ToolConstraint tool_sample_on_body(std::int32_t index, const ContactPlane& plane
   const ContactSample& sample = (*tool.samples)[static_cast<std::size_t>(k)];
   const Eigen::Vector3d p_m = tool.point(sample.point_m);
   const SurfacePoint surface = object.nearest(p_m);
-  return {index,
+  return in_line({index,
           plane.object_id,
           surface.normal,
           p_m - sample.radius_m * surface.normal,
@@ -149,7 +161,7 @@ ToolConstraint tool_sample_on_body(std::int32_t index, const ContactPlane& plane
           surface.signed_distance_m - sample.radius_m,
           Kind::tool_sample,
           static_cast<std::int16_t>(k),
-          -1};
+          -1});
 }
 
 // The object's sample k against the tool's surface: the tool's tangent plane at its point nearest the sample.
@@ -158,7 +170,7 @@ ToolConstraint object_sample_on_tool(std::int32_t index, const ContactPlane& pla
   const ContactSample& sample = (*object.samples)[static_cast<std::size_t>(k)];
   const Eigen::Vector3d v_m = object.point(sample.point_m);
   const SurfacePoint surface = tool.nearest(v_m);
-  return {index,
+  return in_line({index,
           plane.object_id,
           -surface.normal,
           surface.point_m,
@@ -166,7 +178,7 @@ ToolConstraint object_sample_on_tool(std::int32_t index, const ContactPlane& pla
           surface.signed_distance_m - sample.radius_m,
           Kind::object_sample,
           -1,
-          static_cast<std::int16_t>(k)};
+          static_cast<std::int16_t>(k)});
 }
 
 // The tool's edge i against the object's edge j, where they cross (closest points inside both) within `within_m` of
@@ -203,15 +215,15 @@ bool edge_pair(std::int32_t index, const ContactPlane& plane, const PlacedBody& 
   // Edges that overlap are in each other's body: a pair whose tool edge (its ball, for a round one) does not reach into
   // the object has the object between the two lines, or beside them, and is no edge contact, whatever its lines do.
   if (gap_m < 0.0 && object.nearest(on_tool_m).signed_distance_m > tool_edge.radius_m + kOnSurface_m) return false;
-  out = {index,
-         plane.object_id,
-         normal,
-         on_tool_m - tool_edge.radius_m * normal,
-         on_object_m + object_edge.radius_m * normal,
-         gap_m,
-         Kind::edges,
-         static_cast<std::int16_t>(i),
-         static_cast<std::int16_t>(j)};
+  out = in_line({index,
+                 plane.object_id,
+                 normal,
+                 on_tool_m - tool_edge.radius_m * normal,
+                 on_object_m + object_edge.radius_m * normal,
+                 gap_m,
+                 Kind::edges,
+                 static_cast<std::int16_t>(i),
+                 static_cast<std::int16_t>(j)});
   return true;
 }
 

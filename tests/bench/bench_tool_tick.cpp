@@ -28,67 +28,16 @@ namespace {
 
 constexpr int kTicksPerWorldStep = 50;  // 1 kHz servo, 20 Hz world
 
-Shape round_body(ShapeKind kind, double radius_m, double length_m = 0.0) {
-  Shape shape;
-  shape.kind = kind;
-  shape.radius_m = radius_m;
-  shape.length_m = length_m;
-  return shape;
-}
-
-// Sixteen objects within 7 cm of the origin, static, some turned: the planes the servo would carry for them.
-PlaneSet clutter() {
-  PlaneSet set;
-  set.planes[set.count++] = impetus::test::floor_plane(0);
-  set.planes[0].point_m = Eigen::Vector3d(0.0, 0.0, -0.06);
-  for (int k = 1; k < 16; ++k) {
-    const double a = 2.399963 * k;  // golden-angle spiral
-    const double z = 1.0 - 2.0 * (k + 0.5) / 16.0;
-    const double r = std::sqrt(1.0 - z * z);
-    const Eigen::Vector3d centre_m = (0.045 + 0.01 * (k % 3)) * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), z);
-    const Eigen::Matrix3d axes = turn_quaternion(Eigen::Vector3d(0.3 * k, 0.7 * k, 0.1 * k)).toRotationMatrix();
-    ContactPlane plane = impetus::test::box_object(k, centre_m, Eigen::Vector3d(0.012, 0.008, 0.01), false, axes);
-    if (k % 4 == 1) plane.shape = round_body(ShapeKind::sphere, 0.012);
-    if (k % 4 == 2) plane.shape = round_body(ShapeKind::capsule, 0.006, 0.02);
-    if (k == 7) plane.shape = round_body(ShapeKind::cylinder, 0.01, 0.015);
-    if (plane.shape.kind == ShapeKind::sphere) {
-      plane.point_m = centre_m + 0.012 * Eigen::Vector3d::UnitZ();
-      plane.normal = Eigen::Vector3d::UnitZ();
-    }
-    set.planes[set.count++] = plane;
-  }
-  return set;
-}
-
-// The hand's target wanders within 4 cm of `offset_m`, turning up to 0.6 rad about a wandering axis; the hand
-// (common/hand/grip_hand.h) holds the grip and feels the rendered wrench, so the grip stops at surfaces as a user's
-// would, a few millimetres in.
-GripPose target_at(int tick, const Eigen::Vector3d& offset_m) {
-  const double t = tick * 1e-3;
-  const BodyPose pose =
-      pose_at(offset_m + 0.04 * Eigen::Vector3d(std::sin(3.1 * t), std::sin(2.3 * t + 1.0), std::sin(1.7 * t)),
-              0.6 * Eigen::Vector3d(std::sin(1.3 * t), std::sin(0.9 * t + 2.0), std::sin(0.7 * t + 1.0)));
-  return {pose.position_m, pose.orientation};
-}
-
-// Plays the hand against the tool among the clutter.
+// Plays the hand against the tool among the clutter, timing each solve.
 void run_tool(const char* name, const ToolShape& tool, const Eigen::Vector3d& offset_m, int ticks) {
-  const PlaneSet planes = clutter();
+  const PlaneSet planes = impetus::test::clutter();
   ToolProxy proxy(tool, ToolCoupling{});
-  GripHand hand(GripHandParams{}, target_at(0, offset_m));
   std::vector<double> ns(static_cast<std::size_t>(ticks));
   int contact_ticks = 0, active_sum = 0, active_max = 0, passes_max = 0, constraints_max = 0;
-  for (int tick = 0; tick < ticks; ++tick) {
-    const GripPose now = hand.pose();
-    const BodyPose grip{now.position_m, now.orientation};
-    const auto start = std::chrono::steady_clock::now();
-    const ToolResult& result = proxy.solve(planes, grip, 1e-3);
+  std::chrono::steady_clock::time_point start;
+  impetus::test::wander(proxy, planes, offset_m, ticks, [&] { start = std::chrono::steady_clock::now(); },
+                        [&](int tick, const BodyPose&, const ToolResult& result) {
     const auto stop = std::chrono::steady_clock::now();
-    GripWrench wrench;
-    wrench << result.force_N, result.torque_Nm;
-    for (int k = 0; k < 10; ++k) {
-      hand.step(target_at(tick, offset_m), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), wrench, 1e-4);
-    }
     ns[static_cast<std::size_t>(tick)] = std::chrono::duration<double, std::nano>(stop - start).count();
     if (result.active > 0) {
       ++contact_ticks;
@@ -97,7 +46,7 @@ void run_tool(const char* name, const ToolShape& tool, const Eigen::Vector3d& of
     active_max = std::max(active_max, result.active);
     passes_max = std::max(passes_max, result.passes);
     constraints_max = std::max(constraints_max, result.constraints);
-  }
+  });
   std::sort(ns.begin(), ns.end());
   std::printf("tool %-15s 16 objects  tick p50 %6.0f ns  p99 %6.0f ns  max %8.0f ns  (contact %4.1f%% of ticks, "
               "%.1f acting contacts on average, at most %d; at most %d passes, %d constraints; %llu pinches, %llu "
@@ -142,12 +91,12 @@ PlaneFrame frame_for(const PlaneSet& planes, const Eigen::Vector3d& finger_m, st
 // The point finger's servo where the peg's tip would be on the hand's target (into the objects: the god-object
 // holds its proxy on their surfaces).
 void run_point(const Eigen::Vector3d& offset_m, int ticks) {
-  const PlaneSet planes = clutter();
+  const PlaneSet planes = impetus::test::clutter();
   HapticServo servo(ServoOptions{}, 1);
   std::vector<double> ns(static_cast<std::size_t>(ticks));
   int contact_ticks = 0;
   for (int tick = 0; tick < ticks; ++tick) {
-    const GripPose grip = target_at(tick, offset_m);
+    const GripPose grip = impetus::test::wander_target(tick, offset_m);
     FingerSample sample;
     sample.valid = true;
     sample.position_m = grip.position_m + grip.orientation * Eigen::Vector3d(0.0, 0.0, -0.05);  // the peg's tip
@@ -219,9 +168,7 @@ int main(int argc, char** argv) {
   // The grip wanders 5 cm above the clutter's middle, so the tools' tips reach into it.
   const Eigen::Vector3d offset_m(0.0, 0.0, 0.05);
   run_tool("peg (box)", impetus::test::peg_tool(), offset_m, ticks);
-  ToolShape probe{round_body(ShapeKind::capsule, 0.003, 0.06), BodyPose{}};
-  probe.placement.position_m = Eigen::Vector3d(0.0, 0.0, -0.02);
-  run_tool("probe (capsule)", probe, offset_m, ticks);
+  run_tool("probe (capsule)", impetus::test::probe_tool(), offset_m, ticks);
   run_point(offset_m, ticks);
   run_stability();
   return 0;

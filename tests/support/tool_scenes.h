@@ -132,4 +132,75 @@ inline std::vector<double> corner_press_energy(const ToolCoupling& coupling, dou
   return energy_J;
 }
 
+inline Shape round_body(ShapeKind kind, double radius_m, double length_m = 0.0) {
+  Shape shape;
+  shape.kind = kind;
+  shape.radius_m = radius_m;
+  shape.length_m = length_m;
+  return shape;
+}
+
+// Sixteen objects within 7 cm of the origin, static, some turned: the planes the servo would carry for them.
+inline PlaneSet clutter() {
+  PlaneSet set;
+  set.planes[set.count++] = floor_plane(0);
+  set.planes[0].point_m = Eigen::Vector3d(0.0, 0.0, -0.06);
+  for (int k = 1; k < 16; ++k) {
+    const double a = 2.399963 * k;  // golden-angle spiral
+    const double z = 1.0 - 2.0 * (k + 0.5) / 16.0;
+    const double r = std::sqrt(1.0 - z * z);
+    const Eigen::Vector3d centre_m = (0.045 + 0.01 * (k % 3)) * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), z);
+    const Eigen::Matrix3d axes = turn_quaternion(Eigen::Vector3d(0.3 * k, 0.7 * k, 0.1 * k)).toRotationMatrix();
+    ContactPlane plane = box_object(k, centre_m, Eigen::Vector3d(0.012, 0.008, 0.01), false, axes);
+    if (k % 4 == 1) plane.shape = round_body(ShapeKind::sphere, 0.012);
+    if (k % 4 == 2) plane.shape = round_body(ShapeKind::capsule, 0.006, 0.02);
+    if (k == 7) plane.shape = round_body(ShapeKind::cylinder, 0.01, 0.015);
+    if (plane.shape.kind == ShapeKind::sphere) {
+      plane.point_m = centre_m + 0.012 * Eigen::Vector3d::UnitZ();
+      plane.normal = Eigen::Vector3d::UnitZ();
+    }
+    set.planes[set.count++] = plane;
+  }
+  return set;
+}
+
+// The hand's target in a wander through the clutter: within 4 cm of `offset_m`, turning up to 0.6 rad about a wandering axis; the hand
+// (common/hand/grip_hand.h) holds the grip and feels the rendered wrench, so the grip stops at surfaces as a user's
+// would, a few millimetres in.
+inline GripPose wander_target(int tick, const Eigen::Vector3d& offset_m) {
+  const double t = tick * 1e-3;
+  const BodyPose pose =
+      pose_at(offset_m + 0.04 * Eigen::Vector3d(std::sin(3.1 * t), std::sin(2.3 * t + 1.0), std::sin(1.7 * t)),
+              0.6 * Eigen::Vector3d(std::sin(1.3 * t), std::sin(0.9 * t + 2.0), std::sin(0.7 * t + 1.0)));
+  return {pose.position_m, pose.orientation};
+}
+
+// A probe: a capsule of 3 mm radius, 6 cm between its cap centres, its middle 2 cm below the grip.
+inline ToolShape probe_tool() {
+  return {round_body(ShapeKind::capsule, 0.003, 0.06),
+          BodyPose{Eigen::Vector3d(0.0, 0.0, -0.02), Eigen::Quaterniond::Identity()}};
+}
+
+// Plays the hand (common/hand/grip_hand.h, defaults) holding the tool's grip against the wander's target for `ticks`
+// ticks of 1 ms, the proxy's wrench on the grip held over each tick's ten sub-steps: before(), then the solve, then
+// after(tick, grip, result).
+template <typename Before, typename After>
+void wander(ToolProxy& proxy, const PlaneSet& planes, const Eigen::Vector3d& offset_m, int ticks, Before&& before,
+            After&& after) {
+  GripHand hand(GripHandParams{}, wander_target(0, offset_m));
+  for (int tick = 0; tick < ticks; ++tick) {
+    const GripPose now = hand.pose();
+    const BodyPose grip{now.position_m, now.orientation};
+    before();
+    const ToolResult& result = proxy.solve(planes, grip, kToolTick_s);
+    after(tick, grip, result);
+    GripWrench wrench;
+    wrench << result.force_N, result.torque_Nm;
+    for (int k = 0; k < 10; ++k) {
+      hand.step(wander_target(tick, offset_m), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), wrench,
+                kToolTick_s / 10);
+    }
+  }
+}
+
 }  // namespace impetus::test
