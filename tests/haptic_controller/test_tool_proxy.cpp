@@ -95,6 +95,13 @@ std::pair<Vector3d, Vector3d> reaction_about(const ToolProxy& proxy, const Plane
   return {impulse_Ns, angular_Nms};
 }
 
+// The objects got the reaction of the last solve: −(F, τ)·Δt, the torque about the grip's centre.
+void check_reaction(const ToolProxy& proxy, const PlaneSet& planes, const BodyPose& grip, const ToolResult& result) {
+  const auto [impulse_Ns, angular_Nms] = reaction_about(proxy, planes, grip.position_m);
+  CHECK((impulse_Ns + result.force_N * kTick_s).norm() < 1e-15);
+  CHECK((angular_Nms + result.torque_Nm * kTick_s).norm() < 1e-15);
+}
+
 }  // namespace
 
 TEST_CASE("contact features: each kind's samples lie within it and touch its surface, its edges run along it") {
@@ -230,10 +237,7 @@ TEST_CASE("tool: turned while pressed on a face, the cube stays level until k_r 
       CHECK(result.torque_Nm.x() < 0.0);
       CHECK(std::fabs(result.torque_Nm.y()) < 1e-12);
       CHECK(overlap_m(cube_tool(), result.proxy, planes) < 1e-9);
-      // The objects got the reaction: −(F, τ)·Δt about the grip's centre.
-      const auto [impulse_Ns, angular_Nms] = reaction_about(proxy, planes, grip.position_m);
-      CHECK((impulse_Ns + result.force_N * kTick_s).norm() < 1e-15);
-      CHECK((angular_Nms + result.torque_Nm * kTick_s).norm() < 1e-15);
+      check_reaction(proxy, planes, grip, result);
     }
   }
 }
@@ -312,9 +316,7 @@ TEST_CASE("tool: a peg tilted in its hole is stopped by the walls and turned bac
   CHECK((result.torque_Nm - spring_Nm).norm() < 0.01 * spring_Nm.norm());
   // Two walls hold it, one at the tip and one at the rim.
   CHECK(proxy.share_count() >= 2);
-  const auto [impulse_Ns, angular_Nms] = reaction_about(proxy, planes, grip.position_m);
-  CHECK((impulse_Ns + result.force_N * kTick_s).norm() < 1e-15);
-  CHECK((angular_Nms + result.torque_Nm * kTick_s).norm() < 1e-15);
+  check_reaction(proxy, planes, grip, result);
 }
 
 TEST_CASE("tool: a plate slid off a table's edge lets go on the tick its body leaves the table, and no torque "

@@ -6,6 +6,7 @@
 #include "common/contract/rotation.h"
 #include "common/hand/grip_hand.h"
 #include "haptic_controller/tool/tool_proxy.h"
+#include "tests/haptic_controller/test_support.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -16,13 +17,6 @@
 #include <vector>
 
 namespace impetus::test {
-
-inline Shape tool_box_shape(const Eigen::Vector3d& half_m) {
-  Shape shape;
-  shape.kind = ShapeKind::box;
-  shape.box_size_m = to_vec3(2.0 * half_m);
-  return shape;
-}
 
 inline constexpr double kToolTick_s = 1e-3;
 
@@ -38,7 +32,7 @@ inline ContactPlane box_object(int id, const Eigen::Vector3d& centre_m, const Ei
   ContactPlane plane;
   plane.object_id = id;
   plane.flags = dynamic ? kPlaneDynamic : 0u;
-  plane.shape = tool_box_shape(half_m);
+  plane.shape = box_shape(half_m);
   plane.com_m = centre_m;
   plane.axes = axes;
   plane.point_m = centre_m + half_m.z() * axes.col(2);
@@ -62,7 +56,7 @@ inline BodyPose pose_at(const Eigen::Vector3d& position_m,
 }
 
 // A 2 cm cube held at the grip's centre.
-inline ToolShape cube_tool() { return {tool_box_shape(Eigen::Vector3d(0.01, 0.01, 0.01)), BodyPose{}}; }
+inline ToolShape cube_tool() { return {box_shape(Eigen::Vector3d(0.01, 0.01, 0.01)), BodyPose{}}; }
 
 // A square hole of side 11 mm, 30 mm deep, cut out of four static boxes on a floor box: a 10 mm peg fits with
 // 0.5 mm of clearance on each side. Its rim is at z = 0, its bottom at z = −30 mm.
@@ -81,7 +75,7 @@ inline PlaneSet hole_scene() {
 
 // A 10 × 10 × 40 mm peg whose centre is 30 mm below the grip's: its tip 50 mm below the grip.
 inline ToolShape peg_tool() {
-  return {tool_box_shape(Eigen::Vector3d(0.005, 0.005, 0.02)),
+  return {box_shape(Eigen::Vector3d(0.005, 0.005, 0.02)),
           BodyPose{Eigen::Vector3d(0, 0, -0.03), Eigen::Quaterniond::Identity()}};
 }
 
@@ -132,14 +126,6 @@ inline std::vector<double> corner_press_energy(const ToolCoupling& coupling, dou
   return energy_J;
 }
 
-inline Shape round_body(ShapeKind kind, double radius_m, double length_m = 0.0) {
-  Shape shape;
-  shape.kind = kind;
-  shape.radius_m = radius_m;
-  shape.length_m = length_m;
-  return shape;
-}
-
 // Sixteen objects within 7 cm of the origin, static, some turned: the planes the servo would carry for them.
 inline PlaneSet clutter() {
   PlaneSet set;
@@ -152,9 +138,9 @@ inline PlaneSet clutter() {
     const Eigen::Vector3d centre_m = (0.045 + 0.01 * (k % 3)) * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), z);
     const Eigen::Matrix3d axes = turn_quaternion(Eigen::Vector3d(0.3 * k, 0.7 * k, 0.1 * k)).toRotationMatrix();
     ContactPlane plane = box_object(k, centre_m, Eigen::Vector3d(0.012, 0.008, 0.01), false, axes);
-    if (k % 4 == 1) plane.shape = round_body(ShapeKind::sphere, 0.012);
-    if (k % 4 == 2) plane.shape = round_body(ShapeKind::capsule, 0.006, 0.02);
-    if (k == 7) plane.shape = round_body(ShapeKind::cylinder, 0.01, 0.015);
+    if (k % 4 == 1) plane.shape = round_shape(ShapeKind::sphere, 0.012);
+    if (k % 4 == 2) plane.shape = round_shape(ShapeKind::capsule, 0.006, 0.02);
+    if (k == 7) plane.shape = round_shape(ShapeKind::cylinder, 0.01, 0.015);
     if (plane.shape.kind == ShapeKind::sphere) {
       plane.point_m = centre_m + 0.012 * Eigen::Vector3d::UnitZ();
       plane.normal = Eigen::Vector3d::UnitZ();
@@ -177,7 +163,7 @@ inline GripPose wander_target(int tick, const Eigen::Vector3d& offset_m) {
 
 // A probe: a capsule of 3 mm radius, 6 cm between its cap centres, its middle 2 cm below the grip.
 inline ToolShape probe_tool() {
-  return {round_body(ShapeKind::capsule, 0.003, 0.06),
+  return {round_shape(ShapeKind::capsule, 0.003, 0.06),
           BodyPose{Eigen::Vector3d(0.0, 0.0, -0.02), Eigen::Quaterniond::Identity()}};
 }
 
