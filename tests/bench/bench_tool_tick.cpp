@@ -3,7 +3,8 @@
 // capsules, a cylinder and the floor), the hand holding the grip while its target wanders and turns through them,
 // for a box peg and a capsule probe: p50 / p99 / max in ns, how often it touched, the contacts and passes a tick.
 // Beside it, in the same run, the point finger's servo tick (HapticServo::tick) at the peg's tip on the hand's target
-// among the same objects. Then the closed loop's stability (the hand pressing the cube tool into a corner through
+// among the same objects. Then a peg striking a free cube against the world at several rates and couplings
+// (tests/support/tool_strike.h), against the 1 kHz world. Then the closed loop's stability (the hand pressing the cube tool into a corner through
 // lagging motors, tests/support/tool_scenes.h): the loop's energy at the end over at the start, and its largest rise
 // in a tick, over coupling stiffness, motor lag and the dampers. Prints only; no assertions. `--ticks N` sets the
 // ticks per tool (default 20000).
@@ -20,6 +21,7 @@
 #include "haptic_controller/servo.h"
 #include "haptic_controller/tool/tool_proxy.h"
 #include "tests/support/tool_scenes.h"
+#include "tests/support/tool_strike.h"
 
 using namespace impetus;
 using impetus::test::pose_at;
@@ -117,6 +119,22 @@ void run_point(const Eigen::Vector3d& offset_m, int ticks) {
               ns[ns.size() / 2], ns[ns.size() * 99 / 100], ns.back(), 100.0 * contact_ticks / ticks);
 }
 
+// The peg striking a free cube off its centre against the world (tests/support/tool_strike.h): where the cube ends,
+// and how far it turned, per world rate and coupling, against the 1 kHz world.
+void run_strike() {
+  const impetus::test::Strike reference = impetus::test::strike(1000.0, Coupling::impulse);
+  std::printf("\npeg striking a 0.2 kg cube 15 mm off its centre (mu 0.3), against the 1 kHz world: x %.2f mm, "
+              "yaw %.4f rad\n", 1e3 * reference.position_m.x(), reference.yaw_rad);
+  std::printf("%8s %9s %12s %12s %14s\n", "coupling", "rate (Hz)", "x (mm)", "yaw (rad)", "yaw / 1 kHz's");
+  for (const Coupling coupling : {Coupling::impulse, Coupling::local}) {
+    for (const double rate_hz : {1000.0, 100.0, 50.0, 20.0, 10.0}) {
+      const impetus::test::Strike s = impetus::test::strike(rate_hz, coupling);
+      std::printf("%8s %9.0f %12.2f %12.4f %14.3f\n", to_string(coupling), rate_hz, 1e3 * s.position_m.x(), s.yaw_rad,
+                  s.yaw_rad / reference.yaw_rad);
+    }
+  }
+}
+
 void run_stability() {
   std::printf("\nclosed loop, cube pressed into a corner (hand 0.15 kg, 8 N·s/m, 6e-3 N·m·s/rad), 1.5 s:\n");
   std::printf("%9s %11s %8s %-8s %13s %16s\n", "k (N/m)", "k_r (N·m/rad)", "lag (ms)", "dampers", "E end / start",
@@ -170,6 +188,7 @@ int main(int argc, char** argv) {
   run_tool("peg (box)", impetus::test::peg_tool(), offset_m, ticks);
   run_tool("probe (capsule)", impetus::test::probe_tool(), offset_m, ticks);
   run_point(offset_m, ticks);
+  run_strike();
   run_stability();
   return 0;
 }
