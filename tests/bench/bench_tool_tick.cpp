@@ -3,8 +3,8 @@
 // capsules, a cylinder and the floor), the hand holding the grip while its target wanders and turns through them,
 // for a box peg and a capsule probe: p50 / p99 / max in ns, how often it touched, the contacts and passes a tick.
 // Beside it, in the same run, the point finger's servo tick (HapticServo::tick) at the peg's tip on the hand's target
-// among the same objects. Then a peg striking a free cube against the world at several rates and couplings
-// (tests/support/tool_strike.h), against the 1 kHz world. Then the closed loop's stability (the hand pressing the cube tool into a corner through
+// among the same objects. Then a peg striking a free cube, and a hand levering a box over a ledge, against the world
+// at several rates and couplings (tests/support/tool_strike.h), against the 1 kHz world. Then the closed loop's stability (the hand pressing the cube tool into a corner through
 // lagging motors, tests/support/tool_scenes.h): the loop's energy at the end over at the start, and its largest rise
 // in a tick, over coupling stiffness, motor lag and the dampers. Prints only; no assertions. `--ticks N` sets the
 // ticks per tool (default 20000).
@@ -135,6 +135,23 @@ void run_strike() {
   }
 }
 
+// The hand levering a box up over a ledge's edge with the cube tool (tests/support/tool_strike.h): how far it tipped,
+// at its highest and at the end of the hold, per world rate and coupling, against the 1 kHz world.
+void run_lever() {
+  const impetus::test::Lever reference = impetus::test::lever(1000.0, Coupling::impulse);
+  std::printf("\nhand levering a 0.2 kg box up over a ledge's edge, against the 1 kHz world: peak %.4f rad, held %.4f "
+              "rad\n", reference.peak_pitch_rad, reference.end_pitch_rad);
+  std::printf("%8s %9s %11s %11s %14s %12s\n", "coupling", "rate (Hz)", "peak (rad)", "held (rad)", "held / 1 kHz's",
+              "peak force");
+  for (const Coupling coupling : {Coupling::impulse, Coupling::local}) {
+    for (const double rate_hz : {1000.0, 100.0, 50.0, 20.0}) {
+      const impetus::test::Lever l = impetus::test::lever(rate_hz, coupling);
+      std::printf("%8s %9.0f %11.4f %11.4f %14.3f %10.2f N\n", to_string(coupling), rate_hz, l.peak_pitch_rad,
+                  l.end_pitch_rad, l.end_pitch_rad / reference.end_pitch_rad, l.peak_force_N);
+    }
+  }
+}
+
 void run_stability() {
   std::printf("\nclosed loop, cube pressed into a corner (hand 0.15 kg, 8 N·s/m, 6e-3 N·m·s/rad), 1.5 s:\n");
   std::printf("%9s %11s %8s %-8s %13s %16s\n", "k (N/m)", "k_r (N·m/rad)", "lag (ms)", "dampers", "E end / start",
@@ -189,6 +206,7 @@ int main(int argc, char** argv) {
   run_tool("probe (capsule)", impetus::test::probe_tool(), offset_m, ticks);
   run_point(offset_m, ticks);
   run_strike();
+  run_lever();
   run_stability();
   return 0;
 }
