@@ -4,10 +4,10 @@
 // for a box peg and a capsule probe: p50 / p99 / max in ns, how often it touched, the contacts and passes a tick.
 // Beside it, in the same run, the point finger's servo tick (HapticServo::tick) at the peg's tip on the hand's target
 // among the same objects. Then a peg striking a free cube, and a hand levering a box over a ledge, against the world
-// at several rates and couplings (tests/support/tool_strike.h), against the 1 kHz world. Then the closed loop's stability (the hand pressing the cube tool into a corner through
-// lagging motors, tests/support/tool_scenes.h): the loop's energy at the end over at the start, and its largest rise
-// in a tick, over coupling stiffness, motor lag and the dampers. Prints only; no assertions. `--ticks N` sets the
-// ticks per tool (default 20000).
+// at several rates and couplings (tests/support/tool_strike.h), against the 1 kHz world. Then the closed loop's
+// stability (the hand pressing the cube tool into a corner through lagging motors, tests/support/tool_scenes.h): the
+// loop's energy at the end over at the start, and its largest rise in a tick, over coupling stiffness, motor lag and
+// the dampers. Prints only; no assertions. `--ticks N` sets the ticks per tool (default 20000).
 
 #include <algorithm>
 #include <chrono>
