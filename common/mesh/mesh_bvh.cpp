@@ -160,10 +160,8 @@ bool MeshBvh::nearest_within(const Eigen::Vector3d& query_m, double max_distance
 bool MeshBvh::nearest_from(const Eigen::Vector3d& query_m, const MeshPoint& hint, MeshPoint& out) const {
   if (mesh_.triangles.empty()) return false;
   if (hint.triangle >= mesh_.triangles.size()) return nearest(query_m, out);
-  const auto& tri = mesh_.triangles[hint.triangle];
   std::uint8_t feature = 0;
-  const Eigen::Vector3d p = closest_point_on_triangle(query_m, mesh_.vertices_m[tri[0]], mesh_.vertices_m[tri[1]],
-                                                     mesh_.vertices_m[tri[2]], feature);
+  const Eigen::Vector3d p = closest_on(hint.triangle, query_m, feature);
   return search(query_m, (query_m - p).squaredNorm(), true, p, hint.triangle, feature, out);
 }
 
@@ -181,10 +179,8 @@ bool MeshBvh::search(const Eigen::Vector3d& query_m, double best_squared, bool s
     if (node.count > 0) {
       for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
         const std::uint32_t t = order_[i];
-        const auto& tri = mesh_.triangles[t];
         std::uint8_t feature = 0;
-        const Eigen::Vector3d p = closest_point_on_triangle(query_m, mesh_.vertices_m[tri[0]],
-                                                           mesh_.vertices_m[tri[1]], mesh_.vertices_m[tri[2]], feature);
+        const Eigen::Vector3d p = closest_on(t, query_m, feature);
         const double squared = (query_m - p).squaredNorm();
         if (squared <= best_squared) {
           best_squared = squared;
@@ -211,6 +207,12 @@ bool MeshBvh::search(const Eigen::Vector3d& query_m, double best_squared, bool s
   if (!found) return false;
   out = answer(query_m, best_point, best_squared, best_triangle, best_feature);
   return true;
+}
+
+Eigen::Vector3d MeshBvh::closest_on(std::uint32_t t, const Eigen::Vector3d& query_m, std::uint8_t& feature) const {
+  const auto& tri = mesh_.triangles[t];
+  return closest_point_on_triangle(query_m, mesh_.vertices_m[tri[0]], mesh_.vertices_m[tri[1]],
+                                   mesh_.vertices_m[tri[2]], feature);
 }
 
 MeshPoint MeshBvh::answer(const Eigen::Vector3d& query_m, const Eigen::Vector3d& point, double squared,
@@ -248,10 +250,8 @@ int MeshBvh::within(const Eigen::Vector3d& query_m, double radius_m, std::span<M
     }
     for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
       const std::uint32_t t = order_[i];
-      const auto& tri = mesh_.triangles[t];
       std::uint8_t feature = 0;
-      const Eigen::Vector3d p = closest_point_on_triangle(query_m, mesh_.vertices_m[tri[0]], mesh_.vertices_m[tri[1]],
-                                                         mesh_.vertices_m[tri[2]], feature);
+      const Eigen::Vector3d p = closest_on(t, query_m, feature);
       const double squared = (query_m - p).squaredNorm();
       if (squared > radius_squared) continue;
       std::size_t slot = count;

@@ -89,6 +89,8 @@ class MeshBvh {
   bool search(const Eigen::Vector3d& query_m, double best_squared, bool seeded, Eigen::Vector3d best_point,
               std::uint32_t best_triangle, std::uint8_t best_feature, MeshPoint& out) const;
   // The answer for `query_m` at `point` on `triangle`'s `feature`, `squared` away.
+  // The point of triangle t nearest `query_m`, and which feature it lies on (0 face, 1–3 edge, 4–6 vertex).
+  Eigen::Vector3d closest_on(std::uint32_t t, const Eigen::Vector3d& query_m, std::uint8_t& feature) const;
   MeshPoint answer(const Eigen::Vector3d& query_m, const Eigen::Vector3d& point, double squared, std::uint32_t triangle,
                    std::uint8_t feature) const;
   std::uint32_t build(std::uint32_t begin, std::uint32_t end, std::vector<Eigen::Vector3d>& centroids, int depth);
