@@ -85,6 +85,19 @@ void check_scene(const impetus::Scene& scene) {
   FUZZ_CHECK(haptic.stiffness_Npm > 0.0 && std::isfinite(haptic.stiffness_Npm));
   FUZZ_CHECK(haptic.damping_Nspm >= 0.0 && std::isfinite(haptic.damping_Nspm));
   FUZZ_CHECK(material_ok(haptic.finger_material));
+  if (scene.tool) {
+    // What the tool servo's constructor requires (tool_proxy.h), and a world reach that covers the tool.
+    const impetus::ToolCoupling& c = scene.tool->coupling;
+    FUZZ_CHECK(c.stiffness_Npm > 0.0 && std::isfinite(c.stiffness_Npm));
+    FUZZ_CHECK(c.rotational_stiffness_Nmprad > 0.0 && std::isfinite(c.rotational_stiffness_Nmprad));
+    FUZZ_CHECK(c.damping_Nspm >= 0.0 && c.rotational_damping_Nmsprad >= 0.0);
+    FUZZ_CHECK(c.max_force_N > 0.0 && c.max_torque_Nm > 0.0);
+    FUZZ_CHECK(scene.tool->shape.shape.kind != impetus::ShapeKind::mesh);
+    FUZZ_CHECK(scene.tool->shape.placement.position_m.allFinite());
+    FUZZ_CHECK(std::isfinite(scene.tool->reach_m) && scene.tool->reach_m > 0.0);
+    FUZZ_CHECK(haptic.reach_radius_m >= scene.tool->reach_m);
+    FUZZ_CHECK(haptic.reach_radius_m <= impetus::SceneLimits::kMaxReachRadius_m);
+  }
   for (const impetus::SceneObject& object : scene.objects) {
     FUZZ_CHECK(!object.name.empty());
     FUZZ_CHECK(finite3(object.position_m) && finite3(object.linear_velocity_mps) &&

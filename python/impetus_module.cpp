@@ -5,6 +5,7 @@
 
 #include "loop/in_process_trial.h"
 #include "loop/simulation.h"
+#include "loop/tool_loop.h"
 #include "spidar_sim/trajectory.h"
 #include "world_manager/defaults.h"
 
@@ -324,6 +325,144 @@ class ClosedLoop {
   std::vector<impetus::FingerTick> records_;
 };
 
+// A pose from seven numbers: position (m), then the orientation as a unit quaternion w, x, y, z (normalised here;
+// the Python half checks it is near unit).
+impetus::GripPose pose_from(const double* v) {
+  return {Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Quaterniond(v[3], v[4], v[5], v[6]).normalized()};
+}
+
+void pose_into(const impetus::GripPose& pose, double* position, double* wxyz) {
+  std::copy_n(pose.position_m.data(), 3, position);
+  wxyz[0] = pose.orientation.w();
+  wxyz[1] = pose.orientation.x();
+  wxyz[2] = pose.orientation.y();
+  wxyz[3] = pose.orientation.z();
+}
+
+// The tool loop (loop/tool_loop.h) for the Python half: steps with the GIL released and hands back each tick's
+// records as numpy arrays, one per quantity (ticks x 3, or ticks x 4 for orientations).
+class ToolClosedLoop {
+ public:
+  ToolClosedLoop(const std::string& scene, const std::string& scene_text, const std::string& coupling,
+                 std::optional<double> world_rate_hz, const std::array<double, 7>& start) {
+    impetus::ToolLoopOptions options;
+    options.scene_path = scene;
+    options.scene_text = scene_text;
+    options.coupling = parse_coupling(coupling);
+    options.world_rate_hz = world_rate_hz;
+    options.start = pose_from(start.data());
+    py::gil_scoped_release release;
+    loop_ = std::make_unique<impetus::ToolLoop>(options);
+  }
+  ~ToolClosedLoop() {
+    py::gil_scoped_release release;
+    loop_.reset();
+  }
+
+  // `targets`: None, or ticks x 7 poses. Returns a dict of arrays.
+  py::dict step(std::uint64_t ticks, const std::optional<py::array_t<double, py::array::c_style |
+                                                                         py::array::forcecast>>& targets) {
+    std::vector<impetus::GripPose> poses;
+    if (targets) {
+      if (targets->ndim() != 2 || static_cast<std::uint64_t>(targets->shape(0)) != ticks || targets->shape(1) != 7) {
+        throw std::invalid_argument("targets: must be ticks x 7 (x, y, z, w, qx, qy, qz)");
+      }
+      poses.reserve(ticks);
+      for (std::uint64_t i = 0; i < ticks; ++i) poses.push_back(pose_from(targets->data(static_cast<py::ssize_t>(i))));
+    }
+    records_.resize(ticks);
+    constexpr std::uint64_t kChunkTicks = 20000;  // Ctrl-C is seen between chunks, as the finger's closed loop
+    std::uint64_t done = 0;
+    while (done < ticks) {
+      const std::uint64_t chunk = std::min(kChunkTicks, ticks - done);
+      const std::span<const impetus::GripPose> chunk_targets =
+          poses.empty() ? std::span<const impetus::GripPose>() : std::span(poses).subspan(done, chunk);
+      {
+        py::gil_scoped_release release;
+        loop_->step(chunk, chunk_targets, std::span(records_).subspan(done, chunk));
+      }
+      done += chunk;
+      if (done < ticks && PyErr_CheckSignals() != 0) break;
+    }
+    if (PyErr_Occurred() != nullptr) throw py::error_already_set();
+    return records(done);
+  }
+
+  void set_target(const std::array<double, 7>& target) { loop_->set_target(pose_from(target.data())); }
+
+  py::dict objects() const {
+    const std::vector<impetus::ToolLoopObject> objects = loop_->objects();
+    const std::size_t n = objects.size();
+    py::array_t<double> position({n, std::size_t{3}}), orientation({n, std::size_t{4}}), velocity({n, std::size_t{3}}),
+        angular({n, std::size_t{3}}), impulse({n, std::size_t{3}}), angular_impulse({n, std::size_t{3}});
+    for (std::size_t i = 0; i < n; ++i) {
+      const impetus::ToolLoopObject& o = objects[i];
+      pose_into({o.pose.position_m, o.pose.orientation}, position.mutable_data(i), orientation.mutable_data(i));
+      std::copy_n(o.velocity_mps.data(), 3, velocity.mutable_data(i));
+      std::copy_n(o.angular_velocity_radps.data(), 3, angular.mutable_data(i));
+      std::copy_n(o.impulse_Ns.data(), 3, impulse.mutable_data(i));
+      std::copy_n(o.angular_impulse_Nms.data(), 3, angular_impulse.mutable_data(i));
+    }
+    py::dict out;
+    out["position_m"] = position;
+    out["orientation_wxyz"] = orientation;
+    out["velocity_mps"] = velocity;
+    out["angular_velocity_radps"] = angular;
+    out["impulse_Ns"] = impulse;
+    out["angular_impulse_Nms"] = angular_impulse;
+    return out;
+  }
+
+  std::string finish() {
+    py::gil_scoped_release release;
+    return loop_->finish().dump();
+  }
+  std::uint64_t ticks() const { return loop_->ticks(); }
+  double tick_period_s() const { return loop_->tick_period_s(); }
+  bool finished() const { return loop_->finished(); }
+  std::vector<std::string> object_names() const { return loop_->object_names(); }
+
+ private:
+  py::dict records(std::uint64_t ticks) const {
+    const std::size_t n = static_cast<std::size_t>(ticks);
+    py::array_t<double> time(static_cast<py::ssize_t>(n));
+    py::array_t<std::int32_t> active(static_cast<py::ssize_t>(n));
+    using Pose = impetus::GripPose impetus::ToolTick::*;
+    static constexpr std::pair<const char*, Pose> kPoses[] = {
+        {"target", &impetus::ToolTick::target}, {"grip", &impetus::ToolTick::grip},
+        {"hand", &impetus::ToolTick::hand}, {"proxy", &impetus::ToolTick::proxy}};
+    using Vector = Eigen::Vector3d impetus::ToolTick::*;
+    static constexpr std::pair<const char*, Vector> kVectors[] = {
+        {"force_N", &impetus::ToolTick::force_N}, {"torque_Nm", &impetus::ToolTick::torque_Nm},
+        {"strings_force_N", &impetus::ToolTick::strings_force_N},
+        {"strings_torque_Nm", &impetus::ToolTick::strings_torque_Nm}};
+    py::dict out;
+    for (std::size_t i = 0; i < n; ++i) {
+      time.mutable_data()[i] = records_[i].time_s;
+      active.mutable_data()[i] = records_[i].active;
+    }
+    out["time_s"] = time;
+    out["active"] = active;
+    for (const auto& [name, field] : kPoses) {
+      py::array_t<double> position({n, std::size_t{3}}), wxyz({n, std::size_t{4}});
+      for (std::size_t i = 0; i < n; ++i) {
+        pose_into(records_[i].*field, position.mutable_data(i), wxyz.mutable_data(i));
+      }
+      out[py::str(std::string(name) + "_m")] = position;
+      out[py::str(std::string(name) + "_wxyz")] = wxyz;
+    }
+    for (const auto& [name, field] : kVectors) {
+      py::array_t<double> values({n, std::size_t{3}});
+      for (std::size_t i = 0; i < n; ++i) std::copy_n((records_[i].*field).data(), 3, values.mutable_data(i));
+      out[name] = values;
+    }
+    return out;
+  }
+
+  std::unique_ptr<impetus::ToolLoop> loop_;
+  std::vector<impetus::ToolTick> records_;
+};
+
 // Where a trajectory (a built-in spec or a CSV file) puts the target at each of `times_s`: an N x 3 array (m).
 py::array_t<double> sample_trajectory(const std::string& spec, const py::array_t<double, py::array::c_style |
                                                                                    py::array::forcecast>& times_s) {
@@ -376,5 +515,17 @@ PYBIND11_MODULE(_impetus, module) {
       .def_property_readonly("finished", &ClosedLoop::finished)
       .def_property_readonly("object_names", &ClosedLoop::object_names)
       .def_property_readonly("warnings", &ClosedLoop::warnings);
+  py::class_<ToolClosedLoop>(module, "ToolClosedLoop")
+      .def(py::init<const std::string&, const std::string&, const std::string&, std::optional<double>,
+                    const std::array<double, 7>&>(),
+           py::arg("scene"), py::arg("scene_text"), py::arg("coupling"), py::arg("world_rate_hz"), py::arg("start"))
+      .def("step", &ToolClosedLoop::step, py::arg("ticks"), py::arg("targets"))
+      .def("set_target", &ToolClosedLoop::set_target, py::arg("target"))
+      .def("objects", &ToolClosedLoop::objects)
+      .def("finish", &ToolClosedLoop::finish)
+      .def_property_readonly("ticks", &ToolClosedLoop::ticks)
+      .def_property_readonly("tick_period_s", &ToolClosedLoop::tick_period_s)
+      .def_property_readonly("finished", &ToolClosedLoop::finished)
+      .def_property_readonly("object_names", &ToolClosedLoop::object_names);
   module.def("defaults", [] { return impetus::defaults_document().dump(); });
 }

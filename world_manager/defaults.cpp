@@ -22,6 +22,7 @@ nlohmann::json defaults_document() {
   for (const EngineEntry& entry : engine_entries()) engines.push_back(std::string(entry.name));
   const PhysicsParams& physics = scene.physics;
   const HapticParams& haptic = scene.haptic;
+  const ToolCoupling tool;
   return {
       {"couplings", couplings},
       {"engines", engines},
@@ -41,7 +42,14 @@ nlohmann::json defaults_document() {
         {"haptic",
          {{"reach_radius_m", haptic.reach_radius_m},
           {"stiffness_Npm", haptic.stiffness_Npm},
-          {"damping_Nspm", haptic.damping_Nspm}}}}},
+          {"damping_Nspm", haptic.damping_Nspm}}},
+        {"tool",
+         {{"stiffness_Npm", tool.stiffness_Npm},
+          {"damping_Nspm", tool.damping_Nspm},
+          {"rotational_stiffness_Nmprad", tool.rotational_stiffness_Nmprad},
+          {"rotational_damping_Nmsprad", tool.rotational_damping_Nmsprad},
+          {"max_force_N", tool.max_force_N},
+          {"max_torque_Nm", tool.max_torque_Nm}}}}},
   };
 }
 

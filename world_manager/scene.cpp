@@ -31,6 +31,15 @@ using nlohmann::json;
 constexpr double kUnitQuaternionTolerance = 1e-6;
 using Node = JsonNode;
 
+std::array<double, 4> parse_unit_quaternion(const Node& node) {
+  const std::array<double, 4> q = node.numbers<4>();
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (std::abs(norm - 1.0) > kUnitQuaternionTolerance) {
+    node.fail("quaternion must be unit within 1e-6 (norm " + std::to_string(norm) + ")");
+  }
+  return q;
+}
+
 Material parse_material(const Node& node, Material material) {
   if (node.has("static_friction")) {
     material.static_friction = node.child("static_friction").in_range(0.0, SceneLimits::kMaxFriction, "");
@@ -299,15 +308,7 @@ SceneObject parse_object(const Node& node, const std::string& scene_dir) {
       position.element(i).in_range(-SceneLimits::kMaxCoordinate_m, SceneLimits::kMaxCoordinate_m, " m");
     }
   }
-  if (node.has("orientation_wxyz")) {
-    const Node q_node = node.child("orientation_wxyz");
-    object.orientation_wxyz = q_node.numbers<4>();
-    const auto& q = object.orientation_wxyz;
-    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    if (std::abs(norm - 1.0) > kUnitQuaternionTolerance) {
-      q_node.fail("quaternion must be unit within 1e-6 (norm " + std::to_string(norm) + ")");
-    }
-  }
+  if (node.has("orientation_wxyz")) object.orientation_wxyz = parse_unit_quaternion(node.child("orientation_wxyz"));
   if (node.has("linear_velocity_mps")) {
     object.linear_velocity_mps = node.child("linear_velocity_mps").vector_up_to(SceneLimits::kMaxSpeed_mps, " m/s");
   }
@@ -318,6 +319,58 @@ SceneObject parse_object(const Node& node, const std::string& scene_dir) {
   object.material = parse_material(node, Material{});
   if (node.has("deformable")) object.deformable = parse_deformable(node.child("deformable"), object);
   return object;
+}
+
+// The keys a tool may have; its shape's own come from the shape module.
+constexpr std::string_view kToolKeys[] = {
+    "shape", "position_m", "orientation_wxyz", "stiffness_Npm", "damping_Nspm", "rotational_stiffness_Nmprad",
+    "rotational_damping_Nmsprad", "max_force_N", "max_torque_Nm"};
+
+// A "tool" block (docs/scene-format.md): the shape in the grip's frame and the coupling, each value in its range.
+SceneTool parse_tool(const Node& node) {
+  node.expect_object();
+  const ShapeKind kind = parse_shape_kind(node.required("shape"));
+  node.expect_keys({std::span<const std::string_view>(kToolKeys), shape_keys(kind)});
+  if (kind == ShapeKind::mesh) {
+    node.child("shape").fail("a tool cannot be a mesh yet: a tool touches by its shape's corners and edges "
+                             "(docs/tool.md), which a mesh does not give; use box, sphere, capsule or cylinder");
+  }
+  SceneTool tool;
+  tool.shape.shape = parse_shape(node, kind);
+  if (node.has("position_m")) {
+    const Vec3 at = node.child("position_m").vector_up_to(SceneLimits::kMaxToolReach_m, " m");
+    tool.shape.placement.position_m = Eigen::Vector3d(at[0], at[1], at[2]);
+  }
+  if (node.has("orientation_wxyz")) {
+    const std::array<double, 4> q = parse_unit_quaternion(node.child("orientation_wxyz"));
+    tool.shape.placement.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+  }
+  ToolCoupling& coupling = tool.coupling;
+  if (node.has("stiffness_Npm")) {
+    coupling.stiffness_Npm = node.child("stiffness_Npm").positive_up_to(limits::kMaxStiffness_Npm, " N/m");
+  }
+  if (node.has("damping_Nspm")) {
+    coupling.damping_Nspm = node.child("damping_Nspm").in_range(0.0, limits::kMaxDamping_Nspm, " N·s/m");
+  }
+  if (node.has("rotational_stiffness_Nmprad")) {
+    coupling.rotational_stiffness_Nmprad = node.child("rotational_stiffness_Nmprad")
+                                               .positive_up_to(SceneLimits::kMaxRotationalStiffness_Nmprad, " N·m/rad");
+  }
+  if (node.has("rotational_damping_Nmsprad")) {
+    coupling.rotational_damping_Nmsprad = node.child("rotational_damping_Nmsprad")
+                                              .in_range(0.0, SceneLimits::kMaxRotationalDamping_Nmsprad, " N·m·s/rad");
+  }
+  if (node.has("max_force_N")) {
+    coupling.max_force_N = node.child("max_force_N").positive_up_to(SceneLimits::kMaxToolForce_N, " N");
+  }
+  if (node.has("max_torque_Nm")) {
+    coupling.max_torque_Nm = node.child("max_torque_Nm").positive_up_to(SceneLimits::kMaxToolTorque_Nm, " N·m");
+  }
+  // The farthest the tool reaches from the grip's centre: its placement plus its bounding box's farthest corner.
+  const Eigen::AlignedBox3d bounds = world_bounds(tool.shape.shape, BodyPose{});
+  tool.reach_m = tool.shape.placement.position_m.norm() +
+                 std::max(bounds.min().norm(), bounds.max().norm());
+  return tool;
 }
 
 }  // namespace
@@ -350,7 +403,7 @@ double combine_restitution(double a, double b) { return std::max(a, b); }
 
 Scene parse_scene(const nlohmann::json& document, const std::string& source_name) {
   const Node root(document, "", source_name);
-  root.expect_keys({"description", "gravity_mps2", "floor", "physics", "haptic", "objects"});
+  root.expect_keys({"description", "gravity_mps2", "floor", "physics", "haptic", "tool", "objects"});
   if (root.has("description")) root.child("description").string();  // free text for the reader; must be a string
 
   Scene scene;
@@ -361,6 +414,24 @@ Scene parse_scene(const nlohmann::json& document, const std::string& source_name
   if (root.has("floor")) scene.floor = parse_floor(root.child("floor"));
   if (root.has("physics")) scene.physics = parse_physics(root.child("physics"));
   if (root.has("haptic")) scene.haptic = parse_haptic(root.child("haptic"));
+  if (root.has("tool")) {
+    scene.tool = parse_tool(root.child("tool"));
+    // The world sends the planes of objects within the reach radius of the tool's grip: it must cover the tool, with
+    // a finger's neighbourhood around its farthest point. Given, it is checked; not given, it is widened.
+    const bool reach_given = root.has("haptic") && root.child("haptic").has("reach_radius_m");
+    if (scene.tool->reach_m > SceneLimits::kMaxReachRadius_m - HapticParams{}.reach_radius_m) {
+      root.child("tool").fail("the tool reaches " + readable(scene.tool->reach_m) + " m from its grip; the world's "
+                              "reach radius, at most " + readable(SceneLimits::kMaxReachRadius_m) + " m, must cover "
+                              "it with " + readable(HapticParams{}.reach_radius_m) + " m to spare");
+    }
+    if (!reach_given) {
+      scene.haptic.reach_radius_m = HapticParams{}.reach_radius_m + scene.tool->reach_m;
+    } else if (scene.haptic.reach_radius_m < scene.tool->reach_m) {
+      root.child("haptic").child("reach_radius_m").fail(
+          "must cover the tool, which reaches " + readable(scene.tool->reach_m) + " m from its grip (leave it out "
+          "and the world widens it to the tool's reach plus " + readable(HapticParams{}.reach_radius_m) + " m)");
+    }
+  }
 
   const Node objects = root.required("objects");
   if (!objects.value().is_array()) objects.fail("expected an array of objects");

@@ -9,6 +9,7 @@
 // SceneLimits below and common/contract/limits.h, each bound with its reason next to it.
 
 #include "common/contract/limits.h"
+#include "common/contract/tool.h"
 #include "common/contract/vec3.h"
 #include "common/runtime/input_error.h"
 #include "common/shape/shape.h"
@@ -51,6 +52,14 @@ struct SceneLimits {
   static constexpr double kMaxContactStiffness_Npm = 1e12;
   static constexpr double kMaxContactDamping_Nspm = 1e9;
   static constexpr double kMaxReachRadius_m = 10.0;  // 30× a desktop device's workspace
+  // A tool's bounds. A hand-held tool is at most an arm's length; its rotational coupling at most the linear bound at
+  // a 10 cm lever (k·r²), as the defaults (common/contract/tool.h); forces past 1 kN and torques past 100 N·m are no
+  // hand-held device's.
+  static constexpr double kMaxToolReach_m = 1.0;
+  static constexpr double kMaxRotationalStiffness_Nmprad = limits::kMaxStiffness_Npm * 0.01;
+  static constexpr double kMaxRotationalDamping_Nmsprad = limits::kMaxDamping_Nspm * 0.01;
+  static constexpr double kMaxToolForce_N = 1e3;
+  static constexpr double kMaxToolTorque_Nm = 100.0;
   // A world step costs O(objects) in ODE's broadphase and our feature grid; 10^4 static spheres step in ~35 ms on
   // this class of machine (within a 20 Hz period) and 10^5 in tens of seconds (docs/reliability.md).
   static constexpr std::size_t kMaxObjects = 10'000;
@@ -177,6 +186,14 @@ struct PhysicsParams {
   double world_period_s() const { return 1.0 / world_rate_hz; }
 };
 
+// A tool in the hand (the scene's "tool" block; docs/tool.md): a rigid tool held by the first endpoint. The world
+// does not simulate it; the haptic side's tool servo renders it against the objects (haptic_controller/tool/).
+struct SceneTool {
+  ToolShape shape;
+  ToolCoupling coupling;
+  double reach_m = 0.0;  // a bound on the tool's farthest point from the grip's centre
+};
+
 struct Scene {
   std::string source_name;  // file the scene came from, for messages
   Vec3 gravity_mps2{0.0, 0.0, -9.81};
@@ -184,6 +201,7 @@ struct Scene {
   std::vector<SceneObject> objects;  // an object's index is its object_id on the world link
   HapticParams haptic;
   PhysicsParams physics;
+  std::optional<SceneTool> tool;  // none: the endpoints are points (fingers)
 
   // object_id of the floor on the world link: one past the objects.
   std::int32_t floor_object_id() const { return static_cast<std::int32_t>(objects.size()); }

@@ -16,6 +16,7 @@
 // tool can travel (a bound the caller gives, linear and angular) cannot become active. Frames: world, SI.
 // Allocation-free; the tool's own samples are taken once, at construction.
 
+#include "common/contract/tool.h"
 #include "common/shape/shape.h"
 #include "haptic_controller/contact_plane.h"
 
@@ -29,12 +30,6 @@ namespace impetus {
 namespace tool_detail {
 struct PlacedBody;  // a body placed in the world, as the contacts see it (tool_contacts.cpp)
 }  // namespace tool_detail
-
-// The tool: a shape placed in the grip's frame (its centre of mass and axes there), rigidly held by the endpoint.
-struct ToolShape {
-  Shape shape;
-  BodyPose placement;  // shape frame → grip frame
-};
 
 // One unilateral constraint on the tool: gap_m + a·q ≥ 0 for a small move q = (δx, δθ) of the grip pose, with
 // a = [normal; lever_m × normal] (lever from the grip's centre to tool_point_m).

@@ -52,10 +52,12 @@ ToolProxy::ToolProxy(const ToolShape& tool, const ToolCoupling& coupling) : cont
 void ToolProxy::reset(const BodyPose& grip) {
   proxy_ = {grip.position_m, grip.orientation.normalized()};
   grip_ = proxy_;
+  hold_release_s_ = std::numeric_limits<double>::infinity();
+  hold_limit_count_ = 0;
   started_ = finite(proxy_);
   previous_displacement_.setZero();
-  session_start_ = true;
-  sunk_count_ = 0;
+  hold_next_ = true;
+  held_count_ = 0;
   grip_velocity_mps_.setZero();
   grip_angular_velocity_radps_.setZero();
   zero_output();
@@ -78,8 +80,13 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
     return result_;
   }
   if (!started_) reset(grip);
-  const bool session_start = session_start_;
-  session_start_ = false;
+  const bool mark_held = hold_next_;
+  hold_next_ = false;
+  for (int s = held_count_ - 1; s >= 0; --s) {
+    Held& held = held_[static_cast<std::size_t>(s)];
+    held.depth_m -= held.release_mps * dt_s;
+    if (!(held.depth_m > 0.0)) held = held_[static_cast<std::size_t>(--held_count_)];
+  }
   grip_velocity_mps_ = (grip.position_m - grip_.position_m) / dt_s;
   grip_angular_velocity_radps_ = turn_between(grip_.orientation, grip.orientation) / dt_s;
   grip_ = grip;
@@ -88,7 +95,7 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
   if (contacts_.path_clear(planes, proxy_, grip)) {
     proxy_ = grip;
     previous_displacement_.setZero();
-    sunk_count_ = 0;
+    held_count_ = 0;
     zero_output();
     return result_;
   }
@@ -101,6 +108,7 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
   // the same ones again where the tool now is, unless the passes together have moved the tool farther than that
   // reach (then some other contact may have come within it, and the pass is made again from a new gathering).
   double travelled_m = 0.0, turned_rad = 0.0;
+  Vector6d last_move = Vector6d::Zero();
   for (int p = 0; p < kMaxToolPasses; ++p) {
     const Vector6d target = -displacement(proxy_, grip);
     const BodyPose before = proxy_;
@@ -113,14 +121,15 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
     }
     if (p == 0 || travelled_m > gathered_.linear_m || turned_rad > gathered_.angular_rad) {
       proxy_ = before;
-      q = pass(planes, target, true, session_start && p == 0);
+      q = pass(planes, target, true, mark_held && p == 0);
       travelled_m = q.head<3>().norm();
       turned_rad = q.tail<3>().norm();
     }
+    last_move = q;
     const double moved_m = q.head<3>().norm() + q.tail<3>().norm() * contacts_.bounding_radius_m();
     if (failed_ || result_.active == 0 || moved_m <= kToolSettled_m) break;
   }
-  release_sunk();
+  release_held(last_move);
   const Vector6d e = displacement(proxy_, grip);
   damp(e, dt_s);
   previous_displacement_ = e;
@@ -203,7 +212,7 @@ void ToolProxy::damp(const Vector6d& displacement_now, double dt_s) {
   }
 }
 
-Vector6d ToolProxy::pass(const PlaneSet& planes, const Vector6d& target, bool gather, bool mark_sunk) {
+Vector6d ToolProxy::pass(const PlaneSet& planes, const Vector6d& target, bool gather, bool mark_held) {
   const double k_Npm = coupling_.stiffness_Npm;
   const double k_r_Nmprad = coupling_.rotational_stiffness_Nmprad;
   // The move q minimises ½(q − q*)ᵀK(q − q*) over a convex set that holds q = 0 (every gap is kept ≥ 0), so
@@ -215,17 +224,22 @@ Vector6d ToolProxy::pass(const PlaneSet& planes, const Vector6d& target, bool ga
   if (gather) {
     ToolReach reach{reach_K / std::sqrt(k_Npm) + kReachRounding_m, reach_K / std::sqrt(k_r_Nmprad)};
     count = contacts_.gather(planes, proxy_, reach);
-    if (mark_sunk) {
+    if (mark_held) {
       for (int k = 0; k < count; ++k) {
-        if (contacts_[k].gap_m < 0.0) sink(contacts_[k].object_id);
+        if (!(contacts_[k].gap_m < 0.0)) continue;
+        double most_m = -contacts_[k].gap_m;
+        for (int h = 0; h < hold_limit_count_; ++h) {
+          const Held& limit = hold_limits_[static_cast<std::size_t>(h)];
+          if (limit.object_id == contacts_[k].object_id) most_m = std::min(most_m, limit.depth_m);
+        }
+        if (most_m > 0.0) hold(contacts_[k].object_id, most_m);
       }
     }
-    // A body the proxy is inside that it did not start in (one that came onto the tool, or the last pass's
-    // linearised turn) pushes it out: the move may then be longer by the depth (twice it, for a push-out between
-    // oblique faces).
+    // A body the proxy is inside beyond its allowance (one that came onto the tool, or the last pass's linearised
+    // turn) pushes it out: the move may then be longer by the depth (twice it, for a push-out between oblique faces).
     double deepest_m = 0.0;
     for (int k = 0; k < count; ++k) {
-      if (!sunk(contacts_[k].object_id)) deepest_m = std::max(deepest_m, -contacts_[k].gap_m);
+      deepest_m = std::max(deepest_m, -(contacts_[k].gap_m + allowance_m(contacts_[k].object_id)));
     }
     if (deepest_m > 0.0) {
       reach.linear_m += 2.0 * deepest_m;
@@ -235,15 +249,15 @@ Vector6d ToolProxy::pass(const PlaneSet& planes, const Vector6d& target, bool ga
     ++result_.gathers;
   }
 
-  // Rows a = [n; r × n]. A body the tool started inside keeps its gap ≥ 0: the proxy may not go deeper into it, but
-  // is not thrown out (its energy nobody put in).
+  // Rows a = [n; r × n]. A held body's gap is taken less its allowance, up to 0: the proxy may stay as deep in it as
+  // the allowance, no deeper, and is not thrown out (energy nobody put in).
   for (int k = 0; k < count; ++k) {
     const ToolConstraint& c = contacts_[k];
     ContactQpRow& row = rows_[static_cast<std::size_t>(k)];
     row.a.head<3>() = c.normal;
     row.a.tail<3>() = (c.tool_point_m - proxy_.position_m).cross(c.normal);
-    const bool started_inside = sunk(c.object_id);
-    row.gap_m = started_inside ? std::max(c.gap_m, 0.0) : c.gap_m;
+    const double allowance = allowance_m(c.object_id);
+    row.gap_m = allowance > 0.0 ? std::min(std::max(c.gap_m, 0.0), c.gap_m + allowance) : c.gap_m;
   }
   Vector6d metric;
   metric << k_Npm, k_Npm, k_Npm, k_r_Nmprad, k_r_Nmprad, k_r_Nmprad;
@@ -280,26 +294,38 @@ Vector6d ToolProxy::pass(const PlaneSet& planes, const Vector6d& target, bool ga
   return solved.q;
 }
 
-bool ToolProxy::sunk(std::int32_t object_id) const {
-  for (int k = 0; k < sunk_count_; ++k) {
-    if (sunk_[static_cast<std::size_t>(k)] == object_id) return true;
+double ToolProxy::allowance_m(std::int32_t object_id) const {
+  for (int k = 0; k < held_count_; ++k) {
+    if (held_[static_cast<std::size_t>(k)].object_id == object_id) return held_[static_cast<std::size_t>(k)].depth_m;
   }
-  return false;
+  return 0.0;
 }
 
-void ToolProxy::sink(std::int32_t object_id) {
-  if (sunk(object_id) || sunk_count_ == static_cast<int>(sunk_.size())) return;
-  sunk_[static_cast<std::size_t>(sunk_count_++)] = object_id;
+void ToolProxy::hold(std::int32_t object_id, double depth_m) {
+  for (int k = 0; k < held_count_; ++k) {
+    Held& held = held_[static_cast<std::size_t>(k)];
+    if (held.object_id != object_id) continue;
+    held.depth_m = std::max(held.depth_m, depth_m);
+    held.release_mps = std::isfinite(hold_release_s_) ? held.depth_m / hold_release_s_ : 0.0;
+    return;
+  }
+  if (held_count_ == static_cast<int>(held_.size())) return;
+  const double release_mps = std::isfinite(hold_release_s_) ? depth_m / hold_release_s_ : 0.0;
+  held_[static_cast<std::size_t>(held_count_++)] = {object_id, depth_m, release_mps};
 }
 
-void ToolProxy::release_sunk() {
-  // An object the tool started in is released once the last pass found the tool inside it nowhere.
-  for (int s = sunk_count_ - 1; s >= 0; --s) {
-    bool inside = false;
-    for (int k = 0; k < contacts_.count() && !inside; ++k) {
-      inside = contacts_[k].gap_m < 0.0 && contacts_[k].object_id == sunk_[static_cast<std::size_t>(s)];
+void ToolProxy::release_held(const Vector6d& last_move) {
+  // The depth the proxy has in each held object after the last pass's move: its contacts' gaps as measured before
+  // the move, carried by it to first order (gap + a·q).
+  for (int s = held_count_ - 1; s >= 0; --s) {
+    Held& held = held_[static_cast<std::size_t>(s)];
+    double depth_m = 0.0;
+    for (int k = 0; k < contacts_.count(); ++k) {
+      if (contacts_[k].object_id != held.object_id) continue;
+      depth_m = std::max(depth_m, -(contacts_[k].gap_m + rows_[static_cast<std::size_t>(k)].a.dot(last_move)));
     }
-    if (!inside) sunk_[static_cast<std::size_t>(s)] = sunk_[static_cast<std::size_t>(--sunk_count_)];
+    held.depth_m = std::min(held.depth_m, depth_m);
+    if (!(held.depth_m > 0.0)) held = held_[static_cast<std::size_t>(--held_count_)];
   }
 }
 

@@ -28,6 +28,7 @@
 // the servo thread; allocation-free, no exceptions after construction.
 
 #include "common/contract/frames.h"
+#include "common/contract/tool.h"
 #include "common/shape/shape.h"
 #include "haptic_controller/contact_plane.h"
 #include "haptic_controller/impulse_accumulator.h"
@@ -39,18 +40,9 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 
 namespace impetus {
-
-struct ToolCoupling {
-  double stiffness_Npm = 2000.0;               // k
-  double damping_Nspm = 2.0;                   // b: k·T at 1 kHz, as the point finger's default (force_renderer.h)
-  double rotational_stiffness_Nmprad = 20.0;   // k_r
-  double rotational_damping_Nmsprad = 0.02;    // b_r: k_r·T at 1 kHz
-  // The device's limits: a wrench beyond either is scaled down whole (its direction kept), and its reaction with it.
-  double max_force_N = 10.0;
-  double max_torque_Nm = 0.5;
-};
 
 struct ToolResult {
   BodyPose proxy;  // the proxy's grip pose
@@ -97,6 +89,21 @@ class ToolProxy {
 
   // Puts the proxy on the grip, with no history (the device attached, a session restart).
   void reset(const BodyPose& grip);
+  // The objects' poses jumped (a world frame that disagrees with the local model, or a new world): the next solve
+  // holds the proxy inside whatever it then overlaps instead of pushing it out at once, as at a session start
+  // (held_ below), and lets it out over `release_s` of solve time (infinity: only as the tool withdraws).
+  // limit_hold then bounds what object `object_id` may hold to `most_m` (the most its jump can have moved any of its
+  // points toward the tool); an object without a bound holds all of its overlap.
+  void hold_overlaps(double release_s) {
+    hold_next_ = true;
+    hold_release_s_ = release_s;
+    hold_limit_count_ = 0;
+  }
+  void limit_hold(std::int32_t object_id, double most_m) {
+    if (hold_limit_count_ < static_cast<int>(hold_limits_.size())) {
+      hold_limits_[static_cast<std::size_t>(hold_limit_count_++)] = {object_id, most_m};
+    }
+  }
 
   // One tick: the grip at `grip`, dt_s (> 0) after the last; `planes` the objects near the tool this tick.
   const ToolResult& solve(const PlaneSet& planes, const BodyPose& grip, double dt_s);
@@ -118,12 +125,14 @@ class ToolProxy {
  private:
   // One pass: gathers the contacts at the proxy now, solves the QP toward `target` and moves the proxy.
   // One solve of the QP toward `target` from the proxy now, which it moves; returns the move (δx, δθ). `gather`:
-  // gathers the contacts within the move's reach first (else uses those gathered or refreshed last); `mark_sunk`:
-  // the first pass of a session, whose overlapped objects the tool started in.
-  Vector6d pass(const PlaneSet& planes, const Vector6d& target, bool gather, bool mark_sunk);
-  bool sunk(std::int32_t object_id) const;
-  void sink(std::int32_t object_id);
-  void release_sunk();
+  // gathers the contacts within the move's reach first (else uses those gathered or refreshed last); `mark_held`:
+  // the first pass after a session start or a jump (hold_overlaps), whose overlapped objects are held.
+  Vector6d pass(const PlaneSet& planes, const Vector6d& target, bool gather, bool mark_held);
+  // How deep the proxy may stay in `object_id` (m; 0: not held).
+  double allowance_m(std::int32_t object_id) const;
+  void hold(std::int32_t object_id, double depth_m);
+  // After the passes: each held object's allowance shrinks to the depth the moved proxy still has in it.
+  void release_held(const Vector6d& last_move);
   // The damper's part, and the pushes (forces_) that carry the wrench: step 3 of the header.
   void damp(const Vector6d& displacement_now, double dt_s);
   void share_reaction(const PlaneSet& planes, const BodyPose& grip, double dt_s);
@@ -135,11 +144,24 @@ class ToolProxy {
   BodyPose grip_;  // at the last solve
   bool started_ = false;
   bool failed_ = false;  // a pass of this solve found no move (pass())
-  bool session_start_ = true;
-  // Objects the tool started inside (at reset): the proxy may not go deeper into them but is not pushed out, until
-  // it has left them (as the point finger's god-object, god_object.h).
-  std::array<std::int32_t, kMaxServoPlanes> sunk_{};
-  int sunk_count_ = 0;
+  bool hold_next_ = true;
+  double hold_release_s_ = std::numeric_limits<double>::infinity();
+  // Objects the proxy overlapped when it started (the session's first solve) or when their poses jumped
+  // (hold_overlaps): the proxy is not thrown out of them, which would be a kick nobody's push caused. Each keeps the
+  // depth the proxy had in it then, its allowance: the proxy goes no deeper, and the allowance shrinks to the depth
+  // the proxy still has as it leaves, and over the release time at a steady rate (a frame's correction reaches the
+  // hand as a ramp over the world period, as the point finger's plane blends over it, local_dynamics.h). At a
+  // session start it is released only by leaving (the point finger's god-object, god_object.h). An object that moves
+  // in farther than its allowance still pushes the proxy.
+  struct Held {
+    std::int32_t object_id = -1;
+    double depth_m = 0.0;
+    double release_mps = 0.0;  // how fast the allowance shrinks by itself
+  };
+  std::array<Held, kMaxServoPlanes> held_{};
+  int held_count_ = 0;
+  std::array<Held, kMaxServoPlanes> hold_limits_{};  // depth_m: the most object_id may hold at the next mark
+  int hold_limit_count_ = 0;
   Vector6d previous_displacement_ = Vector6d::Zero();
   Eigen::Vector3d grip_velocity_mps_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d grip_angular_velocity_radps_ = Eigen::Vector3d::Zero();

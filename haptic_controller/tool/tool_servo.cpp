@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace impetus {
 
@@ -16,12 +17,41 @@ ToolServo::ToolServo(const ToolShape& tool, const ToolCoupling& coupling, std::u
 void ToolServo::on_plane_frame(const PlaneFrame& frame, double now_s) {
   const bool continues = have_frame_ && frame.world_session == current_frame_.world_session;
   motion_ = frame.coupling == Coupling::local ? static_cast<PlaneMotion*>(&local_) : &interpolated_;
+  // A local frame restarts the objects from the world's state, which may put them where the model did not: the proxy
+  // is held inside what it then overlaps and let out over the period, not thrown out (tool_proxy.h). A new world may
+  // put them anywhere: held until the tool leaves.
+  if (!continues) {
+    proxy_.hold_overlaps(std::numeric_limits<double>::infinity());
+  } else if (frame.coupling == Coupling::local) {
+    proxy_.hold_overlaps(frame.world_period_s);
+    limit_holds(frame);
+  }
   motion_->on_frame(continues ? current_frame_ : frame, frame, continues ? &planes_ : nullptr,
                     result_.proxy.position_m);
   copy_used(frame, current_frame_);
   have_frame_ = true;
   frame_arrival_s_ = now_s;
   accumulator_.on_plane_frame(frame);
+}
+
+void ToolServo::limit_holds(const PlaneFrame& frame) {
+  // Only the world's correction of the model is held, not the motion the model had already shown (an object that
+  // settles onto the tool under its weight must still be held up): per object, the most the jump from the pose the
+  // tool was meeting (the last tick's plane) to the frame's moved any of its points, |δx| + |δθ|·r with r the
+  // farthest point of its shape from its centre.
+  for (std::uint32_t k = 0; k < frame.plane_count && k < kMaxServoPlanes; ++k) {
+    const ContactPlane now = to_contact_plane(frame.planes[k]);
+    for (std::uint32_t d = 0; d < planes_.count; ++d) {
+      const ContactPlane& shown = planes_.planes[d];
+      if (shown.object_id != now.object_id) continue;
+      const BodyPose a = object_pose(shown), b = object_pose(now);
+      const Eigen::AlignedBox3d bounds = world_bounds(now.shape, BodyPose{});
+      const double radius_m = std::max(bounds.min().norm(), bounds.max().norm());
+      proxy_.limit_hold(now.object_id, (b.position_m - a.position_m).norm() +
+                                           a.orientation.angularDistance(b.orientation) * radius_m);
+      break;
+    }
+  }
 }
 
 void ToolServo::idle() {

@@ -62,6 +62,8 @@ class ToolServo {
 
  private:
   void idle();
+  // Bounds what each object the frame moves may hold the proxy inside (tool_proxy.h hold_overlaps).
+  void limit_holds(const PlaneFrame& frame);
 
   PlaneFrame current_frame_{};
   bool have_frame_ = false;

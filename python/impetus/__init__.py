@@ -13,6 +13,12 @@ Or drive the finger yourself, tick by tick (a controller, a policy, a model of a
         step = sim.step(50, targets=...)              # ticks x fingers x 3 targets; forces, proxy, ... come back
         sim.objects()["position_m"]                   # where the objects are
 
+Or hold a tool (the scene's "tool" block) on the simulated 8-string grip SPIDAR, pose by pose:
+
+    with impetus.ToolSimulation(impetus.shipped_scene("peg_in_hole"), start_m=[0, 0, 0.1]) as sim:
+        step = sim.step(targets=...)                  # ticks x 3 positions, or ticks x 7 poses (x, y, z, w, qx, qy, qz)
+        step.force_N, step.torque_Nm                  # the wrench on the grip
+
 A trial is the world, haptic and device nodes of the three daemons, run in this process under the lockstep schedule:
 bitwise the same outcome as `scripts/run.sh --clock lockstep` with the same arguments, and no process is started.
 The call releases the GIL while the trial runs. Trials in one process take turns (the physics engine's state is
@@ -41,8 +47,8 @@ except ImportError as _error:
     raise ImportError(f"impetus: its compiled module cannot be loaded: {_error}") from _error
 
 __version__ = "@PROJECT_VERSION@"
-__all__ = ["COUPLINGS", "ENGINES", "LOG_FILES", "Simulation", "Step", "Trial", "defaults", "read_log", "run_trial",
-           "sample_trajectory", "scene_dir", "shipped_scene"]
+__all__ = ["COUPLINGS", "ENGINES", "LOG_FILES", "Simulation", "Step", "ToolSimulation", "ToolStep", "Trial",
+           "defaults", "read_log", "run_trial", "sample_trajectory", "scene_dir", "shipped_scene"]
 
 
 
@@ -518,3 +524,157 @@ class Simulation:
     def __repr__(self):
         state = "closed" if self._loop is None else f"{self.ticks} ticks"
         return f"Simulation({self._scene_name}, fingers {', '.join(self.finger_names)}, {state})"
+
+
+class ToolStep:
+    """What the tool servo and the grip device did in the ticks of one ToolSimulation.step call, one row per tick:
+
+    time_s                ticks      the tick's time t·T (s)
+    target_m, target_wxyz ticks x 3, ticks x 4   the hand's target pose at the tick's end
+    grip_m, grip_wxyz     the grip's pose as the driver measured it from the eight string counts
+    hand_m, hand_wxyz     where the simulated hand truly holds the grip at the tick's end
+    proxy_m, proxy_wxyz   the tool's proxy (the pose the tool would have if it could not go in)
+    force_N, torque_Nm    ticks x 3  the wrench on the grip (torque about its centre), as the servo commanded it
+    strings_force_N, strings_torque_Nm   what the eight string tensions put on the grip
+    active                ticks      contacts pushing the tool
+    Orientations are unit quaternions w, x, y, z, grip -> world.
+    """
+
+    __slots__ = ("time_s", "target_m", "target_wxyz", "grip_m", "grip_wxyz", "hand_m", "hand_wxyz", "proxy_m",
+                 "proxy_wxyz", "force_N", "torque_Nm", "strings_force_N", "strings_torque_Nm", "active")
+
+    def __init__(self, arrays):
+        for name in self.__slots__:
+            setattr(self, name, arrays[name])
+
+    def __len__(self):
+        return len(self.time_s)
+
+    def __repr__(self):
+        if not len(self):
+            return "ToolStep(0 ticks)"
+        force, torque = self.force_N[-1], self.torque_Nm[-1]
+        return (f"ToolStep({len(self)} ticks to t = {self.time_s[-1]:.3f} s; grip at {self.grip_m[-1]} m, force "
+                f"[{force[0]:+.3f} {force[1]:+.3f} {force[2]:+.3f}] N, torque "
+                f"[{torque[0]:+.4f} {torque[1]:+.4f} {torque[2]:+.4f}] N·m)")
+
+
+class ToolSimulation:
+    """A tool in the hand, in a closed loop: the scene's tool ("tool" block, docs/scene-format.md) held by a
+    simulated hand on the simulated 8-string grip SPIDAR, rendered by the 6-DoF tool servo against the world, in
+    lockstep (bitwise reproducible). The caller moves the hand's target pose; the hand follows it with its own
+    impedance, so the tool stops at surfaces and the hand feels the force and torque.
+
+        with impetus.ToolSimulation(impetus.shipped_scene("peg_in_hole"), start_m=[0, 0, 0.1]) as sim:
+            step = sim.step(targets=np.linspace([0, 0, 0.1], [0, 0, 0.045], 1000))   # down the hole
+            step.force_N[-1]                            # the hole's floor pushing back
+            summary = sim.close()                       # counters, and per object the impulse rendered and applied
+
+    scene        a scene file or a dict in its schema, with a "tool" block
+    start_m      where the grip starts, at rest (x, y, z, metres); start_wxyz its orientation (default level)
+    coupling     "local" (default) or "impulse"; position coupling samples one point and is refused
+    rate_hz      the world's rate (default: the scene's); a 1 ms tick must divide its period
+
+    The world steps every n ticks (n = 1000 / world rate), at ticks 0, n, 2n, ...
+    """
+
+    def __init__(self, scene, start_m, coupling="local", *, start_wxyz=(1.0, 0.0, 0.0, 0.0), rate_hz=None):
+        import numpy as np
+        self._np = np
+        self._loop = None
+        self.summary = None
+        scene_path, scene_text = _scene_argument(scene)
+        if coupling not in COUPLINGS:
+            raise ValueError(f"coupling: must be one of {', '.join(COUPLINGS)}, not {coupling!r}")
+        start = self._pose("start", Simulation._point("start_m", start_m), start_wxyz)
+        self._scene_name = scene_path if not scene_text else "(dict)"
+        self._loop = _impetus.ToolClosedLoop(scene_path, scene_text, coupling, _real("rate_hz", rate_hz, True), start)
+        self.object_names = tuple(self._loop.object_names)
+        self.tick_period_s = self._loop.tick_period_s
+
+    def _pose(self, name, position, wxyz):
+        np = self._np
+        try:
+            q = np.asarray(wxyz, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name}_wxyz: must be four numbers (w, x, y, z), not {wxyz!r}") from None
+        if q.shape != (4,) or not np.all(np.isfinite(q)) or abs(np.linalg.norm(q) - 1.0) > 1e-6:
+            raise ValueError(f"{name}_wxyz: must be a unit quaternion (w, x, y, z; norm 1 within 1e-6), not {wxyz!r}")
+        return tuple(position) + tuple(float(v) for v in q)
+
+    def _open(self):
+        if self._loop is None or self._loop.finished:
+            raise RuntimeError("impetus.ToolSimulation: closed; make a new one")
+        return self._loop
+
+    @property
+    def ticks(self):
+        """Ticks taken so far."""
+        return self._loop.ticks if self._loop is not None else 0
+
+    def step(self, ticks=None, targets=None):
+        """Takes `ticks` ticks (default 1, or as many as `targets` has rows) and returns their ToolStep.
+
+        targets   None (the target holds), or the target at the end of each tick: ticks x 3 positions (the
+                  orientation held level) or ticks x 7 poses (x, y, z in metres, then a unit quaternion w, x, y, z)"""
+        np = self._np
+        loop = self._open()
+        table = None
+        if targets is not None:
+            try:
+                table = np.asarray(targets, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise ValueError(f"targets: must be an array of poses, not {type(targets).__name__}") from None
+            if table.ndim != 2 or table.shape[1] not in (3, 7):
+                raise ValueError(f"targets: must be ticks x 3 or ticks x 7, not shape {table.shape}")
+            if table.shape[1] == 3:
+                table = np.hstack([table, np.tile([1.0, 0.0, 0.0, 0.0], (table.shape[0], 1))])
+            if not np.all(np.isfinite(table)):
+                raise ValueError("targets: must be finite")
+            norms = np.linalg.norm(table[:, 3:], axis=1)
+            if np.any(np.abs(norms - 1.0) > 1e-6):
+                raise ValueError(f"targets: row {int(np.argmax(np.abs(norms - 1.0)))}'s quaternion is not unit")
+            if ticks is not None and int(ticks) != table.shape[0]:
+                raise ValueError(f"ticks: {ticks} but targets has {table.shape[0]} rows")
+            ticks = table.shape[0]
+            table = np.ascontiguousarray(table)
+        else:
+            ticks = 1 if ticks is None else ticks
+        if isinstance(ticks, bool) or not isinstance(ticks, numbers.Integral) or not 0 <= ticks < 2**32:
+            raise ValueError(f"ticks: must be a whole number from 0 to 2**32 - 1, not {ticks!r}")
+        return ToolStep(loop.step(int(ticks), table))
+
+    def set_target(self, target_m, target_wxyz=(1.0, 0.0, 0.0, 0.0)):
+        """Moves the hand's target to the pose over the next tick; it holds there."""
+        self._open().set_target(self._pose("target", Simulation._point("target_m", target_m), target_wxyz))
+
+    def objects(self):
+        """Every scene object after the world's last step, in scene order (object_names): a dict of arrays
+        "position_m", "velocity_mps", "angular_velocity_radps", "impulse_Ns", "angular_impulse_Nms" (what the
+        couplings applied), objects x 3, and "orientation_wxyz", objects x 4."""
+        return self._open().objects()
+
+    def close(self):
+        """Ends the run (two more world steps apply the last ticks' impulse) and returns the summary: ticks, the
+        tool's and the device's counters, and per object touched the impulse rendered and applied ("ledger")."""
+        if self.summary is not None or self._loop is None:
+            return self.summary
+        self.summary = json.loads(self._loop.finish())
+        self.summary["scene"] = self._scene_name
+        self._loop = None
+        return self.summary
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __del__(self):
+        if getattr(self, "_loop", None) is not None:
+            self.close()
+
+    def __repr__(self):
+        state = "closed" if self._loop is None else f"{self.ticks} ticks"
+        return f"ToolSimulation({self._scene_name}, {state})"

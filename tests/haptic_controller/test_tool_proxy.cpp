@@ -597,3 +597,50 @@ TEST_CASE("tool: wandered through clutter of every kind, the tool stays out of e
     CHECK(ghosts <= scored / 100);
   }
 }
+
+// A world frame that disagrees with the local model moves an object the tool is pressing into it (tool_servo.h): held
+// (hold_overlaps), the correction reaches the hand as a ramp over the period, not as a kick, and only as much of it as
+// the jump's bound (limit_hold) allows; a real overlap beyond the bound is pushed out at once.
+TEST_CASE("tool: an object's jump into the pressed tool is let out over the release time, within its bound") {
+  const ToolCoupling coupling;
+  const Vector3d half(0.05, 0.05, 0.01);
+  const auto box_at = [&](double top_m) { return set_of({box_object(1, Vector3d(0, 0, top_m - 0.01), half, true)}); };
+  const BodyPose grip = pose_at(Vector3d(0.0, 0.0, 0.009));  // 1 mm into the box's top at z = 0
+  const auto press = [&](ToolProxy& proxy) {
+    proxy.reset(pose_at(Vector3d(0.0, 0.0, 0.02)));
+    for (int tick = 0; tick < 100; ++tick) proxy.solve(box_at(0.0), grip, kTick_s);
+    return proxy.result().force_N.z();
+  };
+  const double jump_m = 0.5e-3, release_s = 0.05;
+  SECTION("held: the force climbs by k·jump over the release time, never faster than its even ramp") {
+    ToolProxy proxy(cube_tool(), coupling);
+    const double before_N = press(proxy);
+    proxy.hold_overlaps(release_s);
+    proxy.limit_hold(1, jump_m);
+    double last_N = before_N;
+    for (int tick = 1; tick <= 60; ++tick) {
+      const double now_N = proxy.solve(box_at(jump_m), grip, kTick_s).force_N.z();
+      // The spring's ramp k·jump·Δt/T a tick, and its damper b·jump/T.
+      REQUIRE(now_N - last_N <= coupling.stiffness_Npm * jump_m * kTick_s / release_s +
+                                    coupling.damping_Nspm * jump_m / release_s + 1e-9);
+      last_N = now_N;
+    }
+    CHECK(last_N == Approx(before_N + coupling.stiffness_Npm * jump_m).epsilon(1e-6));
+    CHECK(overlap_m(cube_tool(), proxy.result().proxy, box_at(jump_m)) < 1e-9);
+  }
+  SECTION("not held: the proxy is thrown out at once") {
+    ToolProxy proxy(cube_tool(), coupling);
+    const double before_N = press(proxy);
+    const double now_N = proxy.solve(box_at(jump_m), grip, kTick_s).force_N.z();
+    CHECK(now_N - before_N > coupling.stiffness_Npm * jump_m);
+  }
+  SECTION("a bound below the overlap: the excess is pushed out at once, the rest let out") {
+    ToolProxy proxy(cube_tool(), coupling);
+    const double before_N = press(proxy);
+    proxy.hold_overlaps(release_s);
+    proxy.limit_hold(1, 0.2e-3);
+    const double first_N = proxy.solve(box_at(jump_m), grip, kTick_s).force_N.z();
+    CHECK(first_N - before_N >= coupling.stiffness_Npm * 0.3e-3 * (1.0 - 1e-6));
+    CHECK(first_N - before_N < coupling.stiffness_Npm * 0.3e-3 + coupling.damping_Nspm * 0.3e-3 / kTick_s + 0.01);
+  }
+}

@@ -36,11 +36,11 @@ TEST_CASE("tool loop: a peg strikes a free cube off its centre: the world applie
 using impetus::test::Lever;
 using impetus::test::lever;
 
-// The tipping angle against the 1 kHz world is measured in the benchmark and docs/tool.md, not asserted here: at 20 Hz
-// local coupling overshoots it (its model does not know the box pivots on the ledge), and impulse coupling throws the
-// box over.
+// The tipping angle against the 1 kHz world at 20–50 Hz is measured in the benchmark and docs/tool.md, not asserted
+// here: local coupling's model does not know the box pivots on the ledge (it lets the box rise as a free body, so the
+// hand meets a softer box and the world's box hardly tips at 20 Hz), and impulse coupling throws the box over.
 TEST_CASE("tool loop: a hand levers a box up over a ledge's edge with a tool: the world applies what the tool "
-          "rendered, and the box tips without going over") {
+          "rendered, the box tips as the 1 kHz world's at 100 Hz, and no frame kicks the hand") {
   const Lever reference = lever(1000.0, Coupling::impulse);
   CHECK(reference.peak_pitch_rad > 0.05);
   CHECK(reference.peak_pitch_rad < 0.2);
@@ -51,7 +51,14 @@ TEST_CASE("tool loop: a hand levers a box up over a ledge's edge with a tool: th
     CHECK((at_20.applied_Ns - at_20.rendered_Ns).norm() <= 1e-12 * at_20.rendered_Ns.norm());
     CHECK((at_20.applied_Nms - at_20.rendered_Nms).norm() <= 1e-12 * at_20.rendered_Nms.norm());
   }
-  const Lever local = lever(20.0, Coupling::local);
-  CHECK(local.peak_pitch_rad > 0.05);
-  CHECK(local.peak_pitch_rad < 0.5);  // tipping over takes 0.59 rad (its centre of mass above the edge)
+  // At 100 Hz the local model's box stays near the world's within a period: held where the 1 kHz world holds it.
+  const Lever local_100 = lever(100.0, Coupling::local);
+  CHECK(local_100.end_pitch_rad == Approx(reference.end_pitch_rad).epsilon(0.05));
+  // At 20 Hz each frame corrects the model by millimetres; the correction reaches the hand as a ramp over the period
+  // (tool_proxy.h), not as a kick: the push stays within what the hand's 300 N/m spring gives over its target's 8 mm
+  // past the box's bottom (2.4 N) plus the spring's overshoot, where a frame's correction thrown at the hand at once
+  // drove it to the device's 10 N limit.
+  const Lever local_20 = lever(20.0, Coupling::local);
+  CHECK(local_20.peak_force_N < 3.0);
+  CHECK(local_20.peak_pitch_rad < 0.5);  // tipping over takes 0.59 rad (its centre of mass above the edge)
 }

@@ -402,3 +402,44 @@ TEST_CASE("scene error: deep nesting and huge tokens give a short message withou
     CHECK_THAT(message, Catch::Contains(test_case.name) && Catch::Contains(test_case.expected));
   }
 }
+
+TEST_CASE("a tool block is parsed, its reach widens the world's, and bad values name their field") {
+  const Scene scene = impetus::load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/peg_in_hole.json");
+  REQUIRE(scene.tool);
+  CHECK(scene.tool->shape.shape.kind == impetus::ShapeKind::box);
+  CHECK(scene.tool->shape.placement.position_m.z() == Approx(-0.03));
+  CHECK(scene.tool->coupling.stiffness_Npm == 2000.0);
+  // The peg's farthest corner is 3 cm + √(5² + 5² + 20²) mm from the grip; the reach is that plus a finger's 5 cm.
+  CHECK(scene.tool->reach_m == Approx(0.03 + std::sqrt(2 * 0.005 * 0.005 + 0.02 * 0.02)));
+  CHECK(scene.haptic.reach_radius_m == Approx(0.05 + scene.tool->reach_m));
+  const impetus::Scene none = impetus::parse_scene(scene_with(cube()), "ok.json");
+  CHECK_FALSE(none.tool);
+
+  const auto with_tool = [](const json& tool) {
+    json document = scene_with(cube());
+    document["tool"] = tool;
+    return document;
+  };
+  const json ball = {{"shape", "sphere"}, {"radius_m", 0.01}};
+  require_error(with_tool({{"shape", "mesh"}, {"file", "x.obj"}}), "/tool/shape", "cannot be a mesh");
+  require_error(with_tool({{"radius_m", 0.01}}), "/tool/shape", "missing");
+  json bad = ball;
+  bad["stiffness_Npm"] = -1;
+  require_error(with_tool(bad), "/tool/stiffness_Npm", "");
+  bad = ball;
+  bad["orientation_wxyz"] = {1, 1, 0, 0};
+  require_error(with_tool(bad), "/tool/orientation_wxyz", "unit");
+  bad = ball;
+  bad["radius"] = 2;
+  require_error(with_tool(bad), "/tool/radius", "unknown key");
+  bad = ball;
+  bad["position_m"] = {0, 0, -2};
+  require_error(with_tool(bad), "/tool/position_m", "");
+  require_error(with_tool({{"shape", "box"}, {"size_m", {20, 0.01, 0.01}}}), "/tool", "reaches 10 m from its grip");
+  json capsule = {{"shape", "capsule"}, {"radius_m", 0.01}, {"length_m", 0.1}, {"position_m", {0, 0, -0.05}}};
+  json document = with_tool(capsule);
+  document["haptic"] = {{"reach_radius_m", 0.05}};
+  require_error(document, "/haptic/reach_radius_m", "must cover the tool");
+  document["tool"] = ball;
+  CHECK(impetus::parse_scene(document, "ok.json").haptic.reach_radius_m == 0.05);  // given and enough: kept
+}

@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "loop/tool_loop.h"
+
+#include "common/contract/rotation.h"
+#include "haptic_controller/device/grip_driver.h"
+#include "haptic_controller/tool/tool_servo.h"
+#include "loop/in_process_rig.h"
+#include "spidar_sim/grip_sim.h"
+#include "world_manager/engine/engine_registry.h"
+#include "world_manager/scene.h"
+#include "world_manager/world.h"
+
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <stdexcept>
+
+namespace impetus {
+namespace {
+
+constexpr double kTick_s = 1.0 / limits::kDefaultHapticRate_Hz;
+
+Scene load_tool_scene(const ToolLoopOptions& options) {
+  if (options.scene_path.empty() && options.scene_text.empty()) {
+    throw std::invalid_argument("scene: give a scene file or its text");
+  }
+  Scene scene = options.scene_text.empty()
+                    ? load_scene(options.scene_path)
+                    : parse_scene_text(options.scene_text, options.scene_path.empty() ? "scene" : options.scene_path);
+  if (!scene.tool) {
+    throw std::invalid_argument(scene.source_name + ": has no \"tool\" block: a tool loop renders the scene's tool "
+                                "(docs/scene-format.md)");
+  }
+  if (options.world_rate_hz) scene.physics.world_rate_hz = *options.world_rate_hz;
+  return scene;
+}
+
+// World steps every n ticks; the world period must be a whole number of ticks, as in every lockstep run.
+int ticks_per_step(double world_rate_hz) {
+  const double n = limits::kDefaultHapticRate_Hz / world_rate_hz;
+  if (!(world_rate_hz >= limits::kMinWorldRate_Hz && world_rate_hz <= limits::kDefaultHapticRate_Hz) ||
+      std::abs(n - std::round(n)) > 1e-9 * n) {
+    char text[160];
+    std::snprintf(text, sizeof text, "world_rate_hz: %g Hz is not a whole number of 1 ms ticks a period",
+                  world_rate_hz);
+    throw std::invalid_argument(text);
+  }
+  return static_cast<int>(std::lround(n));
+}
+
+bool finite(const GripPose& pose) { return pose.position_m.allFinite() && pose.orientation.coeffs().allFinite(); }
+
+}  // namespace
+
+struct ToolLoop::Parts {
+  Parts(const Scene& scene, const ToolLoopOptions& options)
+      : world(scene, world_options(options)),
+        servo(scene.tool->shape, scene.tool->coupling, 1),
+        driver(options.device, options.start),
+        device(options.device, options.hand, options.start),
+        ticks_per_step(impetus::ticks_per_step(scene.physics.world_rate_hz)),
+        coupling(options.coupling),
+        target(options.start),
+        target_from(options.start) {}
+
+  static WorldOptions world_options(const ToolLoopOptions& options) {
+    WorldOptions out;
+    out.coupling = options.coupling;
+    out.report_force_limit_N = ToolCoupling{}.max_force_N;
+    return out;
+  }
+
+  World world;
+  ToolServo servo;
+  GripDriver driver;
+  GripSim device;
+  int ticks_per_step;
+  Coupling coupling;
+  GripPose target;       // where the hand aims at the end of the next tick
+  GripPose target_from;  // where it aimed at the end of the last
+  GripPose grip_read;    // the driver's last good pose
+};
+
+ToolLoop::ToolLoop(const ToolLoopOptions& options) {
+  if (options.coupling == Coupling::position) {
+    throw std::invalid_argument("coupling: position coupling samples one point per endpoint, and a tool touches at "
+                                "many; use local or impulse");
+  }
+  if (!finite(options.start)) throw std::invalid_argument("start: the grip's start pose must be finite");
+  const Scene scene = load_tool_scene(options);
+  ticks_per_step(scene.physics.world_rate_hz);  // refused before anything is built
+  if (const std::string problem = grip_trajectory_problem(
+          Trajectory::from_waypoints({{0.0, {options.start.position_m.x(), options.start.position_m.y(),
+                                             options.start.position_m.z()}}}, "start"),
+          options.device);
+      !problem.empty()) {
+    throw std::invalid_argument("start: " + problem);
+  }
+  const std::lock_guard<std::mutex> turn(InProcessRig::engine_turn());
+  prepare_engines();
+  parts_ = std::make_unique<Parts>(scene, options);
+  parts_->grip_read = options.start;
+  for (const SceneObject& object : scene.objects) object_names_.push_back(object.name);
+}
+
+ToolLoop::~ToolLoop() {
+  try {
+    finish();
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "impetus: the tool loop did not finish cleanly: %s\n", error.what());
+  }
+  const std::lock_guard<std::mutex> turn(InProcessRig::engine_turn());
+  parts_.reset();
+}
+
+double ToolLoop::tick_period_s() const { return kTick_s; }
+
+void ToolLoop::check_target(const GripPose& target) const {
+  if (!finite(target)) throw std::invalid_argument("target: the pose must be finite");
+  const Eigen::Vector3d& p = target.position_m;
+  const std::string problem = grip_trajectory_problem(
+      Trajectory::from_waypoints({{0.0, {p.x(), p.y(), p.z()}}}, "target"), parts_->device.strings().geometry());
+  if (!problem.empty()) throw std::invalid_argument("target: " + problem);
+}
+
+void ToolLoop::set_target(const GripPose& target) {
+  check_target(target);
+  parts_->target = {target.position_m, target.orientation.normalized()};
+}
+
+void ToolLoop::step(std::uint64_t count, std::span<const GripPose> targets, std::span<ToolTick> out) {
+  if (finished_) throw std::logic_error("the tool loop has finished");
+  if (!targets.empty() && targets.size() != count) throw std::invalid_argument("targets: must hold one pose a tick");
+  if (!out.empty() && out.size() != count) throw std::invalid_argument("out: must hold one record a tick");
+  for (const GripPose& target : targets) check_target(target);
+  const std::lock_guard<std::mutex> turn(InProcessRig::engine_turn());
+  for (std::uint64_t i = 0; i < count; ++i) {
+    if (!targets.empty()) parts_->target = {targets[i].position_m, targets[i].orientation.normalized()};
+    tick(parts_->target, out.empty() ? nullptr : &out[i]);
+  }
+}
+
+void ToolLoop::tick(const GripPose& target, ToolTick* out) {
+  Parts& p = *parts_;
+  const double t_s = static_cast<double>(ticks_) * kTick_s;
+  if (ticks_ % static_cast<std::uint64_t>(p.ticks_per_step) == 0) {
+    p.servo.on_plane_frame(p.world.step(&p.servo.report()), t_s);
+  }
+  const GripPose* grip = p.driver.read(p.device.encoder_counts());
+  if (grip != nullptr) p.grip_read = *grip;
+  const BodyPose grip_pose{p.grip_read.position_m, p.grip_read.orientation};
+  const ToolTickResult& result = p.servo.tick(grip != nullptr ? &grip_pose : nullptr, t_s, kTick_s);
+  GripWrench wrench;
+  wrench << result.force_N, result.torque_Nm;
+  const GripTensions& tensions = p.driver.command(wrench, result.render);
+  // The hand aims along the straight line from the last target to this one over the tick.
+  const Eigen::Vector3d velocity_mps = (target.position_m - p.target_from.position_m) / kTick_s;
+  const Eigen::Vector3d angular_velocity_radps = turn_between(p.target_from.orientation, target.orientation) / kTick_s;
+  p.device.tick(tensions, target, velocity_mps, angular_velocity_radps, kTick_s);
+  p.target_from = target;
+  ++ticks_;
+  if (out == nullptr) return;
+  out->time_s = t_s;
+  out->target = target;
+  out->grip = p.grip_read;
+  out->hand = p.device.pose();
+  out->proxy = {result.proxy.position_m, result.proxy.orientation};
+  out->force_N = result.force_N;
+  out->torque_Nm = result.torque_Nm;
+  const GripWrench strings = p.device.wrench();
+  out->strings_force_N = strings.head<3>();
+  out->strings_torque_Nm = strings.tail<3>();
+  out->active = result.active;
+}
+
+std::vector<ToolLoopObject> ToolLoop::objects() const {
+  std::vector<ToolLoopObject> out;
+  const World& world = parts_->world;
+  for (std::size_t i = 0; i < object_names_.size(); ++i) {
+    const ObjectState& state = world.states()[i];
+    out.push_back({state.pose, state.velocity_mps, state.angular_velocity_radps, world.total_impulse_Ns(i),
+                   world.total_angular_impulse_Nms(i)});
+  }
+  return out;
+}
+
+const nlohmann::json& ToolLoop::finish() {
+  if (finished_) return summary_;
+  finished_ = true;
+  Parts& p = *parts_;
+  {
+    const std::lock_guard<std::mutex> turn(InProcessRig::engine_turn());
+    // The world applies a report at its next step: two more steps bring in the last ticks' impulse.
+    for (int k = 0; k < 2; ++k) {
+      p.servo.on_plane_frame(p.world.step(&p.servo.report()), static_cast<double>(ticks_) * kTick_s);
+    }
+  }
+  const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
+  nlohmann::json ledger = nlohmann::json::object();
+  const HapticReport& report = p.servo.report();
+  for (std::uint32_t e = 0; e < report.entry_count; ++e) {
+    const ObjectImpulse& entry = report.entries[e];
+    if (entry.object_id < 0 || static_cast<std::size_t>(entry.object_id) >= object_names_.size()) continue;
+    const std::size_t id = static_cast<std::size_t>(entry.object_id);
+    ledger[object_names_[id]] = {
+        {"rendered_Ns", vec(to_eigen(entry.impulse_Ns))},
+        {"applied_Ns", vec(p.world.total_impulse_Ns(id))},
+        {"rendered_Nms", vec(to_eigen(entry.angular_impulse_Nms))},
+        {"applied_Nms", vec(p.world.total_angular_impulse_Nms(id))},
+    };
+  }
+  const ToolCounters& proxy = p.servo.proxy().counters();
+  const GripDriverCounters& driver = p.driver.counters();
+  summary_ = {
+      {"ticks", ticks_},
+      {"coupling", to_string(p.coupling)},
+      {"world_rate_hz", 1.0 / p.world.world_period_s()},
+      {"tool", {{"faults", p.servo.faults()}, {"clamps", proxy.clamps}, {"pinches", proxy.pinches},
+                {"unconverged", proxy.unconverged}}},
+      {"device", {{"readings", driver.readings}, {"bad_readings", driver.bad_readings},
+                  {"saturations", driver.saturations}, {"no_closure", driver.no_closure},
+                  {"most_iterations", driver.most_iterations}}},
+      {"ledger", ledger},
+  };
+  return summary_;
+}
+
+}  // namespace impetus
