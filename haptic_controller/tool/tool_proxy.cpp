@@ -225,6 +225,11 @@ Vector6d ToolProxy::pass(const PlaneSet& planes, const Vector6d& target, bool ga
     ToolReach reach{reach_K / std::sqrt(k_Npm) + kReachRounding_m, reach_K / std::sqrt(k_r_Nmprad)};
     count = contacts_.gather(planes, proxy_, reach);
     if (mark_held) {
+      // An object may hold at most what the proxy was already allowed in it plus how far the jump moved it.
+      for (int h = 0; h < hold_limit_count_; ++h) {
+        Held& limit = hold_limits_[static_cast<std::size_t>(h)];
+        limit.depth_m += allowance_m(limit.object_id);
+      }
       for (int k = 0; k < count; ++k) {
         if (!(contacts_[k].gap_m < 0.0)) continue;
         double most_m = -contacts_[k].gap_m;

@@ -90,6 +90,21 @@ class PegInHole(unittest.TestCase):
             np.testing.assert_array_equal(x[1], y[1])
 
 
+class Example(unittest.TestCase):
+    def test_the_peg_in_hole_example_feels_each_stage(self):
+        import pathlib
+        import sys
+        sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "examples" / "python"))
+        import peg_in_hole
+        stages, cube_m, summary = peg_in_hole.run()
+        felt = {name: (step.force_N[-1], step.torque_Nm[-1]) for name, step in stages}
+        self.assertGreater(felt["pressing its floor"][0][2], 0.5)
+        self.assertLess(felt["held turned"][1][1], -1e-3)
+        self.assertEqual(np.linalg.norm(felt["out"][0]), 0.0)
+        self.assertGreater(cube_m[0], 0.085)
+        self.assertEqual(summary["device"]["bad_readings"], 0)
+
+
 class BadInput(unittest.TestCase):
     def test_named(self):
         cases = [
