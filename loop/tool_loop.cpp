@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "loop/tool_loop.h"
 
-#include "common/contract/rotation.h"
-#include "haptic_controller/device/grip_driver.h"
+#include "common/link/inproc/inproc_device_port.h"
+#include "haptic_controller/device/grip_port_driver.h"
 #include "haptic_controller/tool/tool_servo.h"
 #include "loop/in_process_rig.h"
+#include "spidar_sim/grip_node.h"
 #include "spidar_sim/grip_sim.h"
 #include "world_manager/engine/engine_registry.h"
 #include "world_manager/scene.h"
@@ -56,12 +57,14 @@ struct ToolLoop::Parts {
   Parts(const Scene& scene, const ToolLoopOptions& options)
       : world(scene, world_options(options)),
         servo(scene.tool->shape, scene.tool->coupling, 1),
-        driver(options.device, options.start),
+        port(kTick_s),
         device(options.device, options.hand, options.start),
+        device_node(device, port, 1),
+        driver(options.device, port, ClockMode::lockstep, 1),
         ticks_per_step(impetus::ticks_per_step(scene.physics.world_rate_hz)),
-        coupling(options.coupling),
-        target(options.start),
-        target_from(options.start) {}
+        coupling(options.coupling) {
+    port.connect(device_node);
+  }
 
   static WorldOptions world_options(const ToolLoopOptions& options) {
     WorldOptions out;
@@ -72,13 +75,15 @@ struct ToolLoop::Parts {
 
   World world;
   ToolServo servo;
-  GripDriver driver;
+  // The device behind its port, as a daemon's would be: the simulated grip SPIDAR and its hand at the device end, the
+  // driver at the host end (lockstep: the driver's read gives the device its tick).
+  InProcessDevicePort port;
   GripSim device;
+  GripNode device_node;
+  GripPortDriver driver;
   int ticks_per_step;
   Coupling coupling;
-  GripPose target;       // where the hand aims at the end of the next tick
-  GripPose target_from;  // where it aimed at the end of the last
-  GripPose grip_read;    // the driver's last good pose
+  BodyPose grip_read;  // the driver's last good pose
 };
 
 ToolLoop::ToolLoop(const ToolLoopOptions& options) {
@@ -99,7 +104,7 @@ ToolLoop::ToolLoop(const ToolLoopOptions& options) {
   const std::lock_guard<std::mutex> turn(InProcessRig::engine_turn());
   prepare_engines();
   parts_ = std::make_unique<Parts>(scene, options);
-  parts_->grip_read = options.start;
+  parts_->grip_read = {options.start.position_m, options.start.orientation};
   for (const SceneObject& object : scene.objects) object_names_.push_back(object.name);
 }
 
@@ -125,7 +130,7 @@ void ToolLoop::check_target(const GripPose& target) const {
 
 void ToolLoop::set_target(const GripPose& target) {
   check_target(target);
-  parts_->target = {target.position_m, target.orientation.normalized()};
+  parts_->device_node.steer({target.position_m, target.orientation.normalized()});
 }
 
 void ToolLoop::step(std::uint64_t count, std::span<const GripPose> targets, std::span<ToolTick> out) {
@@ -135,34 +140,28 @@ void ToolLoop::step(std::uint64_t count, std::span<const GripPose> targets, std:
   for (const GripPose& target : targets) check_target(target);
   const std::lock_guard<std::mutex> turn(InProcessRig::engine_turn());
   for (std::uint64_t i = 0; i < count; ++i) {
-    if (!targets.empty()) parts_->target = {targets[i].position_m, targets[i].orientation.normalized()};
-    tick(parts_->target, out.empty() ? nullptr : &out[i]);
+    if (!targets.empty()) parts_->device_node.steer({targets[i].position_m, targets[i].orientation.normalized()});
+    tick(out.empty() ? nullptr : &out[i]);
   }
 }
 
-void ToolLoop::tick(const GripPose& target, ToolTick* out) {
+void ToolLoop::tick(ToolTick* out) {
   Parts& p = *parts_;
   const double t_s = static_cast<double>(ticks_) * kTick_s;
   if (ticks_ % static_cast<std::uint64_t>(p.ticks_per_step) == 0) {
     p.servo.on_plane_frame(p.world.step(&p.servo.report()), t_s);
   }
-  const GripPose* grip = p.driver.read(p.device.encoder_counts());
-  if (grip != nullptr) p.grip_read = *grip;
-  const BodyPose grip_pose{p.grip_read.position_m, p.grip_read.orientation};
-  const ToolTickResult& result = p.servo.tick(grip != nullptr ? &grip_pose : nullptr, t_s, kTick_s);
-  GripWrench wrench;
-  wrench << result.force_N, result.torque_Nm;
-  const GripTensions& tensions = p.driver.command(wrench, result.render);
-  // The hand aims along the straight line from the last target to this one over the tick.
-  const Eigen::Vector3d velocity_mps = (target.position_m - p.target_from.position_m) / kTick_s;
-  const Eigen::Vector3d angular_velocity_radps = turn_between(p.target_from.orientation, target.orientation) / kTick_s;
-  p.device.tick(tensions, target, velocity_mps, angular_velocity_radps, kTick_s);
-  p.target_from = target;
+  // The device's tick (its hand toward the target under the last tensions), then its counts as the grip's pose.
+  const GripSample* sample = p.driver.read(ticks_, t_s);
+  const bool valid = sample != nullptr && sample->valid;
+  if (valid) p.grip_read = sample->pose;
+  const ToolTickResult& result = p.servo.tick(valid ? &p.grip_read : nullptr, t_s, kTick_s);
+  p.driver.command(ticks_, result.force_N, result.torque_Nm, result.render);
   ++ticks_;
   if (out == nullptr) return;
   out->time_s = t_s;
-  out->target = target;
-  out->grip = p.grip_read;
+  out->target = p.device_node.target();
+  out->grip = {p.grip_read.position_m, p.grip_read.orientation};
   out->hand = p.device.pose();
   out->proxy = {result.proxy.position_m, result.proxy.orientation};
   out->force_N = result.force_N;
@@ -210,7 +209,7 @@ const nlohmann::json& ToolLoop::finish() {
     };
   }
   const ToolCounters& proxy = p.servo.proxy().counters();
-  const GripDriverCounters& driver = p.driver.counters();
+  const GripDriverCounters& driver = p.driver.driver().counters();
   summary_ = {
       {"ticks", ticks_},
       {"coupling", to_string(p.coupling)},

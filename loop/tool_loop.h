@@ -9,9 +9,10 @@
 // Each tick t (time t·T, T = 1 ms):
 //  1. every world period (ticks 0, n, 2n, …; n = haptic rate / world rate) the world steps on the servo's report and
 //     the servo takes the new frame;
-//  2. the device's encoder counts → the driver's pose of the grip;
+//  2. the device's tick on its in-process port (its hand toward the target pose under the last tensions), and its
+//     eight encoder counts → the driver's pose of the grip (the device behind its port, as a daemon's would be);
 //  3. the servo's tick: the tool's proxy, the wrench on the grip, the reaction booked per object;
-//  4. the wrench → the driver's eight tensions → the simulated device, whose hand aims at the target over the tick.
+//  4. the wrench → the driver's eight tensions → the port, for the device's next tick.
 // The world and the servo see the same frames as in every lockstep run, so runs are bitwise reproducible.
 //
 // Frames: world, SI; a pose is the grip's centre and orientation (grip → world). Not thread-safe; ODE's process-wide
@@ -52,7 +53,7 @@ struct ToolTick {
   double time_s = 0.0;
   GripPose target;  // the hand's target at the tick's end
   GripPose grip;    // as the driver measured it from the counts (the last good pose if this reading gave none)
-  GripPose hand;    // where the simulated hand truly holds the grip at the tick's end
+  GripPose hand;    // where the simulated hand truly holds the grip, when the counts were read
   GripPose proxy;   // the tool proxy's grip pose
   Eigen::Vector3d force_N = Eigen::Vector3d::Zero();    // on the grip, as the servo commanded it
   Eigen::Vector3d torque_Nm = Eigen::Vector3d::Zero();  // on the grip, about its centre
@@ -101,7 +102,7 @@ class ToolLoop {
 
  private:
   struct Parts;
-  void tick(const GripPose& target, ToolTick* out);
+  void tick(ToolTick* out);
   void check_target(const GripPose& target) const;
 
   std::unique_ptr<Parts> parts_;

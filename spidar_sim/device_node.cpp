@@ -46,7 +46,9 @@ void DeviceNode::tick(double dt_s) {
       held_s_ += dt_s;
     }
   }
-  if (watchdog_.applies(received ? &command : nullptr, sim_.time_s())) tensions = command.tension_N;
+  if (watchdog_.applies(received ? &command : nullptr, sim_.time_s())) {
+    tensions = first_strings<kStringCount>(command.tension_N);
+  }
   DeviceState state = sim_.tick(tensions, dt_s);
   state.device_session = session_;
   port_.publish_state(state);

@@ -60,7 +60,8 @@ DeviceSim::DeviceSim(const SpidarGeometry& geometry, HardwareParams hardware, Fi
     : hardware_(geometry, hardware),
       trajectory_(std::move(trajectory)),
       finger_(finger, to_eigen(checked(trajectory_, geometry).position_at(0.0))) {
-  state_.encoder_counts = hardware_.encoder_counts(finger_.position_m());
+  counts_ = hardware_.encoder_counts(finger_.position_m());
+  set_first_strings(counts_, state_.encoder_counts);
 }
 
 const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& commanded_tension_N, double dt_s) {
@@ -104,7 +105,8 @@ const DeviceState& DeviceSim::tick(const std::array<double, kStringCount>& comma
   target_now_m_ = target_next_m_;
   time_s_ += dt_s;
   ++state_.tick;
-  state_.encoder_counts = hardware_.encoder_counts(finger_.position_m());
+  counts_ = hardware_.encoder_counts(finger_.position_m());
+  set_first_strings(counts_, state_.encoder_counts);
   return state_;
 }
 

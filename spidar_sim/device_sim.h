@@ -75,7 +75,7 @@ class DeviceSim {
   // Net string force on the finger at the end of the last tick (N): Σ t_i·u_i.
   Vec3 device_force_N() const { return to_vec3(hardware_.force_on_finger(finger_.position_m())); }
   const std::array<double, kStringCount>& tensions_N() const { return hardware_.tensions_N(); }
-  const std::array<std::int64_t, kStringCount>& encoder_counts() const { return state_.encoder_counts; }
+  const std::array<std::int64_t, kStringCount>& encoder_counts() const { return counts_; }
   // True once the session time reaches the end of the trajectory (the target then holds still).
   bool finished() const { return !steered_ && trajectory_time_s() >= trajectory_.duration_s(); }
 
@@ -101,6 +101,7 @@ class DeviceSim {
   double time_s_ = 0.0;
   double trajectory_start_s_ = 0.0;  // session time of the trajectory's time 0 (hold_trajectory)
   DeviceState state_{};
+  std::array<std::int64_t, kStringCount> counts_{};  // the first kStringCount of state_'s
   // Steered (closed loop): the target now and at the end of the next tick, and the hand's own push.
   bool steered_ = false;
   Vec3 target_now_m_{};

@@ -215,18 +215,35 @@ struct HapticReport {
   std::array<ObjectImpulse, kMaxImpulseEntries> entries{};
 };
 
-inline constexpr int kStringCount = 4;
+inline constexpr int kStringCount = 4;  // the desktop SPIDAR's strings, one finger (common/spidar/geometry.h)
+// The most strings a device port carries: the grip SPIDAR's eight (common/spidar/grip_geometry.h). A device with fewer
+// uses the first of them and leaves the rest zero.
+inline constexpr int kMaxDeviceStrings = 8;
 
 // DeviceCommand::flags: the haptic controller renders a world (a world frame has reached its servo). A device may
 // show it; a simulated hand playing a script waits for it in real time, so the script does not start before there is
 // anything to touch (the processes of a trial start in any order).
 inline constexpr std::uint64_t kCommandWorldPresent = 1;
 
+// The first N of a port's string arrays as a device of N strings has them, and back (the rest left as they are).
+template <std::size_t N, typename T>
+std::array<T, N> first_strings(const std::array<T, kMaxDeviceStrings>& all) {
+  static_assert(N <= kMaxDeviceStrings);
+  std::array<T, N> out{};
+  for (std::size_t i = 0; i < N; ++i) out[i] = all[i];
+  return out;
+}
+template <std::size_t N, typename T>
+void set_first_strings(const std::array<T, N>& some, std::array<T, kMaxDeviceStrings>& all) {
+  static_assert(N <= kMaxDeviceStrings);
+  for (std::size_t i = 0; i < N; ++i) all[i] = some[i];
+}
+
 // Haptic → device: the tensions to command (docs/architecture.md §1.2 step 6).
 struct DeviceCommand {
   std::uint64_t tick = 0;
   std::uint64_t haptic_session = 0;
-  std::array<double, kStringCount> tension_N{};
+  std::array<double, kMaxDeviceStrings> tension_N{};
   std::uint64_t flags = 0;  // kCommand* bits; others are reserved and ignored
 };
 
@@ -234,7 +251,7 @@ struct DeviceCommand {
 struct DeviceState {
   std::uint64_t tick = 0;            // device tick; in lockstep equal to the haptic tick it answers
   std::uint64_t device_session = 0;  // changes on each attach
-  std::array<std::int64_t, kStringCount> encoder_counts{};
+  std::array<std::int64_t, kMaxDeviceStrings> encoder_counts{};
 };
 
 // Copy a frame or report by its used part: the header, then the planes (entries) below its count, clamped to the

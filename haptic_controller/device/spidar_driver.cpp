@@ -11,14 +11,21 @@ SpidarDriver::SpidarDriver(const SpidarGeometry& geometry, DevicePortHost& port,
   for (int i = 0; i < kStringCount; ++i) motors_m_[i] = kinematics_.motor_m(i);
   limits_.max_force_N = geometry.max_force_N;
   command_.haptic_session = haptic_session;
-  command_.tension_N.fill(geometry.tension_min_N);
+  set_first_strings(minimum_tensions(), command_.tension_N);
+}
+
+std::array<double, kStringCount> SpidarDriver::minimum_tensions() const {
+  std::array<double, kStringCount> out{};
+  out.fill(geometry_.tension_min_N);
+  return out;
 }
 
 const FingerSample* SpidarDriver::read(std::uint64_t tick, double now_s) {
   const DeviceState* state = clock_ == ClockMode::lockstep ? port_.lockstep_turn(tick) : port_.latest_state(now_s);
   have_sample_ = state != nullptr;
   if (!have_sample_) return nullptr;
-  sample_.valid = kinematics_.finger_position(state->encoder_counts, sample_.position_m);
+  sample_.valid =
+      kinematics_.finger_position(first_strings<kStringCount>(state->encoder_counts), sample_.position_m);
   return &sample_;
 }
 
@@ -28,11 +35,11 @@ bool SpidarDriver::command(std::uint64_t tick, const Eigen::Vector3d& force_N, b
   if (render && have_sample_ && sample_.valid) {
     const TensionSolution tensions = distribute_tension(force_N, sample_.position_m, motors_m_,
                                                         geometry_.tension_min_N, geometry_.tension_max_N);
-    command_.tension_N = tensions.tension_N;
+    set_first_strings(tensions.tension_N, command_.tension_N);
     exact = !tensions.saturated;
     if (tensions.saturated) ++saturations_;
   } else {
-    command_.tension_N.fill(geometry_.tension_min_N);  // strings taut, no force
+    set_first_strings(minimum_tensions(), command_.tension_N);  // strings taut, no force
   }
   port_.send_command(command_);
   return exact;

@@ -32,6 +32,8 @@ class SpidarDriver final : public HapticDevice {
   DeviceCounters counters() const override;
 
  private:
+  std::array<double, kStringCount> minimum_tensions() const;  // every string at t_min
+
   SpidarGeometry geometry_;
   SpidarKinematics kinematics_;
   std::array<Eigen::Vector3d, kStringCount> motors_m_;

@@ -94,7 +94,7 @@ void run(int planes, bool port_layer) {
     const Eigen::Vector3d finger =
         to_eigen(geometry.centre_m) +
         0.05 * Eigen::Vector3d(std::sin(tick * 0.0031), std::sin(tick * 0.0023), std::sin(tick * 0.0017));
-    device.state.encoder_counts = kinematics.encoder_counts(finger);
+    impetus::set_first_strings(kinematics.encoder_counts(finger), device.state.encoder_counts);
     const auto start = std::chrono::steady_clock::now();
     const FingerSample* sample = driver.read(static_cast<std::uint64_t>(tick), now_s);
     const TickResult& result = servo.tick(sample, now_s, 1e-3);
@@ -142,7 +142,7 @@ void run_endpoints(int endpoints) {
       const Eigen::Vector3d finger =
           to_eigen(geometry.centre_m) + 0.05 * Eigen::Vector3d(std::sin(tick * 0.0031 + k), std::sin(tick * 0.0023),
                                                                std::sin(tick * 0.0017 - k));
-      devices[k]->state.encoder_counts = kinematics.encoder_counts(finger);
+      impetus::set_first_strings(kinematics.encoder_counts(finger), devices[k]->state.encoder_counts);
     }
     const auto start = std::chrono::steady_clock::now();
     const FingerSample* samples = set.read(static_cast<std::uint64_t>(tick), now_s);

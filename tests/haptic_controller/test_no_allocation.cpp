@@ -27,7 +27,7 @@ class WanderingDevice final : public DeviceStepper {
  public:
   WanderingDevice(InProcessDevicePort& port, const SpidarKinematics& kinematics) : port_(port), kinematics_(kinematics) {}
   bool step_device() override {
-    state_.encoder_counts = kinematics_.encoder_counts(finger_m);
+    impetus::set_first_strings(kinematics_.encoder_counts(finger_m), state_.encoder_counts);
     port_.publish_state(state_);
     return true;
   }

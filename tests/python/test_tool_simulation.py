@@ -44,8 +44,8 @@ class PegInHole(unittest.TestCase):
         self.assertLess(np.linalg.norm(rest.force_N[-1, :2]), 1e-6)
         self.assertLess(np.linalg.norm(rest.torque_Nm[-1]), 1e-6)
         self.assertLess(np.linalg.norm(rest.strings_force_N[-1] - rest.force_N[-1]), 1e-3)
-        # The driver's pose from the counts against the hand's true grip a tick before.
-        self.assertLess(np.linalg.norm(rest.grip_m[1:] - rest.hand_m[:-1], axis=1).max(), 2e-5)
+        # The driver's pose from the counts against the hand's true grip when they were read.
+        self.assertLess(np.linalg.norm(rest.grip_m - rest.hand_m, axis=1).max(), 2e-5)
 
     def test_a_tilt_in_the_hole_is_pushed_back(self):
         with impetus.ToolSimulation(PEG, start_m=START) as sim:
@@ -55,13 +55,14 @@ class PegInHole(unittest.TestCase):
             step = sim.step(targets=poses)
             held = sim.step(300)
         # The hand turns the grip about +y; the walls hold the peg, so the torque on the grip is about -y, and it is
-        # what the coupling's spring gives for the turn between grip and proxy, k_r times the angle.
-        torque = held.torque_Nm[-1]
-        self.assertLess(torque[1], -1e-3)
-        grip = held.grip_wxyz[-1]
-        proxy = held.proxy_wxyz[-1]
-        between = 2 * math.acos(min(1.0, abs(float(np.dot(grip, proxy)))))
-        self.assertAlmostEqual(-torque[1], 20.0 * between, delta=0.05 * 20.0 * between)
+        # what the coupling's spring gives for the turn between grip and proxy, k_r times the angle. Averaged over the
+        # last 0.2 s: the grip's turn read from the counts dithers by about a count over the grip's radius (~1 mrad),
+        # and the coupling's damper renders the dither's rate.
+        torque = held.torque_Nm[-200:]
+        self.assertLess(torque[:, 1].max(), -1e-3)
+        between = [2 * math.acos(min(1.0, abs(float(np.dot(g, p)))))
+                   for g, p in zip(held.grip_wxyz[-200:], held.proxy_wxyz[-200:])]
+        self.assertAlmostEqual(-torque[:, 1].mean(), 20.0 * np.mean(between), delta=0.05 * 20.0 * np.mean(between))
         self.assertGreater(len(step), 0)
 
     def test_a_pushed_cube_slides_and_the_world_applies_what_was_rendered(self):

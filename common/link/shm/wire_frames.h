@@ -127,7 +127,7 @@ struct HapticReport {
 struct DeviceCommand {
   std::uint64_t tick = 0;
   std::uint64_t haptic_session = 0;
-  std::array<double, kStringCount> tension_N{};
+  std::array<double, kMaxDeviceStrings> tension_N{};
   std::uint64_t flags = 0;
   std::uint64_t checksum = 0;
 };
@@ -135,7 +135,7 @@ struct DeviceCommand {
 struct DeviceState {
   std::uint64_t tick = 0;
   std::uint64_t device_session = 0;
-  std::array<std::int64_t, kStringCount> encoder_counts{};
+  std::array<std::int64_t, kMaxDeviceStrings> encoder_counts{};
   std::uint64_t checksum = 0;
 };
 

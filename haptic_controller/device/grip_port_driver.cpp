@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "haptic_controller/device/grip_port_driver.h"
+
+#include "common/contract/tool.h"
+
+namespace impetus {
+namespace {
+
+// The device's rated limits, the tool coupling's defaults (common/contract/tool.h): what the servo clamps to first.
+// Beyond what the strings can give at a pose the distribution scales the wrench down and counts it (grip_tension.h).
+ToolDeviceLimits grip_limits() {
+  const ToolCoupling defaults;
+  return {defaults.max_force_N, defaults.max_torque_Nm};
+}
+
+GripCounts counts_of(const DeviceState& state) {
+  GripCounts counts{};
+  for (int k = 0; k < kGripStringCount; ++k) counts[static_cast<std::size_t>(k)] = state.encoder_counts[k];
+  return counts;
+}
+
+}  // namespace
+
+GripPortDriver::GripPortDriver(const SpidarGripGeometry& geometry, DevicePortHost& port, ClockMode clock,
+                               std::uint64_t haptic_session)
+    : driver_(geometry, GripPose{Eigen::Vector3d(geometry.centre_m[0], geometry.centre_m[1], geometry.centre_m[2]),
+                                 Eigen::Quaterniond::Identity()}),
+      port_(port),
+      clock_(clock),
+      limits_(grip_limits()) {
+  static_assert(kGripStringCount <= kMaxDeviceStrings);
+  command_.haptic_session = haptic_session;
+  set_first_strings(driver_.command(GripWrench::Zero(), false), command_.tension_N);
+}
+
+const GripSample* GripPortDriver::read(std::uint64_t tick, double now_s) {
+  const DeviceState* state = clock_ == ClockMode::lockstep ? port_.lockstep_turn(tick) : port_.latest_state(now_s);
+  if (state == nullptr) return nullptr;
+  const GripPose* pose = driver_.read(counts_of(*state));
+  sample_.valid = pose != nullptr;
+  if (pose != nullptr) sample_.pose = {pose->position_m, pose->orientation};
+  return &sample_;
+}
+
+bool GripPortDriver::command(std::uint64_t tick, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm,
+                             bool render) {
+  GripWrench wrench;
+  wrench << force_N, torque_Nm;
+  const std::uint64_t saturations_before = driver_.counters().saturations;
+  set_first_strings(driver_.command(wrench, render && sample_.valid), command_.tension_N);
+  command_.tick = tick;
+  port_.send_command(command_);
+  return driver_.counters().saturations == saturations_before;
+}
+
+DeviceCounters GripPortDriver::counters() const {
+  DeviceCounters counters;
+  counters.saturations = driver_.counters().saturations;
+  counters.rejected_frames = port_.rejected_states();
+  counters.devices_lost = port_.devices_lost();
+  counters.channel_repairs = port_.channel_repairs();
+  return counters;
+}
+
+}  // namespace impetus
