@@ -192,6 +192,14 @@ py::tuple read_log(const std::string& path) {
   return py::make_tuple(header, table);
 }
 
+// An objects x `width` array whose row i `fill(i, row)` writes: one quantity of every scene object.
+template <typename Fill>
+py::array_t<double> object_rows(std::size_t objects, std::size_t width, Fill&& fill) {
+  py::array_t<double> out({objects, width});
+  for (std::size_t i = 0; i < objects; ++i) fill(i, out.mutable_data(i));
+  return out;
+}
+
 // The closed loop (loop/simulation.h) for the Python half: steps with the GIL released and hands back each tick's
 // records as numpy arrays, one per quantity, ticks x fingers (x 3).
 class ClosedLoop {
@@ -260,21 +268,22 @@ class ClosedLoop {
   py::dict objects() const {
     const std::vector<impetus::SimulationObject> objects = simulation_->objects();
     const std::size_t n = objects.size();
-    py::array_t<double> position({n, std::size_t{3}}), orientation({n, std::size_t{4}}), velocity({n, std::size_t{3}}),
-        angular({n, std::size_t{3}}), impulse({n, std::size_t{3}});
-    for (std::size_t i = 0; i < n; ++i) {
-      std::copy_n(objects[i].position_m.data(), 3, position.mutable_data(i));
-      std::copy_n(objects[i].orientation_wxyz.data(), 4, orientation.mutable_data(i));
-      std::copy_n(objects[i].velocity_mps.data(), 3, velocity.mutable_data(i));
-      std::copy_n(objects[i].angular_velocity_radps.data(), 3, angular.mutable_data(i));
-      std::copy_n(objects[i].impulse_Ns.data(), 3, impulse.mutable_data(i));
-    }
+    using Object = impetus::SimulationObject;
+    using Field = impetus::Vec3 Object::*;
+    static constexpr std::pair<const char*, Field> kVectors[] = {
+        {"position_m", &Object::position_m},
+        {"velocity_mps", &Object::velocity_mps},
+        {"angular_velocity_radps", &Object::angular_velocity_radps},
+        {"impulse_Ns", &Object::impulse_Ns}};
     py::dict out;
-    out["position_m"] = position;
-    out["orientation_wxyz"] = orientation;
-    out["velocity_mps"] = velocity;
-    out["angular_velocity_radps"] = angular;
-    out["impulse_Ns"] = impulse;
+    for (const auto& [name, field] : kVectors) {
+      out[name] = object_rows(n, 3, [&](std::size_t i, double* row) {
+        std::copy_n((objects[i].*field).data(), 3, row);
+      });
+    }
+    out["orientation_wxyz"] = object_rows(n, 4, [&](std::size_t i, double* row) {
+      std::copy_n(objects[i].orientation_wxyz.data(), 4, row);
+    });
     return out;
   }
 
@@ -390,26 +399,30 @@ class ToolClosedLoop {
 
   void set_target(const std::array<double, 7>& target) { loop_->set_target(pose_from(target.data())); }
 
+  // Every object now: a dict of arrays, objects x 3 (x 4 for the orientation).
   py::dict objects() const {
     const std::vector<impetus::ToolLoopObject> objects = loop_->objects();
     const std::size_t n = objects.size();
-    py::array_t<double> position({n, std::size_t{3}}), orientation({n, std::size_t{4}}), velocity({n, std::size_t{3}}),
-        angular({n, std::size_t{3}}), impulse({n, std::size_t{3}}), angular_impulse({n, std::size_t{3}});
-    for (std::size_t i = 0; i < n; ++i) {
-      const impetus::ToolLoopObject& o = objects[i];
-      pose_into({o.pose.position_m, o.pose.orientation}, position.mutable_data(i), orientation.mutable_data(i));
-      std::copy_n(o.velocity_mps.data(), 3, velocity.mutable_data(i));
-      std::copy_n(o.angular_velocity_radps.data(), 3, angular.mutable_data(i));
-      std::copy_n(o.impulse_Ns.data(), 3, impulse.mutable_data(i));
-      std::copy_n(o.angular_impulse_Nms.data(), 3, angular_impulse.mutable_data(i));
-    }
+    using Object = impetus::ToolLoopObject;
+    using Field = Eigen::Vector3d Object::*;
+    static constexpr std::pair<const char*, Field> kVectors[] = {
+        {"velocity_mps", &Object::velocity_mps},
+        {"angular_velocity_radps", &Object::angular_velocity_radps},
+        {"impulse_Ns", &Object::impulse_Ns},
+        {"angular_impulse_Nms", &Object::angular_impulse_Nms}};
     py::dict out;
-    out["position_m"] = position;
-    out["orientation_wxyz"] = orientation;
-    out["velocity_mps"] = velocity;
-    out["angular_velocity_radps"] = angular;
-    out["impulse_Ns"] = impulse;
-    out["angular_impulse_Nms"] = angular_impulse;
+    for (const auto& [name, field] : kVectors) {
+      out[name] = object_rows(n, 3, [&](std::size_t i, double* row) {
+        std::copy_n((objects[i].*field).data(), 3, row);
+      });
+    }
+    out["position_m"] = object_rows(n, 3, [&](std::size_t i, double* row) {
+      std::copy_n(objects[i].pose.position_m.data(), 3, row);
+    });
+    out["orientation_wxyz"] = object_rows(n, 4, [&](std::size_t i, double* row) {
+      const Eigen::Quaterniond& q = objects[i].pose.orientation;
+      row[0] = q.w(), row[1] = q.x(), row[2] = q.y(), row[3] = q.z();
+    });
     return out;
   }
 

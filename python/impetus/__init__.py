@@ -311,7 +311,20 @@ def sample_trajectory(trajectory, times_s):
     return _impetus.sample_trajectory(str(trajectory), times)
 
 
-class Step:
+class _Ticks:
+    """A call's records, one numpy array per quantity (the subclass's __slots__), one row per tick."""
+
+    __slots__ = ()
+
+    def __init__(self, arrays):
+        for name in self.__slots__:
+            setattr(self, name, arrays[name])
+
+    def __len__(self):
+        return len(self.time_s)
+
+
+class Step(_Ticks):
     """What the servo did in the ticks of one Simulation.step call, as numpy arrays, one row per tick:
 
     time_s               ticks               the tick's time t·T (s)
@@ -327,13 +340,6 @@ class Step:
     __slots__ = ("time_s", "target_m", "finger_m", "finger_velocity_mps", "proxy_m", "force_N", "object_impulse_Ns",
                  "active_planes")
 
-    def __init__(self, arrays):
-        for name in self.__slots__:
-            setattr(self, name, arrays[name])
-
-    def __len__(self):
-        return len(self.time_s)
-
     def __repr__(self):
         if not len(self):
             return "Step(0 ticks)"
@@ -342,7 +348,22 @@ class Step:
                 f"force [{force[0]:+.3f} {force[1]:+.3f} {force[2]:+.3f}] N)")
 
 
-class Simulation:
+class _Closable:
+    """What both closed loops share about their lifetime: a `with` block closes them, and so does collection."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __del__(self):
+        if getattr(self, "_loop", None) is not None:
+            self.close()
+
+
+class Simulation(_Closable):
     """A closed loop: the trial of run_trial advanced tick by tick by the caller, who moves each finger's target (or
     pushes with the hand) and reads back what the servo rendered and where the objects are.
 
@@ -510,23 +531,12 @@ class Simulation:
         self._loop = None
         return summary
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
-
-    def __del__(self):
-        if getattr(self, "_loop", None) is not None:
-            self.close()
-
     def __repr__(self):
         state = "closed" if self._loop is None else f"{self.ticks} ticks"
         return f"Simulation({self._scene_name}, fingers {', '.join(self.finger_names)}, {state})"
 
 
-class ToolStep:
+class ToolStep(_Ticks):
     """What the tool servo and the grip device did in the ticks of one ToolSimulation.step call, one row per tick:
 
     time_s                ticks      the tick's time t·T (s)
@@ -543,13 +553,6 @@ class ToolStep:
     __slots__ = ("time_s", "target_m", "target_wxyz", "grip_m", "grip_wxyz", "hand_m", "hand_wxyz", "proxy_m",
                  "proxy_wxyz", "force_N", "torque_Nm", "strings_force_N", "strings_torque_Nm", "active")
 
-    def __init__(self, arrays):
-        for name in self.__slots__:
-            setattr(self, name, arrays[name])
-
-    def __len__(self):
-        return len(self.time_s)
-
     def __repr__(self):
         if not len(self):
             return "ToolStep(0 ticks)"
@@ -559,7 +562,7 @@ class ToolStep:
                 f"[{torque[0]:+.4f} {torque[1]:+.4f} {torque[2]:+.4f}] N·m)")
 
 
-class ToolSimulation:
+class ToolSimulation(_Closable):
     """A tool in the hand, in a closed loop: the scene's tool ("tool" block, docs/scene-format.md) held by a
     simulated hand on the simulated 8-string grip SPIDAR, rendered by the 6-DoF tool servo against the world, in
     lockstep (bitwise reproducible). The caller moves the hand's target pose; the hand follows it with its own
@@ -663,17 +666,6 @@ class ToolSimulation:
         self.summary["scene"] = self._scene_name
         self._loop = None
         return self.summary
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
-
-    def __del__(self):
-        if getattr(self, "_loop", None) is not None:
-            self.close()
 
     def __repr__(self):
         state = "closed" if self._loop is None else f"{self.ticks} ticks"
