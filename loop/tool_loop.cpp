@@ -152,11 +152,15 @@ void ToolLoop::tick(ToolTick* out) {
     p.servo.on_plane_frame(p.world.step(&p.servo.report()), t_s);
   }
   // The device's tick (its hand toward the target under the last tensions), then its counts as the grip's pose.
-  const GripSample* sample = p.driver.read(ticks_, t_s);
+  const FingerSample* sample = p.driver.read(ticks_, t_s);
   const bool valid = sample != nullptr && sample->valid;
-  if (valid) p.grip_read = sample->pose;
+  if (valid) p.grip_read = {sample->position_m, sample->orientation};
   const ToolTickResult& result = p.servo.tick(valid ? &p.grip_read : nullptr, t_s, kTick_s);
-  p.driver.command(ticks_, result.force_N, result.torque_Nm, result.render);
+  FingerCommand command;
+  command.force_N = result.force_N;
+  command.torque_Nm = result.torque_Nm;
+  command.render = result.render;
+  p.driver.command_fingers(ticks_, &command);
   ++ticks_;
   if (out == nullptr) return;
   out->time_s = t_s;

@@ -43,7 +43,8 @@ const FingerSample* FingerSet::read(std::uint64_t tick, double now_s) {
 
 bool FingerSet::command(std::uint64_t tick, const Eigen::Vector3d& force_N, bool render) {
   std::array<FingerCommand, kMaxFingers> commands{};
-  commands[0] = {force_N, render};
+  commands[0].force_N = force_N;
+  commands[0].render = render;
   return (command_fingers(tick, commands.data()) & 1u) == 0;
 }
 

@@ -8,7 +8,7 @@ namespace {
 
 // The device's rated limits, the tool coupling's defaults (common/contract/tool.h): what the servo clamps to first.
 // Beyond what the strings can give at a pose the distribution scales the wrench down and counts it (grip_tension.h).
-ToolDeviceLimits grip_limits() {
+DeviceLimits grip_limits() {
   const ToolCoupling defaults;
   return {defaults.max_force_N, defaults.max_torque_Nm};
 }
@@ -33,24 +33,33 @@ GripPortDriver::GripPortDriver(const SpidarGripGeometry& geometry, DevicePortHos
   set_first_strings(driver_.command(GripWrench::Zero(), false), command_.tension_N);
 }
 
-const GripSample* GripPortDriver::read(std::uint64_t tick, double now_s) {
+const FingerSample* GripPortDriver::read(std::uint64_t tick, double now_s) {
   const DeviceState* state = clock_ == ClockMode::lockstep ? port_.lockstep_turn(tick) : port_.latest_state(now_s);
   if (state == nullptr) return nullptr;
   const GripPose* pose = driver_.read(counts_of(*state));
   sample_.valid = pose != nullptr;
-  if (pose != nullptr) sample_.pose = {pose->position_m, pose->orientation};
+  if (pose != nullptr) {
+    sample_.position_m = pose->position_m;
+    sample_.orientation = pose->orientation;
+  }
   return &sample_;
 }
 
-bool GripPortDriver::command(std::uint64_t tick, const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm,
-                             bool render) {
+bool GripPortDriver::command(std::uint64_t tick, const Eigen::Vector3d& force_N, bool render) {
+  FingerCommand command;
+  command.force_N = force_N;
+  command.render = render;
+  return command_fingers(tick, &command) == 0;
+}
+
+std::uint32_t GripPortDriver::command_fingers(std::uint64_t tick, const FingerCommand* commands) {
   GripWrench wrench;
-  wrench << force_N, torque_Nm;
+  wrench << commands[0].force_N, commands[0].torque_Nm;
   const std::uint64_t saturations_before = driver_.counters().saturations;
-  set_first_strings(driver_.command(wrench, render && sample_.valid), command_.tension_N);
+  set_first_strings(driver_.command(wrench, commands[0].render && sample_.valid), command_.tension_N);
   command_.tick = tick;
   port_.send_command(command_);
-  return driver_.counters().saturations == saturations_before;
+  return driver_.counters().saturations == saturations_before ? 0u : 1u;
 }
 
 DeviceCounters GripPortDriver::counters() const {
@@ -60,6 +69,12 @@ DeviceCounters GripPortDriver::counters() const {
   counters.devices_lost = port_.devices_lost();
   counters.channel_repairs = port_.channel_repairs();
   return counters;
+}
+
+nlohmann::json GripPortDriver::details() const {
+  const GripDriverCounters& c = driver_.counters();
+  return {{"kind", "grip"},           {"readings", c.readings},     {"bad_readings", c.bad_readings},
+          {"saturations", c.saturations}, {"no_closure", c.no_closure}, {"most_iterations", c.most_iterations}};
 }
 
 }  // namespace impetus

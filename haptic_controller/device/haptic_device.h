@@ -2,7 +2,8 @@
 #pragma once
 // A haptic device as the servo sees it (docs/architecture.md §1.2): finger samples in, forces out, within its limits.
 // What a device is made of — strings and encoders (SpidarDriver), linkages, a network bridge — stays behind this
-// interface, so the servo is `tick(finger sample, dt) -> force` for any of them.
+// interface, so the servo is `tick(finger sample, dt) -> force` for any of them. An oriented device (oriented()) is a
+// grip held in the hand: its sample has an orientation and its command a torque, for a tool's servo (docs/tool.md).
 //
 // Called from the servo thread once per tick: read() first, then command(). Implementations do not allocate, lock or
 // throw there; read() may block only in lockstep (the device's turn).
@@ -10,6 +11,7 @@
 #include "common/contract/frames.h"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
@@ -20,6 +22,8 @@ namespace impetus {
 // its workspace): the servo renders no force and counts a fault.
 struct FingerSample {
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // world frame
+  // An oriented device's grip (HapticDevice::oriented): its turn, grip → world, unit; the identity for a finger.
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   bool valid = false;
   // False when this finger's part of a several-finger device is absent or stale while others answer: the servo then
   // gets no finger (minimum output, no fault), as when the whole device is absent.
@@ -29,11 +33,13 @@ struct FingerSample {
 // What the device can render; the servo clamps to it.
 struct DeviceLimits {
   double max_force_N = 0.0;
+  double max_torque_Nm = 0.0;  // an oriented device's, about the grip's centre; 0 for a finger
 };
 
 // What to render on one finger: `render` false commands the device's minimum output there.
 struct FingerCommand {
   Eigen::Vector3d force_N = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque_Nm = Eigen::Vector3d::Zero();  // an oriented device's, about the grip's centre
   bool render = false;
 };
 
@@ -51,6 +57,9 @@ class HapticDevice {
   virtual const DeviceLimits& limits() const = 0;
   // The fingers it serves, 1 to kMaxFingers; constant for the device's lifetime.
   virtual std::uint32_t finger_count() const { return 1; }
+  // Whether it is a 6-DoF device (a grip for a tool, docs/tool.md): its one finger is the grip, whose orientation
+  // read() gives and whose torque command_fingers() renders. Constant for the device's lifetime.
+  virtual bool oriented() const { return false; }
 
   // Lockstep: blocks until a device is attached; false if a stop was requested first (or it will never attach).
   virtual bool wait_attached() = 0;

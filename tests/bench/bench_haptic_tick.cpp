@@ -148,7 +148,8 @@ void run_endpoints(int endpoints) {
     const FingerSample* samples = set.read(static_cast<std::uint64_t>(tick), now_s);
     for (int k = 0; k < endpoints; ++k) {
       const TickResult& result = servos[k]->tick(&samples[k], now_s, 1e-3);
-      commands[k] = {to_eigen(result.force_N), result.render};
+      commands[k].force_N = to_eigen(result.force_N);
+      commands[k].render = result.render;
     }
     exchange_pushes(servo_list);
     set.command_fingers(static_cast<std::uint64_t>(tick), commands.data());

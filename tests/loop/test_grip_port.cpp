@@ -54,17 +54,21 @@ TEST_CASE("grip port: the driver reads the pose the hand holds, and the strings 
   const Vector3d force_N(1.0, 0.0, 0.0), torque_Nm(0.0, 0.0, 0.02);
   double worst_m = 0.0, worst_rad = 0.0, worst_N = 0.0, worst_Nm = 0.0;
   for (std::uint64_t tick = 0; tick < 500; ++tick) {
-    const GripSample* sample = driver.read(tick, static_cast<double>(tick) * kTick_s);
+    const FingerSample* sample = driver.read(tick, static_cast<double>(tick) * kTick_s);
     REQUIRE(sample != nullptr);
     REQUIRE(sample->valid);
-    worst_m = std::max(worst_m, (sample->pose.position_m - sim.pose().position_m).norm());
-    worst_rad = std::max(worst_rad, sample->pose.orientation.angularDistance(sim.pose().orientation));
+    worst_m = std::max(worst_m, (sample->position_m - sim.pose().position_m).norm());
+    worst_rad = std::max(worst_rad, sample->orientation.angularDistance(sim.pose().orientation));
     if (tick > 0) {  // the strings' wrench over the tick just done is the last tick's command
       const GripWrench strings = sim.wrench();
       worst_N = std::max(worst_N, (strings.head<3>() - force_N).norm());
       worst_Nm = std::max(worst_Nm, (strings.tail<3>() - torque_Nm).norm());
     }
-    REQUIRE(driver.command(tick, force_N, torque_Nm, true));
+    FingerCommand command;
+    command.force_N = force_N;
+    command.torque_Nm = torque_Nm;
+    command.render = true;
+    REQUIRE(driver.command_fingers(tick, &command) == 0);
   }
   // The kinematics' accuracy from quantised counts (test_grip.cpp: 11 µm and 0.6 mrad at worst over the volume).
   CHECK(worst_m < 2e-5);
@@ -73,6 +77,7 @@ TEST_CASE("grip port: the driver reads the pose the hand holds, and the strings 
   // the pose's error (~10⁻⁵ m over ~0.2 m strings, ~10⁻³ rad at the grip's 2 cm) leaves millinewtons.
   CHECK(worst_N < 5e-3);
   CHECK(worst_Nm < 2e-4);
+  CHECK(driver.oriented());
   CHECK(driver.counters().saturations == 0);
   CHECK(driver.driver().counters().bad_readings == 0);
   CHECK(node.ticks() == 500);
@@ -95,11 +100,11 @@ TEST_CASE("grip port: without a valid pose, or told not to render, every string 
   };
 
   REQUIRE(driver.read(0, 0.0)->valid);
-  driver.command(0, Vector3d(1, 0, 0), Vector3d::Zero(), false);
+  driver.command(0, Vector3d(1, 0, 0), false);
   for (int k = 0; k < kGripStringCount; ++k) CHECK(sent_tensions()[k] == geometry.tension_min_N);
 
   REQUIRE(driver.read(1, 0.0)->valid);
-  CHECK_FALSE(driver.command(1, Vector3d(500, 0, 0), Vector3d::Zero(), true));
+  CHECK_FALSE(driver.command(1, Vector3d(500, 0, 0), true));
   CHECK(driver.counters().saturations == 1);
   const auto scaled = sent_tensions();
   for (int k = 0; k < kGripStringCount; ++k) {
@@ -111,10 +116,10 @@ TEST_CASE("grip port: without a valid pose, or told not to render, every string 
 
   // One string 10 cm long: lengths no rigid pose has.
   device.state.encoder_counts[3] += static_cast<std::int64_t>(0.1 / geometry.metres_per_count);
-  const GripSample* bad = driver.read(2, 0.0);
+  const FingerSample* bad = driver.read(2, 0.0);
   REQUIRE(bad != nullptr);
   CHECK_FALSE(bad->valid);
   CHECK(driver.driver().counters().bad_readings == 1);
-  driver.command(2, Vector3d(1, 0, 0), Vector3d::Zero(), true);
+  driver.command(2, Vector3d(1, 0, 0), true);
   for (int k = 0; k < kGripStringCount; ++k) CHECK(sent_tensions()[k] == geometry.tension_min_N);
 }
