@@ -56,10 +56,22 @@ HapticNode::HapticNode(const HapticNodeOptions& options, WorldLinkClient& world,
     schedule_.emplace(LockstepSchedule::ticks_per_world_step(world.info().world_period_s, options.rate_hz),
                       world.info().phase_ticks);  // throws if not whole
   }
+  if (options.tool.has_value() != device.oriented() || (options.tool && fingers != 1)) {
+    throw std::invalid_argument(options.tool ? "a tool needs a device with one oriented grip (--device grip), not a "
+                                               "device of fingers"
+                                             : "an oriented device holds a tool: give the node the scene's tool");
+  }
   const ServoOptions servo = servo_options(options, device.limits());
   for (EndpointId k = 0; k < fingers; ++k) {
     endpoints_.push_back(std::make_unique<Endpoint>(servo, options.haptic_session, k));
-    servos_.push_back(&endpoints_.back()->servo);
+    if (options.tool) {
+      ToolCoupling coupling = options.tool_coupling;
+      coupling.max_force_N = std::min(coupling.max_force_N, device.limits().max_force_N);
+      coupling.max_torque_Nm = std::min(coupling.max_torque_Nm, device.limits().max_torque_Nm);
+      endpoints_.back()->tool = std::make_unique<ToolServo>(*options.tool, coupling, options.haptic_session, k);
+    } else {
+      servos_.push_back(&endpoints_.back()->servo);
+    }
     if (!options.log_path.empty()) {
       endpoints_.back()->log.emplace(endpoint_log_path(options.log_path, k), kLogHeader, format_row, kLogRows,
                                      options.clock == ClockMode::lockstep ? LogOverflow::wait : LogOverflow::drop,
@@ -75,10 +87,37 @@ std::uint64_t HapticNode::max_ticks() const {
 
 void HapticNode::receive_frames(double now_s) {
   for (std::size_t k = 0; k < endpoints_.size(); ++k) {
-    if (world_.receive_frame(static_cast<EndpointId>(k), frame_buffer_)) {
+    if (!world_.receive_frame(static_cast<EndpointId>(k), frame_buffer_)) continue;
+    if (endpoints_[k]->tool) {
+      endpoints_[k]->tool->on_plane_frame(frame_buffer_, now_s);
+    } else {
       endpoints_[k]->servo.on_plane_frame(frame_buffer_, now_s);
     }
   }
+}
+
+const HapticReport& HapticNode::report_of(const Endpoint& endpoint) {
+  return endpoint.tool ? endpoint.tool->report() : endpoint.servo.report();
+}
+
+std::uint64_t HapticNode::ticks_of(const Endpoint& endpoint) {
+  return endpoint.tool ? endpoint.tool->ticks() : endpoint.servo.counters().ticks;
+}
+
+std::uint64_t HapticNode::faults_of(const Endpoint& endpoint) {
+  return endpoint.tool ? endpoint.tool->faults() : endpoint.servo.counters().faults;
+}
+
+void HapticNode::tick_tool(Endpoint& endpoint, const FingerSample* grip, double now_s, double dt_s,
+                           FingerCommand& command) {
+  // A reading that gives no pose is a fault (the servo renders nothing and counts it), as a finger's invalid sample.
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  BodyPose pose{Eigen::Vector3d::Constant(kNaN), Eigen::Quaterniond::Identity()};
+  if (grip != nullptr && grip->valid) pose = {grip->position_m, grip->orientation};
+  const ToolTickResult& result = endpoint.tool->tick(grip != nullptr ? &pose : nullptr, now_s, dt_s);
+  command.force_N = result.force_N;
+  command.torque_Nm = result.torque_Nm;
+  command.render = result.render;
 }
 
 // After the world's frames: the fingers, a servo tick per finger, the forces to the device, the reports to the
@@ -91,6 +130,10 @@ void HapticNode::tick(std::uint64_t tick, double now_s, double dt_s, std::int64_
   const std::int64_t cpu_before_ns = sampled ? thread_cpu_now_ns() : 0;
   for (std::size_t k = 0; k < endpoints_.size(); ++k) {
     const FingerSample* finger = fingers != nullptr && fingers[k].present ? &fingers[k] : nullptr;
+    if (endpoints_[k]->tool) {
+      tick_tool(*endpoints_[k], finger, now_s, dt_s, commands_[k]);
+      continue;
+    }
     const TickResult& result = endpoints_[k]->servo.tick(finger, now_s, dt_s);
     commands_[k].force_N = to_eigen(result.force_N);
     commands_[k].render = result.render;
@@ -98,12 +141,18 @@ void HapticNode::tick(std::uint64_t tick, double now_s, double dt_s, std::int64_
   exchange_pushes(servos_);
   if (sampled) tick_cpu_ns_.record(thread_cpu_now_ns() - cpu_before_ns);
   bool world_present = false;
-  for (const HapticServo* servo : servos_) world_present = world_present || servo->has_world();
+  for (const auto& endpoint : endpoints_) {
+    world_present = world_present || (endpoint->tool ? endpoint->tool->has_world() : endpoint->servo.has_world());
+  }
   device_.note_world(world_present);
   const std::uint32_t saturated = device_.command_fingers(tick, commands_.data());
   for (std::size_t k = 0; k < endpoints_.size(); ++k) {
     Endpoint& endpoint = *endpoints_[k];
-    world_.publish_report(endpoint.servo.report());
+    world_.publish_report(report_of(endpoint));
+    if (endpoint.tool) {
+      log_tool_tick(endpoint, tick, now_s, (saturated >> k) & 1u, lateness_ns);
+      continue;
+    }
     const TickResult& result = endpoint.servo.last_result();
     log_tick(endpoint, tick, now_s, result, (saturated >> k) & 1u, lateness_ns);
     if (result.render) {
@@ -114,6 +163,30 @@ void HapticNode::tick(std::uint64_t tick, double now_s, double dt_s, std::int64_
                                                                     result.force_N[1] * result.force_N[1] +
                                                                     result.force_N[2] * result.force_N[2]));
   }
+}
+
+void HapticNode::log_tool_tick(Endpoint& endpoint, std::uint64_t tick, double now_s, bool saturated,
+                               std::int64_t lateness_ns) {
+  const ToolTickResult& result = endpoint.tool->last_result();
+  endpoint.max_force_N = std::max(endpoint.max_force_N, result.force_N.norm());
+  endpoint.max_torque_Nm = std::max(endpoint.max_torque_Nm, result.torque_Nm.norm());
+  if (!endpoint.log) return;
+  // The haptic log's columns for a tool: the grip's centre as the finger, the proxy's grip centre as the proxy, the
+  // force on the grip; the torque is in the summary, not the log.
+  const HapticReport& report = endpoint.tool->report();
+  HapticLogRow row{};
+  row.tick = tick;
+  row.time_s = now_s;
+  row.finger_m = to_vec3(result.grip.position_m);
+  row.proxy_m = to_vec3(result.proxy.position_m);
+  row.force_N = to_vec3(result.force_N);
+  row.object_impulse_Ns = object_impulse_total_Ns(report);
+  row.static_impulse_Ns = report.static_impulse_Ns;
+  row.interpolation_weight = result.interpolation_weight;
+  row.lateness_ns = lateness_ns;
+  row.active_planes = result.active;
+  row.flags = (result.grip_valid ? 1u : 0u) | (saturated ? 2u : 0u) | (result.world_stale ? 8u : 0u);
+  endpoint.log->push(row);
 }
 
 void HapticNode::log_tick(Endpoint& endpoint, std::uint64_t tick, double now_s, const TickResult& result,
@@ -287,14 +360,42 @@ int HapticNode::close() {
 
 void HapticNode::publish_stats(const RealtimeClock* clock) {
   LoopStats stats = loop_stats_now(clock);
-  stats.ticks = endpoints_[0]->servo.counters().ticks;
+  stats.ticks = ticks_of(*endpoints_[0]);
   stats.faults = 0;
-  for (const auto& endpoint : endpoints_) stats.faults += endpoint->servo.counters().faults;
+  for (const auto& endpoint : endpoints_) stats.faults += faults_of(*endpoint);
   stats.rejected_frames = world_.rejected_frames() + device_.counters().rejected_frames;
   world_.publish_stats(stats);
 }
 
 nlohmann::json HapticNode::endpoint_summary(const Endpoint& endpoint) const {
+  if (endpoint.tool) {
+    const ToolServo& tool = *endpoint.tool;
+    const HapticReport& report = tool.report();
+    nlohmann::json impulses = nlohmann::json::object(), angular = nlohmann::json::object();
+    for (std::uint32_t k = 0; k < report.entry_count; ++k) {
+      const ObjectImpulse& entry = report.entries[k];
+      const std::string id = std::to_string(entry.object_id);
+      impulses[id] = {entry.impulse_Ns[0], entry.impulse_Ns[1], entry.impulse_Ns[2]};
+      angular[id] = {entry.angular_impulse_Nms[0], entry.angular_impulse_Nms[1], entry.angular_impulse_Nms[2]};
+    }
+    const ToolCounters& proxy = tool.proxy().counters();
+    return {{"endpoint", report.endpoint},
+            {"haptic_session", options_.haptic_session},
+            {"tool", true},
+            {"faults", faults_of(endpoint)},
+            {"force_clamps", proxy.clamps},
+            {"pinches", proxy.pinches},
+            {"unconverged", proxy.unconverged},
+            {"log_rows_dropped", endpoint.log ? endpoint.log->dropped() : 0},
+            {"max_force_N", endpoint.max_force_N},
+            {"max_torque_Nm", endpoint.max_torque_Nm},
+            {"stiffness_Npm", tool.proxy().coupling().stiffness_Npm},
+            {"rotational_stiffness_Nmprad", tool.proxy().coupling().rotational_stiffness_Nmprad},
+            {"impulse_by_object_Ns", impulses},
+            {"angular_impulse_by_object_Nms", angular},
+            {"static_impulse_Ns",
+             {report.static_impulse_Ns[0], report.static_impulse_Ns[1], report.static_impulse_Ns[2]}}};
+  }
   const ServoCounters& counters = endpoint.servo.counters();
   nlohmann::json impulses = nlohmann::json::object();
   const HapticReport& report = endpoint.servo.report();
@@ -344,10 +445,10 @@ nlohmann::json HapticNode::summary() const {
   nlohmann::json all = nlohmann::json::array();
   for (const auto& endpoint : endpoints_) {
     all.push_back(endpoint_summary(*endpoint));
-    faults += endpoint->servo.counters().faults;
+    faults += faults_of(*endpoint);
   }
   haptic.update(nlohmann::json{
-      {"ticks", endpoints_[0]->servo.counters().ticks},
+      {"ticks", ticks_of(*endpoints_[0])},
       {"rate_hz", options_.rate_hz},
       {"duration_reached", duration_reached_},
       {"faults", faults},

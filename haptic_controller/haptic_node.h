@@ -16,8 +16,10 @@
 #include "common/runtime/loop_stats.h"
 #include "common/runtime/process.h"
 #include "common/runtime/rt_log.h"
+#include "common/contract/tool.h"
 #include "haptic_controller/device/haptic_device.h"
 #include "haptic_controller/servo.h"
+#include "haptic_controller/tool/tool_servo.h"
 
 #include <nlohmann/json.hpp>
 
@@ -46,6 +48,11 @@ struct HapticNodeOptions {
   // Besides the process's stop request (g_stop_requested): a flag its owner sets to end the trial between two ticks
   // (an in-process trial interrupted from Python). Not owned; may be null.
   const std::atomic<bool>* stop = nullptr;
+  // A tool in the hand (docs/tool.md): the endpoint is the grip of an oriented device (HapticDevice::oriented), served
+  // by a tool servo (tool/tool_servo.h) instead of the point finger's. The coupling's limits are lowered to the
+  // device's where they exceed them.
+  std::optional<ToolShape> tool;
+  ToolCoupling tool_coupling;
 };
 
 // One row of the haptic log (the ring holds these; formatted by the drain thread).
@@ -72,7 +79,8 @@ inline Vec3 object_impulse_total_Ns(const HapticReport& report) {
 }
 
 // A haptic node serves one endpoint per finger of its device (HapticDevice::finger_count()): a servo each, ticked in
-// finger order every tick, their forces commanded to the device together.
+// finger order every tick, their forces commanded to the device together. With a tool (HapticNodeOptions::tool) its
+// one endpoint is an oriented device's grip, served by a tool servo: the grip's pose in, force and torque out.
 class HapticNode final : public FollowerStepper {
  public:
   // The link and the device must outlive the node. Throws std::invalid_argument for a lockstep world period that is
@@ -82,7 +90,8 @@ class HapticNode final : public FollowerStepper {
 
   // Whether the trial ended at --duration (a trajectory longer than it was cut; the summary's "duration_reached").
   bool duration_reached() const { return duration_reached_; }
-  // Runs until the duration, a stop request, or (lockstep) no device. Returns the exit status.
+  // Throws std::invalid_argument also for a tool without an oriented one-grip device, or an oriented device without a
+  // tool. Runs until the duration, a stop request, or (lockstep) no device. Returns the exit status.
   int run();
 
   // Lockstep, driven from outside (several nodes in one process, the first the master): tick `t` of this node, with
@@ -101,6 +110,8 @@ class HapticNode final : public FollowerStepper {
   // The haptic half of summary.json; per endpoint under "endpoints".
   nlohmann::json summary() const;
   const HapticServo& servo(EndpointId endpoint = 0) const { return endpoints_[endpoint]->servo; }
+  // The tool servo of a node with a tool (nullptr without).
+  const ToolServo* tool_servo() const { return endpoints_[0]->tool.get(); }
   std::uint32_t endpoint_count() const { return static_cast<std::uint32_t>(endpoints_.size()); }
 
  private:
@@ -111,8 +122,10 @@ class HapticNode final : public FollowerStepper {
   struct Endpoint {
     Endpoint(const ServoOptions& options, std::uint64_t session, EndpointId id) : servo(options, session, id) {}
     HapticServo servo;
+    std::unique_ptr<ToolServo> tool;  // serves the endpoint instead of `servo` when the node has a tool
     std::optional<RtLog<HapticLogRow>> log;
     double max_force_N = 0.0;
+    double max_torque_Nm = 0.0;  // a tool's
     double stiffness_Npm = 0.0;  // k_p and k_d of the last tick that rendered a force
     double damping_Nspm = 0.0;
   };
@@ -120,6 +133,12 @@ class HapticNode final : public FollowerStepper {
   void tick(std::uint64_t tick, double now_s, double dt_s, std::int64_t lateness_ns);
   void log_tick(Endpoint& endpoint, std::uint64_t tick, double now_s, const TickResult& result, bool saturated,
                 std::int64_t lateness_ns);
+  // A tool endpoint's tick: the grip's sample (nullptr: none) → the tool servo → the command.
+  void tick_tool(Endpoint& endpoint, const FingerSample* grip, double now_s, double dt_s, FingerCommand& command);
+  void log_tool_tick(Endpoint& endpoint, std::uint64_t tick, double now_s, bool saturated, std::int64_t lateness_ns);
+  static const HapticReport& report_of(const Endpoint& endpoint);
+  static std::uint64_t ticks_of(const Endpoint& endpoint);
+  static std::uint64_t faults_of(const Endpoint& endpoint);
   void receive_frames(double now_s);
   void run_lockstep();
   void run_follower();

@@ -3,6 +3,9 @@
 
 #include "common/link/inproc/inproc_device_port.h"
 #include "haptic_controller/device/grip_port_driver.h"
+#include "common/link/inproc/inproc_world_link.h"
+#include "common/runtime/lockstep_schedule.h"
+#include "haptic_controller/haptic_node.h"
 #include "haptic_controller/tool/tool_servo.h"
 #include "loop/in_process_rig.h"
 #include "spidar_sim/grip_node.h"
@@ -10,6 +13,7 @@
 #include "world_manager/engine/engine_registry.h"
 #include "world_manager/scene.h"
 #include "world_manager/world.h"
+#include "world_manager/world_node.h"
 
 #include <cmath>
 #include <cstdio>
@@ -53,37 +57,61 @@ bool finite(const GripPose& pose) { return pose.position_m.allFinite() && pose.o
 
 }  // namespace
 
+// The nodes of the daemons, in one process (as loop/in_process_rig.h wires a finger's): the world node and the haptic
+// node on an in-process world link; the haptic node serves the tool on the grip device, whose simulated end is on an
+// in-process device port.
 struct ToolLoop::Parts {
   Parts(const Scene& scene, const ToolLoopOptions& options)
-      : world(scene, world_options(options)),
-        servo(scene.tool->shape, scene.tool->coupling, 1),
+      : world(world_options(options)),
+        link(world.link_info(),
+             InProcessLinkDelay{0, LockstepSchedule::ticks_per_world_step(world.link_info().world_period_s,
+                                                                          limits::kDefaultHapticRate_Hz)}),
+        client(attach(link, world)),
         port(kTick_s),
         device(options.device, options.hand, options.start),
         device_node(device, port, 1),
         driver(options.device, port, ClockMode::lockstep, 1),
-        ticks_per_step(impetus::ticks_per_step(scene.physics.world_rate_hz)),
+        haptic(haptic_options(scene), client, driver),
         coupling(options.coupling) {
     port.connect(device_node);
   }
 
-  static WorldOptions world_options(const ToolLoopOptions& options) {
-    WorldOptions out;
+  static WorldNodeOptions world_options(const ToolLoopOptions& options) {
+    WorldNodeOptions out;
+    out.scene_path = options.scene_path.empty() ? "scene" : options.scene_path;
+    out.scene_text = options.scene_text;
+    out.rate_hz = options.world_rate_hz;
     out.coupling = options.coupling;
-    out.report_force_limit_N = ToolCoupling{}.max_force_N;
+    out.clock = ClockMode::lockstep;
+    out.world_session = 1;  // fixed: the run is one deterministic session
     return out;
   }
+  static HapticNodeOptions haptic_options(const Scene& scene) {
+    HapticNodeOptions out;
+    out.clock = ClockMode::lockstep;
+    out.haptic_session = 1;
+    out.realtime_priority = false;
+    out.tool = scene.tool->shape;
+    out.tool_coupling = scene.tool->coupling;
+    return out;
+  }
+  static WorldLinkClient& attach(InProcessWorldLink& link, WorldNode& world) {
+    world.connect(link);
+    link.connect(world);
+    return link.attach(1);
+  }
 
-  World world;
-  ToolServo servo;
+  WorldNode world;
+  InProcessWorldLink link;
+  WorldLinkClient& client;
   // The device behind its port, as a daemon's would be: the simulated grip SPIDAR and its hand at the device end, the
   // driver at the host end (lockstep: the driver's read gives the device its tick).
   InProcessDevicePort port;
   GripSim device;
   GripNode device_node;
   GripPortDriver driver;
-  int ticks_per_step;
+  HapticNode haptic;
   Coupling coupling;
-  BodyPose grip_read;  // the driver's last good pose
 };
 
 ToolLoop::ToolLoop(const ToolLoopOptions& options) {
@@ -104,7 +132,6 @@ ToolLoop::ToolLoop(const ToolLoopOptions& options) {
   const std::lock_guard<std::mutex> turn(InProcessRig::engine_turn());
   prepare_engines();
   parts_ = std::make_unique<Parts>(scene, options);
-  parts_->grip_read = {options.start.position_m, options.start.orientation};
   for (const SceneObject& object : scene.objects) object_names_.push_back(object.name);
 }
 
@@ -147,25 +174,16 @@ void ToolLoop::step(std::uint64_t count, std::span<const GripPose> targets, std:
 
 void ToolLoop::tick(ToolTick* out) {
   Parts& p = *parts_;
+  // The haptic node's lockstep tick: the device's tick and its pose, the tool servo, the wrench to the device, the
+  // report to the world, and the world's step when one is due.
+  if (!p.haptic.lockstep_tick(ticks_)) throw std::logic_error("the tool loop's haptic node stopped");
   const double t_s = static_cast<double>(ticks_) * kTick_s;
-  if (ticks_ % static_cast<std::uint64_t>(p.ticks_per_step) == 0) {
-    p.servo.on_plane_frame(p.world.step(&p.servo.report()), t_s);
-  }
-  // The device's tick (its hand toward the target under the last tensions), then its counts as the grip's pose.
-  const FingerSample* sample = p.driver.read(ticks_, t_s);
-  const bool valid = sample != nullptr && sample->valid;
-  if (valid) p.grip_read = {sample->position_m, sample->orientation};
-  const ToolTickResult& result = p.servo.tick(valid ? &p.grip_read : nullptr, t_s, kTick_s);
-  FingerCommand command;
-  command.force_N = result.force_N;
-  command.torque_Nm = result.torque_Nm;
-  command.render = result.render;
-  p.driver.command_fingers(ticks_, &command);
   ++ticks_;
   if (out == nullptr) return;
+  const ToolTickResult& result = p.haptic.tool_servo()->last_result();
   out->time_s = t_s;
   out->target = p.device_node.target();
-  out->grip = {p.grip_read.position_m, p.grip_read.orientation};
+  out->grip = {result.grip.position_m, result.grip.orientation};
   out->hand = p.device.pose();
   out->proxy = {result.proxy.position_m, result.proxy.orientation};
   out->force_N = result.force_N;
@@ -178,7 +196,7 @@ void ToolLoop::tick(ToolTick* out) {
 
 std::vector<ToolLoopObject> ToolLoop::objects() const {
   std::vector<ToolLoopObject> out;
-  const World& world = parts_->world;
+  const World& world = parts_->world.world();
   for (std::size_t i = 0; i < object_names_.size(); ++i) {
     const ObjectState& state = world.states()[i];
     out.push_back({state.pose, state.velocity_mps, state.angular_velocity_radps, world.total_impulse_Ns(i),
@@ -193,38 +211,43 @@ const nlohmann::json& ToolLoop::finish() {
   Parts& p = *parts_;
   {
     const std::lock_guard<std::mutex> turn(InProcessRig::engine_turn());
-    // The world applies a report at its next step: two more steps bring in the last ticks' impulse.
-    for (int k = 0; k < 2; ++k) {
-      p.servo.on_plane_frame(p.world.step(&p.servo.report()), static_cast<double>(ticks_) * kTick_s);
-    }
+    // The world applies a report at its next step: two more steps bring in the last ticks' impulse. Then the sessions
+    // end.
+    for (int k = 0; k < 2; ++k) p.client.step_world(ticks_ + static_cast<std::uint64_t>(k));
+    p.haptic.finish_lockstep();
+    p.haptic.close();
   }
   const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
   nlohmann::json ledger = nlohmann::json::object();
-  const HapticReport& report = p.servo.report();
+  const ToolServo& servo = *p.haptic.tool_servo();
+  const World& world = p.world.world();
+  const HapticReport& report = servo.report();
   for (std::uint32_t e = 0; e < report.entry_count; ++e) {
     const ObjectImpulse& entry = report.entries[e];
     if (entry.object_id < 0 || static_cast<std::size_t>(entry.object_id) >= object_names_.size()) continue;
     const std::size_t id = static_cast<std::size_t>(entry.object_id);
     ledger[object_names_[id]] = {
         {"rendered_Ns", vec(to_eigen(entry.impulse_Ns))},
-        {"applied_Ns", vec(p.world.total_impulse_Ns(id))},
+        {"applied_Ns", vec(world.total_impulse_Ns(id))},
         {"rendered_Nms", vec(to_eigen(entry.angular_impulse_Nms))},
-        {"applied_Nms", vec(p.world.total_angular_impulse_Nms(id))},
+        {"applied_Nms", vec(world.total_angular_impulse_Nms(id))},
     };
   }
-  const ToolCounters& proxy = p.servo.proxy().counters();
+  const ToolCounters& proxy = servo.proxy().counters();
   const GripDriverCounters& driver = p.driver.driver().counters();
   summary_ = {
       {"ticks", ticks_},
       {"coupling", to_string(p.coupling)},
-      {"world_rate_hz", 1.0 / p.world.world_period_s()},
-      {"tool", {{"faults", p.servo.faults()}, {"clamps", proxy.clamps}, {"pinches", proxy.pinches},
+      {"world_rate_hz", 1.0 / world.world_period_s()},
+      {"tool", {{"faults", servo.faults()}, {"clamps", proxy.clamps}, {"pinches", proxy.pinches},
                 {"unconverged", proxy.unconverged}}},
       {"device", {{"readings", driver.readings}, {"bad_readings", driver.bad_readings},
                   {"saturations", driver.saturations}, {"no_closure", driver.no_closure},
                   {"most_iterations", driver.most_iterations}}},
       {"ledger", ledger},
   };
+  summary_.update(p.world.summary());
+  summary_.update(p.haptic.summary());
   return summary_;
 }
 

@@ -1,19 +1,21 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// A tool in the hand against the world, in one process and in lockstep (docs/tool.md): the scene's tool ("tool"
-// block) rendered by the tool servo (haptic_controller/tool/tool_servo.h) on the simulated 8-string grip SPIDAR
-// (spidar_sim/grip_sim.h: its motors, strings and the hand holding the grip) through its driver
-// (haptic_controller/device/grip_driver.h), against the world (world_manager/world.h). The caller moves the hand's
-// target pose between ticks, as the point finger's closed loop (simulation.h) moves a finger's target.
+// A tool in the hand against the world, in one process and in lockstep (docs/tool.md): the nodes of the daemons wired
+// together as a finger's in-process trial wires them (in_process_rig.h). The world node and the haptic node share an
+// in-process world link; the haptic node serves the scene's tool ("tool" block) with its tool servo
+// (haptic_controller/tool/tool_servo.h) on the 8-string grip SPIDAR: the driver at the host end of an in-process device
+// port (haptic_controller/device/grip_port_driver.h), the simulated motors, strings and the hand holding the grip at
+// the device end (spidar_sim/grip_node.h). The caller moves the hand's target pose between ticks, as the point
+// finger's closed loop (simulation.h) moves a finger's target.
 //
-// Each tick t (time t·T, T = 1 ms):
-//  1. every world period (ticks 0, n, 2n, …; n = haptic rate / world rate) the world steps on the servo's report and
-//     the servo takes the new frame;
-//  2. the device's tick on its in-process port (its hand toward the target pose under the last tensions), and its
-//     eight encoder counts → the driver's pose of the grip (the device behind its port, as a daemon's would be);
-//  3. the servo's tick: the tool's proxy, the wrench on the grip, the reaction booked per object;
-//  4. the wrench → the driver's eight tensions → the port, for the device's next tick.
-// The world and the servo see the same frames as in every lockstep run, so runs are bitwise reproducible.
+// Each tick t (time t·T, T = 1 ms) is the haptic node's lockstep tick:
+//  1. the device's tick on its port (its hand toward the target pose under the last tensions), and its eight encoder
+//     counts → the driver's pose of the grip;
+//  2. the tool servo: the tool's proxy, the wrench on the grip, the reaction booked per object;
+//  3. the wrench → the driver's eight tensions → the port, for the device's next tick; the report → the world;
+//  4. every world period (ticks 0, n, 2n, …; n = haptic rate / world rate) the world steps on the newest report and
+//     its frame reaches the servo.
+// The schedule is every lockstep run's, so runs are bitwise reproducible.
 //
 // Frames: world, SI; a pose is the grip's centre and orientation (grip → world). Not thread-safe; ODE's process-wide
 // state is guarded by the in-process rig's engine turn (in_process_rig.h), held while building, stepping and
@@ -94,8 +96,9 @@ class ToolLoop {
   const std::vector<std::string>& object_names() const { return object_names_; }
   std::vector<ToolLoopObject> objects() const;
 
-  // Ends the run: two more world steps apply the servo's last reports. Returns a summary: the ticks, the device's
-  // and the servo's counters, and per object the impulse the tool rendered against what the world applied. Later
+  // Ends the run: two more world steps apply the servo's last reports, then the sessions end. Returns a summary: the
+  // ticks, the device's and the tool's counters, per object the impulse the tool rendered against what the world
+  // applied ("ledger"), and the world and haptic nodes' halves of a trial's summary.json ("world", "haptic"). Later
   // calls return the same document.
   const nlohmann::json& finish();
   bool finished() const { return finished_; }

@@ -57,6 +57,7 @@ class ToolServo {
   const ToolProxy& proxy() const { return proxy_; }
   const PlaneSet& planes() const { return planes_; }  // the planes of the last tick
   const ToolTickResult& last_result() const { return result_; }
+  bool has_world() const { return have_frame_; }  // a world frame has reached it
   std::uint64_t ticks() const { return ticks_; }
   std::uint64_t faults() const { return faults_; }
 
