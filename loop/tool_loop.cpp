@@ -2,9 +2,9 @@
 #include "loop/tool_loop.h"
 
 #include "common/link/inproc/inproc_device_port.h"
-#include "haptic_controller/device/grip_port_driver.h"
 #include "common/link/inproc/inproc_world_link.h"
 #include "common/runtime/lockstep_schedule.h"
+#include "haptic_controller/device/grip_port_driver.h"
 #include "haptic_controller/haptic_node.h"
 #include "haptic_controller/tool/tool_servo.h"
 #include "loop/in_process_rig.h"
@@ -17,6 +17,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <mutex>
 #include <stdexcept>
 
@@ -40,8 +41,9 @@ Scene load_tool_scene(const ToolLoopOptions& options) {
   return scene;
 }
 
-// World steps every n ticks; the world period must be a whole number of ticks, as in every lockstep run.
-int ticks_per_step(double world_rate_hz) {
+// The world steps every n ticks: its period must be a whole number of ticks, as in every lockstep run. Said here in
+// the option's own name, before anything is built.
+void check_world_rate(double world_rate_hz) {
   const double n = limits::kDefaultHapticRate_Hz / world_rate_hz;
   if (!(world_rate_hz >= limits::kMinWorldRate_Hz && world_rate_hz <= limits::kDefaultHapticRate_Hz) ||
       std::abs(n - std::round(n)) > 1e-9 * n) {
@@ -50,7 +52,6 @@ int ticks_per_step(double world_rate_hz) {
                   world_rate_hz);
     throw std::invalid_argument(text);
   }
-  return static_cast<int>(std::lround(n));
 }
 
 bool finite(const GripPose& pose) { return pose.position_m.allFinite() && pose.orientation.coeffs().allFinite(); }
@@ -71,13 +72,17 @@ struct ToolLoop::Parts {
         device(options.device, options.hand, options.start),
         device_node(device, port, 1),
         driver(options.device, port, ClockMode::lockstep, 1),
-        haptic(haptic_options(scene), client, driver),
+        haptic(haptic_options(scene, options), client, driver),
         coupling(options.coupling) {
     port.connect(device_node);
   }
 
+  static std::string log_path(const ToolLoopOptions& options, const char* name) {
+    return options.out_dir.empty() ? std::string() : (std::filesystem::path(options.out_dir) / name).string();
+  }
   static WorldNodeOptions world_options(const ToolLoopOptions& options) {
     WorldNodeOptions out;
+    out.log_path = log_path(options, "world.csv");
     out.scene_path = options.scene_path.empty() ? "scene" : options.scene_path;
     out.scene_text = options.scene_text;
     out.rate_hz = options.world_rate_hz;
@@ -86,8 +91,9 @@ struct ToolLoop::Parts {
     out.world_session = 1;  // fixed: the run is one deterministic session
     return out;
   }
-  static HapticNodeOptions haptic_options(const Scene& scene) {
+  static HapticNodeOptions haptic_options(const Scene& scene, const ToolLoopOptions& options) {
     HapticNodeOptions out;
+    out.log_path = log_path(options, "haptic.csv");
     out.clock = ClockMode::lockstep;
     out.haptic_session = 1;
     out.realtime_priority = false;
@@ -121,7 +127,7 @@ ToolLoop::ToolLoop(const ToolLoopOptions& options) {
   }
   if (!finite(options.start)) throw std::invalid_argument("start: the grip's start pose must be finite");
   const Scene scene = load_tool_scene(options);
-  ticks_per_step(scene.physics.world_rate_hz);  // refused before anything is built
+  check_world_rate(scene.physics.world_rate_hz);
   if (const std::string problem = grip_trajectory_problem(
           Trajectory::from_waypoints({{0.0, {options.start.position_m.x(), options.start.position_m.y(),
                                              options.start.position_m.z()}}}, "start"),

@@ -48,6 +48,10 @@ struct ToolLoopOptions {
   GripHandParams hand;                  // the hand that holds the grip (common/hand/grip_hand.h)
   SpidarGripGeometry device;            // the 8-string frame (common/spidar/grip_geometry.h)
   GripPose start;                       // where the grip starts, at rest, and the target holds until moved
+  // A directory (which must exist) for the nodes' logs, world.csv and haptic.csv (the grip's centre as the finger,
+  // the proxy's as the proxy), as a trial writes them: `viewer --replay` plays them back with the summary.json written
+  // beside them. "": no logs.
+  std::string out_dir;
 };
 
 // One tick, read after it.

@@ -577,11 +577,14 @@ class ToolSimulation(_Closable):
     start_m      where the grip starts, at rest (x, y, z, metres); start_wxyz its orientation (default level)
     coupling     "local" (default) or "impulse"; position coupling samples one point and is refused
     rate_hz      the world's rate (default: the scene's); a 1 ms tick must divide its period
+    out_dir      a directory for world.csv and haptic.csv (the grip's centre as the finger, the proxy's as the proxy)
+                 and, at close, summary.json: `viewer --replay OUT_DIR` plays the run back; None: no logs
 
     The world steps every n ticks (n = 1000 / world rate), at ticks 0, n, 2n, ...
     """
 
-    def __init__(self, scene, start_m, coupling="local", *, start_wxyz=(1.0, 0.0, 0.0, 0.0), rate_hz=None):
+    def __init__(self, scene, start_m, coupling="local", *, start_wxyz=(1.0, 0.0, 0.0, 0.0), rate_hz=None,
+                 out_dir=None):
         import numpy as np
         self._np = np
         self._loop = None
@@ -590,8 +593,14 @@ class ToolSimulation(_Closable):
         if coupling not in COUPLINGS:
             raise ValueError(f"coupling: must be one of {', '.join(COUPLINGS)}, not {coupling!r}")
         start = self._pose("start", Simulation._point("start_m", start_m), start_wxyz)
+        if out_dir is not None and not isinstance(out_dir, (str, os.PathLike)):
+            raise TypeError(f"out_dir: must be a path or None, not {type(out_dir).__name__}")
+        self.out_dir = pathlib.Path(out_dir) if out_dir is not None else None
+        if self.out_dir is not None:
+            self.out_dir.mkdir(parents=True, exist_ok=True)
         self._scene_name = scene_path if not scene_text else "(dict)"
-        self._loop = _impetus.ToolClosedLoop(scene_path, scene_text, coupling, _real("rate_hz", rate_hz, True), start)
+        self._loop = _impetus.ToolClosedLoop(scene_path, scene_text, coupling, _real("rate_hz", rate_hz, True), start,
+                                             str(self.out_dir) if self.out_dir is not None else "")
         self.object_names = tuple(self._loop.object_names)
         self.tick_period_s = self._loop.tick_period_s
 
@@ -659,11 +668,14 @@ class ToolSimulation(_Closable):
 
     def close(self):
         """Ends the run (two more world steps apply the last ticks' impulse) and returns the summary: ticks, the
-        tool's and the device's counters, and per object touched the impulse rendered and applied ("ledger")."""
+        tool's and the device's counters, per object touched the impulse rendered and applied ("ledger"), and the
+        world's and haptic node's halves of a trial's summary.json; written to out_dir as summary.json if given."""
         if self.summary is not None or self._loop is None:
             return self.summary
         self.summary = json.loads(self._loop.finish())
         self.summary["scene"] = self._scene_name
+        if self.out_dir is not None:
+            (self.out_dir / "summary.json").write_text(json.dumps(self.summary, indent=2) + "\n")
         self._loop = None
         return self.summary
 

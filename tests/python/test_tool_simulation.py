@@ -8,6 +8,7 @@ Run by CTest with PYTHONPATH=BUILD/python.
 """
 import json
 import math
+import pathlib
 import unittest
 
 import numpy as np
@@ -91,9 +92,26 @@ class PegInHole(unittest.TestCase):
             np.testing.assert_array_equal(x[1], y[1])
 
 
+class Logs(unittest.TestCase):
+    def test_out_dir_gets_the_logs_and_summary_a_replay_reads(self):
+        import tempfile
+        with tempfile.TemporaryDirectory() as scratch:
+            out = pathlib.Path(scratch) / "run"
+            with impetus.ToolSimulation(PEG, start_m=START, out_dir=out) as sim:
+                sim.step(targets=line(START, [0.04, 0, 0.07], 300))
+                summary = sim.close()
+            self.assertEqual(json.loads((out / "summary.json").read_text()), summary)
+            self.assertEqual(summary["config"]["scene"], str(PEG))
+            haptic = impetus.read_log(out / "haptic.csv")
+            self.assertEqual(len(haptic["tick"]), 300)  # a row a tick: the grip's centre as the finger
+            np.testing.assert_allclose(haptic["finger_z_m"][-1], 0.07, atol=1e-3)
+            world = impetus.read_log(out / "world.csv")
+            self.assertEqual(len(world["time_s"]), 6 + 2)  # a row a world step: 300 ticks at 20 Hz, and close()'s two
+            self.assertIn("cube.x_m", world)
+
+
 class Example(unittest.TestCase):
     def test_the_peg_in_hole_example_feels_each_stage(self):
-        import pathlib
         import sys
         sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "examples" / "python"))
         import peg_in_hole
