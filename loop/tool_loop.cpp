@@ -15,9 +15,9 @@
 #include "world_manager/world.h"
 #include "world_manager/world_node.h"
 
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <mutex>
 #include <stdexcept>
 
@@ -26,32 +26,28 @@ namespace {
 
 constexpr double kTick_s = 1.0 / limits::kDefaultHapticRate_Hz;
 
-Scene load_tool_scene(const ToolLoopOptions& options) {
-  if (options.scene_path.empty() && options.scene_text.empty()) {
-    throw std::invalid_argument("scene: give a scene file or its text");
+// The world steps every n ticks: its period must be a whole number of ticks, as in every lockstep run. Said here in
+// the option's own name, before anything is built (a scene's own rate is checked by the world node).
+void check_world_rate(std::optional<double> world_rate_hz) {
+  if (!world_rate_hz) return;
+  try {
+    if (!(*world_rate_hz >= limits::kMinWorldRate_Hz)) throw std::invalid_argument("");
+    LockstepSchedule::ticks_per_world_step(1.0 / *world_rate_hz, limits::kDefaultHapticRate_Hz);
+  } catch (const std::invalid_argument&) {
+    char text[160];
+    std::snprintf(text, sizeof text, "world_rate_hz: %g Hz is not a whole number of 1 ms ticks a period",
+                  *world_rate_hz);
+    throw std::invalid_argument(text);
   }
-  Scene scene = options.scene_text.empty()
-                    ? load_scene(options.scene_path)
-                    : parse_scene_text(options.scene_text, options.scene_path.empty() ? "scene" : options.scene_path);
+}
+
+// The scene's tool; std::invalid_argument for a scene without one.
+const SceneTool& tool_of(const Scene& scene) {
   if (!scene.tool) {
     throw std::invalid_argument(scene.source_name + ": has no \"tool\" block: a tool loop renders the scene's tool "
                                 "(docs/scene-format.md)");
   }
-  if (options.world_rate_hz) scene.physics.world_rate_hz = *options.world_rate_hz;
-  return scene;
-}
-
-// The world steps every n ticks: its period must be a whole number of ticks, as in every lockstep run. Said here in
-// the option's own name, before anything is built.
-void check_world_rate(double world_rate_hz) {
-  const double n = limits::kDefaultHapticRate_Hz / world_rate_hz;
-  if (!(world_rate_hz >= limits::kMinWorldRate_Hz && world_rate_hz <= limits::kDefaultHapticRate_Hz) ||
-      std::abs(n - std::round(n)) > 1e-9 * n) {
-    char text[160];
-    std::snprintf(text, sizeof text, "world_rate_hz: %g Hz is not a whole number of 1 ms ticks a period",
-                  world_rate_hz);
-    throw std::invalid_argument(text);
-  }
+  return *scene.tool;
 }
 
 bool finite(const GripPose& pose) { return pose.position_m.allFinite() && pose.orientation.coeffs().allFinite(); }
@@ -62,7 +58,7 @@ bool finite(const GripPose& pose) { return pose.position_m.allFinite() && pose.o
 // node on an in-process world link; the haptic node serves the tool on the grip device, whose simulated end is on an
 // in-process device port.
 struct ToolLoop::Parts {
-  Parts(const Scene& scene, const ToolLoopOptions& options)
+  explicit Parts(const ToolLoopOptions& options)
       : world(world_options(options)),
         link(world.link_info(),
              InProcessLinkDelay{0, LockstepSchedule::ticks_per_world_step(world.link_info().world_period_s,
@@ -72,7 +68,7 @@ struct ToolLoop::Parts {
         device(options.device, options.hand, options.start),
         device_node(device, port, 1),
         driver(options.device, port, ClockMode::lockstep, 1),
-        haptic(haptic_options(scene, options), client, driver),
+        haptic(haptic_options(tool_of(world.world().scene()), options), client, driver),
         coupling(options.coupling) {
     port.connect(device_node);
   }
@@ -91,14 +87,14 @@ struct ToolLoop::Parts {
     out.world_session = 1;  // fixed: the run is one deterministic session
     return out;
   }
-  static HapticNodeOptions haptic_options(const Scene& scene, const ToolLoopOptions& options) {
+  static HapticNodeOptions haptic_options(const SceneTool& tool, const ToolLoopOptions& options) {
     HapticNodeOptions out;
     out.log_path = log_path(options, "haptic.csv");
     out.clock = ClockMode::lockstep;
     out.haptic_session = 1;
     out.realtime_priority = false;
-    out.tool = scene.tool->shape;
-    out.tool_coupling = scene.tool->coupling;
+    out.tool = tool.shape;
+    out.tool_coupling = tool.coupling;
     return out;
   }
   static WorldLinkClient& attach(InProcessWorldLink& link, WorldNode& world) {
@@ -125,20 +121,18 @@ ToolLoop::ToolLoop(const ToolLoopOptions& options) {
     throw std::invalid_argument("coupling: position coupling samples one point per endpoint, and a tool touches at "
                                 "many; use local or impulse");
   }
+  if (options.scene_path.empty() && options.scene_text.empty()) {
+    throw std::invalid_argument("scene: give a scene file or its text");
+  }
   if (!finite(options.start)) throw std::invalid_argument("start: the grip's start pose must be finite");
-  const Scene scene = load_tool_scene(options);
-  check_world_rate(scene.physics.world_rate_hz);
-  if (const std::string problem = grip_trajectory_problem(
-          Trajectory::from_waypoints({{0.0, {options.start.position_m.x(), options.start.position_m.y(),
-                                             options.start.position_m.z()}}}, "start"),
-          options.device);
-      !problem.empty()) {
+  if (const std::string problem = grip_point_problem(options.start.position_m, options.device); !problem.empty()) {
     throw std::invalid_argument("start: " + problem);
   }
+  check_world_rate(options.world_rate_hz);
   const std::lock_guard<std::mutex> turn(InProcessRig::engine_turn());
   prepare_engines();
-  parts_ = std::make_unique<Parts>(scene, options);
-  for (const SceneObject& object : scene.objects) object_names_.push_back(object.name);
+  parts_ = std::make_unique<Parts>(options);  // the world node reads the scene
+  for (const SceneObject& object : parts_->world.world().scene().objects) object_names_.push_back(object.name);
 }
 
 ToolLoop::~ToolLoop() {
@@ -155,9 +149,7 @@ double ToolLoop::tick_period_s() const { return kTick_s; }
 
 void ToolLoop::check_target(const GripPose& target) const {
   if (!finite(target)) throw std::invalid_argument("target: the pose must be finite");
-  const Eigen::Vector3d& p = target.position_m;
-  const std::string problem = grip_trajectory_problem(
-      Trajectory::from_waypoints({{0.0, {p.x(), p.y(), p.z()}}}, "target"), parts_->device.strings().geometry());
+  const std::string problem = grip_point_problem(target.position_m, parts_->device.strings().geometry());
   if (!problem.empty()) throw std::invalid_argument("target: " + problem);
 }
 

@@ -26,19 +26,26 @@ GripPose start_of(const Trajectory& trajectory) {
 
 }  // namespace
 
-std::string grip_trajectory_problem(const Trajectory& trajectory, const SpidarGripGeometry& geometry) {
+std::string grip_point_problem(const Eigen::Vector3d& point_m, const SpidarGripGeometry& geometry) {
   const double room_m = 0.5 * geometry.frame_side_m - geometry.grip_radius_m;
   const Eigen::Vector3d centre_m(geometry.centre_m[0], geometry.centre_m[1], geometry.centre_m[2]);
+  if (!((point_m - centre_m).cwiseAbs().maxCoeff() > room_m)) return {};
+  char message[256];
+  std::snprintf(message, sizeof message,
+                "the grip's target (%.4f, %.4f, %.4f) m is within its radius of the frame's cube (side %.3f m about "
+                "(%.3f, %.3f, %.3f) m) or beyond: the strings cannot hold it there",
+                point_m.x(), point_m.y(), point_m.z(), geometry.frame_side_m, centre_m.x(), centre_m.y(),
+                centre_m.z());
+  return message;
+}
+
+std::string grip_trajectory_problem(const Trajectory& trajectory, const SpidarGripGeometry& geometry) {
   auto outside = [&](double t_s, std::string& problem) {
-    const Eigen::Vector3d point_m = to_eigen(trajectory.position_at(t_s));
-    if (!((point_m - centre_m).cwiseAbs().maxCoeff() > room_m)) return false;
-    char message[256];
-    std::snprintf(message, sizeof message,
-                  "at t = %.3f s the grip's target (%.4f, %.4f, %.4f) m is within its radius of the frame's cube "
-                  "(side %.3f m about (%.3f, %.3f, %.3f) m) or beyond: the strings cannot hold it there",
-                  t_s, point_m.x(), point_m.y(), point_m.z(), geometry.frame_side_m, centre_m.x(), centre_m.y(),
-                  centre_m.z());
-    problem = message;
+    problem = grip_point_problem(to_eigen(trajectory.position_at(t_s)), geometry);
+    if (problem.empty()) return false;
+    char when[48];
+    std::snprintf(when, sizeof when, "at t = %.3f s ", t_s);
+    problem = when + problem;
     return true;
   };
   // A line stays between its ends, inside the cube if they are (it is convex); an arc is sampled 64 times, where its

@@ -26,6 +26,9 @@ namespace impetus {
 // leave the frame's cube (its centre closer to a face than the grip's radius), where the strings cannot hold it.
 // Names the time and the point.
 std::string grip_trajectory_problem(const Trajectory& trajectory, const SpidarGripGeometry& geometry);
+// The same for one target point (world frame, m): "" if the strings can hold the grip there. Allocates only for a
+// message.
+std::string grip_point_problem(const Eigen::Vector3d& point_m, const SpidarGripGeometry& geometry);
 
 class GripSim {
  public:
