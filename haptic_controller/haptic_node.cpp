@@ -34,6 +34,20 @@ void format_row(std::ostream& out, const HapticLogRow& row) {
   line.number(row.interpolation_weight).integer(row.lateness_ns).integer(row.active_planes).integer(row.flags);
 }
 
+constexpr const char* kToolLogHeader =
+    "time_s,tick,grip_x_m,grip_y_m,grip_z_m,grip_qw,grip_qx,grip_qy,grip_qz,proxy_x_m,proxy_y_m,proxy_z_m,proxy_qw,"
+    "proxy_qx,proxy_qy,proxy_qz,force_x_N,force_y_N,force_z_N,torque_x_Nm,torque_y_Nm,torque_z_Nm,active_contacts,"
+    "flags";
+
+void format_tool_row(std::ostream& out, const ToolLogRow& row) {
+  CsvLine line(out);
+  line.number(row.time_s).integer(static_cast<std::int64_t>(row.tick));
+  line.numbers(row.grip_m).numbers(row.grip_wxyz).numbers(row.proxy_m).numbers(row.proxy_wxyz);
+  line.numbers(row.force_N).numbers(row.torque_Nm).integer(row.active_contacts).integer(row.flags);
+}
+
+std::array<double, 4> wxyz(const Eigen::Quaterniond& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+
 ServoOptions servo_options(const HapticNodeOptions& options, const DeviceLimits& limits) {
   ServoOptions servo;
   servo.max_force_N = limits.max_force_N;
@@ -76,6 +90,13 @@ HapticNode::HapticNode(const HapticNodeOptions& options, WorldLinkClient& world,
       endpoints_.back()->log.emplace(endpoint_log_path(options.log_path, k), kLogHeader, format_row, kLogRows,
                                      options.clock == ClockMode::lockstep ? LogOverflow::wait : LogOverflow::drop,
                                      "haptic_controller");
+      if (options.tool) {
+        endpoints_.back()->tool_log.emplace(tool_log_path(options.log_path), kToolLogHeader, format_tool_row,
+                                            kLogRows,
+                                            options.clock == ClockMode::lockstep ? LogOverflow::wait
+                                                                                 : LogOverflow::drop,
+                                            "haptic_controller");
+      }
     }
   }
 }
@@ -171,8 +192,22 @@ void HapticNode::log_tool_tick(Endpoint& endpoint, std::uint64_t tick, double no
   endpoint.max_force_N = std::max(endpoint.max_force_N, result.force_N.norm());
   endpoint.max_torque_Nm = std::max(endpoint.max_torque_Nm, result.torque_Nm.norm());
   if (!endpoint.log) return;
-  // The haptic log's columns for a tool: the grip's centre as the finger, the proxy's grip centre as the proxy, the
-  // force on the grip; the torque is in the summary, not the log.
+  const std::uint32_t flags =
+      (result.grip_valid ? 1u : 0u) | (saturated ? 2u : 0u) | (result.world_stale ? 8u : 0u);
+  // The poses and the torque go to the tool's log; the haptic log's columns take the grip's centre as the finger, the
+  // proxy's grip centre as the proxy and the force on the grip, so whatever reads a finger's log reads a tool's.
+  ToolLogRow pose{};
+  pose.tick = tick;
+  pose.time_s = now_s;
+  pose.grip_m = to_vec3(result.grip.position_m);
+  pose.grip_wxyz = wxyz(result.grip.orientation);
+  pose.proxy_m = to_vec3(result.proxy.position_m);
+  pose.proxy_wxyz = wxyz(result.proxy.orientation);
+  pose.force_N = to_vec3(result.force_N);
+  pose.torque_Nm = to_vec3(result.torque_Nm);
+  pose.active_contacts = result.active;
+  pose.flags = flags;
+  endpoint.tool_log->push(pose);
   const HapticReport& report = endpoint.tool->report();
   HapticLogRow row{};
   row.tick = tick;
@@ -185,7 +220,7 @@ void HapticNode::log_tool_tick(Endpoint& endpoint, std::uint64_t tick, double no
   row.interpolation_weight = result.interpolation_weight;
   row.lateness_ns = lateness_ns;
   row.active_planes = result.active;
-  row.flags = (result.grip_valid ? 1u : 0u) | (saturated ? 2u : 0u) | (result.world_stale ? 8u : 0u);
+  row.flags = flags;
   endpoint.log->push(row);
 }
 
@@ -335,6 +370,7 @@ int HapticNode::run() {
         [](void* node) {
           for (auto& endpoint : static_cast<HapticNode*>(node)->endpoints_) {
             if (endpoint->log && endpoint->log->drain_one()) return true;
+            if (endpoint->tool_log && endpoint->tool_log->drain_one()) return true;
           }
           return false;
         },
@@ -350,9 +386,14 @@ int HapticNode::close() {
   publish_stats(nullptr);
   bool log_failed = false;
   for (auto& endpoint : endpoints_) {
-    if (!endpoint->log) continue;
-    endpoint->log->close();
-    log_failed = log_failed || endpoint->log->failed();
+    if (endpoint->log) {
+      endpoint->log->close();
+      log_failed = log_failed || endpoint->log->failed();
+    }
+    if (endpoint->tool_log) {
+      endpoint->tool_log->close();
+      log_failed = log_failed || endpoint->tool_log->failed();
+    }
   }
   // A failed log write was reported when it happened (rt_log.h), a trial cut short at its end.
   return cut_short_ || log_failed ? 1 : 0;
@@ -386,7 +427,8 @@ nlohmann::json HapticNode::endpoint_summary(const Endpoint& endpoint) const {
             {"force_clamps", proxy.clamps},
             {"pinches", proxy.pinches},
             {"unconverged", proxy.unconverged},
-            {"log_rows_dropped", endpoint.log ? endpoint.log->dropped() : 0},
+            {"log_rows_dropped",
+             (endpoint.log ? endpoint.log->dropped() : 0) + (endpoint.tool_log ? endpoint.tool_log->dropped() : 0)},
             {"max_force_N", endpoint.max_force_N},
             {"max_torque_Nm", endpoint.max_torque_Nm},
             {"stiffness_Npm", tool.proxy().coupling().stiffness_Npm},

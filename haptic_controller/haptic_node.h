@@ -68,6 +68,21 @@ struct HapticLogRow {
   std::uint32_t flags;  // bit 0 finger valid, 1 saturated, 2 fault, 3 world stale, 4 sticking
 };
 
+// One row of a tool's pose log (haptic.tool.csv beside haptic.csv): the grip's and the proxy's poses, which the
+// haptic log's point columns cannot hold, and the wrench on the grip.
+struct ToolLogRow {
+  std::uint64_t tick;
+  double time_s;
+  Vec3 grip_m;
+  std::array<double, 4> grip_wxyz;  // unit quaternion, grip → world
+  Vec3 proxy_m;
+  std::array<double, 4> proxy_wxyz;
+  Vec3 force_N;    // on the grip
+  Vec3 torque_Nm;  // on the grip, about its centre
+  std::int32_t active_contacts;
+  std::uint32_t flags;  // bit 0 grip valid, 1 saturated, 3 world stale (the haptic log's bits)
+};
+
 // The running total of the reaction a report's endpoint has given all objects together (N·s): the sum of its
 // entries' totals, as the haptic log's object_impulse columns record it.
 inline Vec3 object_impulse_total_Ns(const HapticReport& report) {
@@ -124,6 +139,7 @@ class HapticNode final : public FollowerStepper {
     HapticServo servo;
     std::unique_ptr<ToolServo> tool;  // serves the endpoint instead of `servo` when the node has a tool
     std::optional<RtLog<HapticLogRow>> log;
+    std::optional<RtLog<ToolLogRow>> tool_log;  // a tool endpoint's poses
     double max_force_N = 0.0;
     double max_torque_Nm = 0.0;  // a tool's
     double stiffness_Npm = 0.0;  // k_p and k_d of the last tick that rendered a force

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "viewer/replay.h"
 
+#include "common/runtime/log_paths.h"
 #include "common/runtime/message_text.h"
 
 #include "world_manager/scene.h"
@@ -129,6 +130,61 @@ fs::path find_scene(const std::string& named, const fs::path& dir) {
   throw ReplayError((dir / "summary.json").string() + ": /config/scene: no such file '" + named + "'");
 }
 
+// The row of a log sorted by `time_column` that is the last at or before `time_s` (from `next`, which advances), and
+// whether there is one (else row 0, before the log starts).
+bool advance_to(const CsvTable& table, int time_column, double time_s, std::size_t& next) {
+  while (next + 1 < table.rows.size() && table.rows[next + 1][time_column] <= time_s) ++next;
+  return table.rows[next][time_column] <= time_s;
+}
+
+// A tool's pose log (haptic.tool.csv, haptic_controller/haptic_node.h ToolLogRow): its poses and wrench at each frame
+// time (on the world's clock, `world_ahead_s` ahead of the haptic side's).
+std::vector<ViewToolFrame> read_tool_track(const fs::path& path, const std::vector<double>& times_s,
+                                           double world_ahead_s) {
+  const CsvTable log = read_csv(path);
+  static const char* const kColumns[] = {"time_s",    "grip_x_m",  "grip_y_m",  "grip_z_m",  "grip_qw",   "grip_qx",
+                                         "grip_qy",   "grip_qz",   "proxy_x_m", "proxy_y_m", "proxy_z_m", "proxy_qw",
+                                         "proxy_qx",  "proxy_qy",  "proxy_qz",  "force_x_N", "force_y_N", "force_z_N",
+                                         "torque_x_Nm", "torque_y_Nm", "torque_z_Nm", "flags"};
+  constexpr std::size_t kCount = std::size(kColumns);
+  std::array<int, kCount> c{};
+  for (std::size_t v = 0; v < kCount; ++v) {
+    c[v] = log.column(kColumns[v]);
+    if (c[v] < 0) throw ReplayError(path.string() + ": no column '" + kColumns[v] + "'");
+  }
+  std::vector<ViewToolFrame> frames(times_s.size());
+  if (log.rows.empty()) return frames;
+  check_times(log, c[0], path);
+  std::size_t next = 0;
+  for (std::size_t f = 0; f < times_s.size(); ++f) {
+    const bool started = advance_to(log, c[0], times_s[f] - world_ahead_s, next);
+    const std::vector<double>& row = log.rows[next];
+    ViewToolFrame& frame = frames[f];
+    auto value = [&](std::size_t v) { return row[static_cast<std::size_t>(c[v])]; };
+    for (int i = 0; i < 3; ++i) {
+      frame.grip.position_m[i] = value(1 + i);
+      frame.proxy.position_m[i] = value(8 + i);
+      frame.force_N[i] = value(15 + i);
+      frame.torque_Nm[i] = value(18 + i);
+    }
+    for (int i = 0; i < 4; ++i) {
+      frame.grip.orientation_wxyz[i] = value(4 + i);
+      frame.proxy.orientation_wxyz[i] = value(11 + i);
+    }
+    const auto unit = [](const std::array<double, 4>& q) {
+      const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      return std::abs(norm - 1.0) < 1e-6;
+    };
+    // A tick without a pose (flags bit 0 clear) logs the last pose it had; a grip before its first tick has none.
+    const bool grip_valid = (static_cast<std::uint32_t>(value(21)) & 1u) != 0;
+    frame.valid = started && grip_valid && all_finite(frame.grip.position_m) && all_finite(frame.proxy.position_m) &&
+                  all_finite(frame.force_N) && all_finite(frame.torque_Nm) && unit(frame.grip.orientation_wxyz) &&
+                  unit(frame.proxy.orientation_wxyz);
+    if (!frame.valid) frame = ViewToolFrame{};
+  }
+  return frames;
+}
+
 Coupling coupling_named(const std::string& name, const fs::path& summary) {
   for (Coupling coupling : {Coupling::impulse, Coupling::position, Coupling::local}) {
     if (name == to_string(coupling)) return coupling;
@@ -223,7 +279,8 @@ Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<View
     std::vector<ViewEndpoint>& track = endpoints_.emplace_back(times_s_.size());
     std::size_t next = 0;
     for (std::size_t f = 0; f < times_s_.size(); ++f) {
-      while (next + 1 < haptic.rows.size() && haptic.rows[next + 1][hc[0]] <= times_s_[f] - world_ahead_s) ++next;
+      // Before the finger's first tick (a world started before the finger) there is no finger yet.
+      const bool started = advance_to(haptic, hc[0], times_s_[f] - world_ahead_s, next);
       const std::vector<double>& row = haptic.rows[next];
       ViewEndpoint& endpoint = track[f];
       endpoint.endpoint = e;
@@ -232,10 +289,16 @@ Replay::Replay(const std::string& dir) : dir_(dir), scene_(std::make_unique<View
       endpoint.force_N = {row[hc[7]], row[hc[8]], row[hc[9]]};
       endpoint.finger_valid =
           all_finite(endpoint.finger_m) && all_finite(endpoint.proxy_m) && all_finite(endpoint.force_N);
-      // Before the finger's first tick (a world started before the finger) there is no finger yet.
-      const bool started = row[hc[0]] <= times_s_[f] - world_ahead_s;
       if (!endpoint.finger_valid || !started) endpoint = ViewEndpoint{};
     }
+  }
+
+  // A tool in the hand: drawn where its pose log puts it (a trial without that log shows its grip as a finger's).
+  const fs::path tool_path = folder / tool_log_path("haptic.csv");
+  std::error_code missing;
+  if (scene.tool && fs::is_regular_file(tool_path, missing)) {
+    tool_ = scene.tool->shape;
+    tool_frames_ = read_tool_track(tool_path, times_s_, world_ahead_s);
   }
 }
 

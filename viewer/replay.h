@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A finished trial, read back for the viewer's replay (viewer --replay DIR): the scene its summary names, every world
-// step's poses from world.csv, and the finger, proxy and force from haptic.csv at each step's time. Planes are not
-// logged, so a replay shows none.
+// step's poses from world.csv, and the finger, proxy and force from haptic.csv at each step's time; for a tool in the
+// hand, the grip's and the proxy's poses and the wrench from haptic.tool.csv. Planes are not logged, so a replay shows
+// none.
 
 #include "common/contract/world_view.h"
+#include "viewer/view_encoding.h"
 
 #include <cstddef>
 #include <memory>
@@ -36,6 +38,11 @@ class Replay {
   std::size_t frame_at(double time_s) const;
   // Fills `out` with frame `frame` (< frame_count()).
   void snapshot(std::size_t frame, WorldSnapshot& out) const;
+  // The scene's tool and its poses at frame `frame`, when the trial had a tool and logged it (nullptr otherwise).
+  const ToolShape* tool() const { return tool_frames_.empty() ? nullptr : &tool_; }
+  const ViewToolFrame* tool_frame(std::size_t frame) const {
+    return tool_frames_.empty() ? nullptr : &tool_frames_[frame];
+  }
 
  private:
   std::string dir_;
@@ -45,6 +52,8 @@ class Replay {
   std::vector<ViewBodyPose> poses_;  // frame_count × body_count, frame-major
   // Per endpoint (at most kMaxViewEndpoints), its finger at every frame.
   std::vector<std::vector<ViewEndpoint>> endpoints_;
+  ToolShape tool_;
+  std::vector<ViewToolFrame> tool_frames_;  // per frame; empty without a tool log
 };
 
 }  // namespace impetus::view

@@ -66,9 +66,18 @@ nlohmann::json mesh_form(const Shape& shape) {
   return form;
 }
 
+// A shape's fields for the page, as a body's (view_protocol.h §1).
+void add_shape(const Shape& shape, nlohmann::json& entry) {
+  entry["shape"] = to_string(shape.kind);
+  entry["size_m"] = shape.box_size_m;
+  entry["radius_m"] = shape.radius_m;
+  entry["length_m"] = shape.length_m;
+}
+
 }  // namespace
 
-std::string scene_message(const ViewScene& scene, const std::string& source, const std::optional<ReplayRange>& replay) {
+std::string scene_message(const ViewScene& scene, const std::string& source, const std::optional<ReplayRange>& replay,
+                          const ToolShape* tool) {
   nlohmann::json message = {{"type", "scene"},
                             {"mode", replay ? "replay" : "live"},
                             {"source", source},
@@ -79,11 +88,8 @@ std::string scene_message(const ViewScene& scene, const std::string& source, con
   for (std::uint32_t k = 0; k < scene.body_count; ++k) {
     const ViewBodyInfo& body = scene.bodies[k];
     nlohmann::json entry = {{"name", std::string(body.name.data())},  // NUL-terminated (scene_problem checked)
-                            {"shape", to_string(body.shape.kind)},
-                            {"dynamic", body.dynamic != 0},
-                            {"size_m", body.shape.box_size_m},
-                            {"radius_m", body.shape.radius_m},
-                            {"length_m", body.shape.length_m}};
+                            {"dynamic", body.dynamic != 0}};
+    add_shape(body.shape, entry);
     if (body.shape.kind == ShapeKind::mesh) {
       char hash[17];
       std::snprintf(hash, sizeof hash, "%016" PRIx64, body.shape.mesh_hash);
@@ -93,6 +99,14 @@ std::string scene_message(const ViewScene& scene, const std::string& source, con
     bodies.push_back(std::move(entry));
   }
   message["bodies"] = std::move(bodies);
+  if (tool != nullptr) {
+    nlohmann::json entry = nlohmann::json::object();
+    add_shape(tool->shape, entry);
+    const Eigen::Vector3d& p = tool->placement.position_m;
+    const Eigen::Quaterniond& q = tool->placement.orientation;
+    entry["placement"] = {{"position_m", {p.x(), p.y(), p.z()}}, {"orientation_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
+    message["tool"] = std::move(entry);
+  }
   if (replay) {
     message["replay"] = {{"start_s", replay->start_s}, {"end_s", replay->end_s}, {"frame_count", replay->frame_count}};
   }
@@ -100,7 +114,8 @@ std::string scene_message(const ViewScene& scene, const std::string& source, con
   return message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-void encode_frame(const WorldSnapshot& snapshot, bool playing, double speed, std::string& out) {
+void encode_frame(const WorldSnapshot& snapshot, bool playing, double speed, std::string& out,
+                  const ViewToolFrame* tool) {
   Packer pack(out);
   const double lateness_p99_s = snapshot.haptic_stats.lateness_p99_ns > 0
                                     ? static_cast<double>(snapshot.haptic_stats.lateness_p99_ns) * 1e-9
@@ -118,7 +133,8 @@ void encode_frame(const WorldSnapshot& snapshot, bool playing, double speed, std
                                              playing ? 1.0 : 0.0,
                                              speed,
                                              snapshot.dent.object_id >= 0 ? 1.0 : 0.0,
-                                             0.0, 0.0, 0.0};
+                                             tool != nullptr ? 1.0 : 0.0,
+                                             0.0, 0.0};
   for (double value : header) pack.add(value);
   for (std::uint32_t k = 0; k < snapshot.body_count; ++k) {
     const ViewBodyPose& body = snapshot.bodies[k];
@@ -145,6 +161,15 @@ void encode_frame(const WorldSnapshot& snapshot, bool playing, double speed, std
                                         dent.x0_m, dent.y0_m, dent.dx_m, dent.dy_m};
     for (double value : values) pack.add(value);
     for (std::uint32_t k = 0; k < dent.columns * dent.rows; ++k) pack.add(static_cast<double>(dent.depth_m[k]));
+  }
+  if (tool != nullptr) {
+    pack.add(tool->valid ? 1.0 : 0.0);
+    for (const ViewBodyPose* pose : {&tool->grip, &tool->proxy}) {
+      pack.add(pose->position_m);
+      for (double q : pose->orientation_wxyz) pack.add(q);
+    }
+    pack.add(tool->force_N);
+    pack.add(tool->torque_Nm);
   }
 }
 

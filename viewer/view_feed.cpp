@@ -90,7 +90,8 @@ bool LiveFeed::control(Playback& /*playback*/, const nlohmann::json& message) { 
 ReplayFeed::ReplayFeed(const std::string& dir)
     : replay_(dir), snapshot_(std::make_unique<WorldSnapshot>()) {
   scene_message_ = std::make_shared<const std::string>(
-      scene_message(replay_.scene(), dir, ReplayRange{replay_.start_s(), replay_.end_s(), replay_.frame_count()}));
+      scene_message(replay_.scene(), dir, ReplayRange{replay_.start_s(), replay_.end_s(), replay_.frame_count()},
+                    replay_.tool()));
 }
 
 std::shared_ptr<const std::string> ReplayFeed::next_frame(Playback& playback, double elapsed_s) {
@@ -108,7 +109,7 @@ std::shared_ptr<const std::string> ReplayFeed::next_frame(Playback& playback, do
   playback.frame = frame;
   replay_.snapshot(frame, *snapshot_);
   auto message = std::make_shared<std::string>();
-  encode_frame(*snapshot_, playback.playing, playback.speed, *message);
+  encode_frame(*snapshot_, playback.playing, playback.speed, *message, replay_.tool_frame(frame));
   return message;
 }
 

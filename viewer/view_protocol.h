@@ -16,7 +16,9 @@
 //       its file (--meshes-from, or a replay's scene); a mesh of more than kMaxViewMeshTriangles is sent coarsened
 //       to at most that many (viewer/mesh_coarsening.h), with "coarsened_from": its own count and "cell_m", or
 //         {"drawn": "bound", "why": "..."}: the page draws a ball of radius_m about its centre instead.
-//       "replay": {"start_s": t0, "end_s": t1, "frame_count": n}}          (replay only)
+//       "replay": {"start_s": t0, "end_s": t1, "frame_count": n},          (replay only)
+//       "tool": {"shape": ..., "size_m": ..., "radius_m": ..., "length_m": ...,   (a replay of a tool in the hand)
+//                "placement": {"position_m": [x, y, z], "orientation_wxyz": [w, x, y, z]}}}   (shape → grip frame)
 //    Body k of every frame below is bodies[k]. A shape's axis of symmetry is its body z.
 //
 // 2. Each world frame, one binary message: little-endian float64 values (a Float64Array on the page):
@@ -26,7 +28,8 @@
 //        [6] haptic lateness p99, s (NaN: unknown, e.g. lockstep or replay)
 //        [7] haptic faults            [8] world skipped periods  [9] haptic skipped periods
 //        [10] playing (replay: 1 or 0; live: 1)                  [11] replay speed (live: 1)
-//        [12] dent: 1 when a dent follows the endpoints, else 0     [13..15] reserved, 0
+//        [12] dent: 1 when a dent follows the endpoints, else 0
+//        [13] tool: 1 when the tool's poses follow (after the dent), else 0        [14..15] reserved, 0
 //      then B bodies, kBodyValues each: position x, y, z (m), orientation w, x, y, z (unit quaternion, body → world)
 //      then E endpoints, each kEndpointValues followed by 6·P plane values:
 //        endpoint id, finger valid (1/0), finger x, y, z (m), proxy x, y, z (m), force on the finger x, y, z (N),
@@ -35,6 +38,9 @@
 //      kDentValues values and C·R depths: body k, version (changes with the dent), columns C, rows R, x0, y0, dx, dy
 //      (m, the box's body frame: point (c, r) at (x0 + c·dx, y0 + r·dy) on the top face), then the depths below the
 //      face (m), row-major (r·C + c)
+//      then, if [13] is 1, the tool, kToolValues values: valid (1/0: a grip pose this frame), the grip's pose
+//      (x, y, z, qw, qx, qy, qz; grip → world), the proxy's pose (the tool as rendered, held out of the objects), the
+//      force on the grip x, y, z (N), the torque on the grip about its centre x, y, z (N·m)
 //    World frame right-handed, z up, SI units.
 //
 // 3. Page → viewer (replay only; ignored live), text messages of one JSON object:
@@ -62,6 +68,7 @@ inline constexpr std::size_t kBodyValues = 7;
 inline constexpr std::size_t kEndpointValues = 12;
 inline constexpr std::size_t kPlaneValues = 6;
 inline constexpr std::size_t kDentValues = 8;
+inline constexpr std::size_t kToolValues = 21;
 inline constexpr std::size_t kMaxClientMessageBytes = 4096;
 // A mesh of 10^5 triangles is a scene message of about 3 MB, sent to each page as it connects; a finer one (a terrain)
 // is coarsened to that many rather than hold up a page for seconds.

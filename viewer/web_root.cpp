@@ -53,6 +53,7 @@ std::optional<fs::path> WebRoot::file_for(std::string_view target) const {
   if (target == "/" || target == "/index.html") return dir_ / "index.html";
   if (target == "/viewer.js") return dir_ / "viewer.js";
   if (target == "/touch.js") return dir_ / "touch.js";
+  if (target == "/tool.js") return dir_ / "tool.js";
   if (target == "/touch_worker.js") return dir_ / "touch_worker.js";
   for (const std::string_view prefix : {std::string_view("/three/build/"), std::string_view("/three/examples/jsm/")}) {
     if (target.substr(0, prefix.size()) != prefix) continue;

@@ -42,7 +42,11 @@ class CsvLine {
                                      buffer_.data());
     return *this;
   }
-  CsvLine& numbers(const Vec3& v) { return number(v[0]).number(v[1]).number(v[2]); }
+  template <std::size_t N>
+  CsvLine& numbers(const std::array<double, N>& values) {
+    for (double value : values) number(value);
+    return *this;
+  }
   template <class Vector3>
   CsvLine& vector(const Vector3& v) {
     return number(v[0]).number(v[1]).number(v[2]);

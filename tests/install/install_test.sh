@@ -60,7 +60,7 @@ viewer_serves() {
     sleep 0.05
   done
   [ -n "$url" ] || { cat "$scratch/viewer.out" >&2; echo "install_test: the installed viewer did not start" >&2; exit 1; }
-  for target in "" viewer.js touch.js touch_worker.js three/build/three.module.js three/build/three.core.js \
+  for target in "" viewer.js touch.js tool.js touch_worker.js three/build/three.module.js three/build/three.core.js \
                 three/examples/jsm/controls/OrbitControls.js; do
     # What this checks is that the installed files are served (the viewer's own tests time it): on a machine busy
     # with the rest of the suite, a connection refused or reset is retried twice before it counts, and a failure

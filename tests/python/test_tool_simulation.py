@@ -98,7 +98,7 @@ class Logs(unittest.TestCase):
         with tempfile.TemporaryDirectory() as scratch:
             out = pathlib.Path(scratch) / "run"
             with impetus.ToolSimulation(PEG, start_m=START, out_dir=out) as sim:
-                sim.step(targets=line(START, [0.04, 0, 0.07], 300))
+                step = sim.step(targets=line(START, [0.04, 0, 0.07], 300))
                 summary = sim.close()
             self.assertEqual(json.loads((out / "summary.json").read_text()), summary)
             self.assertEqual(summary["config"]["scene"], str(PEG))
@@ -108,6 +108,15 @@ class Logs(unittest.TestCase):
             world = impetus.read_log(out / "world.csv")
             self.assertEqual(len(world["time_s"]), 6 + 2)  # a row a world step: 300 ticks at 20 Hz, and close()'s two
             self.assertIn("cube.x_m", world)
+            # The tool's own log: the grip's and the proxy's poses and the wrench, a row a tick, as the steps had them.
+            tool = impetus.read_log(out / "haptic.tool.csv")
+            self.assertEqual(len(tool["tick"]), 300)
+            grip = np.column_stack([tool[f"grip_{c}"] for c in ("x_m", "y_m", "z_m", "qw", "qx", "qy", "qz")])
+            np.testing.assert_array_equal(grip, np.hstack([step.grip_m, step.grip_wxyz]))
+            proxy = np.column_stack([tool[f"proxy_{c}"] for c in ("x_m", "y_m", "z_m", "qw", "qx", "qy", "qz")])
+            np.testing.assert_array_equal(proxy, np.hstack([step.proxy_m, step.proxy_wxyz]))
+            torque = np.column_stack([tool[f"torque_{c}_Nm"] for c in "xyz"])
+            np.testing.assert_array_equal(torque, step.torque_Nm)
 
 
 class Example(unittest.TestCase):

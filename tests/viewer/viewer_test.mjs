@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The viewer in a real browser (headless Chromium driven by Playwright), against the project's own binaries.
-//   node tests/viewer/viewer_test.mjs --build BUILD_DIR --case live|replay|bodies|kill|bad-input|clay|meshes|terrain
+//   node tests/viewer/viewer_test.mjs --build BUILD_DIR
+//     --case live|replay|bodies|kill|bad-input|clay|meshes|terrain|tool
 //     [--picture FILE]
 // --picture (replay only): also saves the page at the tap's hardest push as FILE (the README's picture;
 // scripts/make_figures.sh).
@@ -484,5 +485,68 @@ async function terrain(procs, browser) {
   check(drawn.rejectedMessages === 0 && drawn.rejectedFrames === 0, "no message rejected by the page");
 }
 
-const cases = { live, replay, bodies, kill, "bad-input": badInput, clay, meshes, terrain };
+// A tool in the hand replayed (impetus.ToolSimulation's out_dir): the page draws the tool's shape, solid at the
+// proxy's pose and as a ghost at the grip's, turned as its log has it, and the torque on the grip.
+async function tool(procs, browser) {
+  const { spawnSync } = await import("node:child_process");
+  const trial = path.join(outDir, "trial");
+  // The peg down its hole, then turned 0.3 rad about y with the hand: the walls hold it, so the grip and the proxy
+  // turn by different angles and the hand feels a torque.
+  const script = `
+import impetus, math, sys
+half = 0.15
+with impetus.ToolSimulation(impetus.shipped_scene("peg_in_hole"), start_m=[0, 0, 0.1], out_dir=sys.argv[1]) as sim:
+    sim.step(targets=[[0, 0, 0.1 - 0.04 * k / 399] for k in range(400)])
+    sim.step(targets=[[0, 0, 0.06, math.cos(half), 0, math.sin(half), 0]] * 300)
+`;
+  const result = spawnSync("/usr/bin/python3", ["-c", script, trial],
+    { env: { ...process.env, PYTHONPATH: path.join(build, "python") }, encoding: "utf8" });
+  if (result.status !== 0) throw new Failure(`the tool run failed: ${result.stderr}`);
+  const log = readCsv(path.join(trial, "haptic.tool.csv"));
+  const viewer = await procs.viewer(["--replay", trial]);
+  const page = await openPage(browser, viewer.url);
+  const scene = await waitFor("the replay's scene", async () => (await view(page))?.scene);
+  check(scene.tool?.shape === "box" && scene.tool.size_m.join() === "0.01,0.01,0.04",
+    `the scene message carries the tool: a ${scene.tool?.shape} of ${scene.tool?.size_m?.join(" × ")} m`);
+  check(Math.abs(scene.tool.placement.position_m[2] + 0.03) < 1e-12, "placed 3 cm below the grip, as the scene has it");
+  await page.evaluate(() => window.impetusView.send({ speed: 10 }));
+  const end = scene.replay.end_s;
+  const last = await waitFor("the end of the replay", async () => {
+    const state = await view(page);
+    return state?.latest && Math.abs(state.latest.worldTime_s - end) < 1e-9 ? state.latest : null;
+  }, 30000, 100);
+  const shown = last.tool;
+  check(shown?.valid && shown.drawn, "the tool is drawn at the end of the replay");
+  // The frame shows a row of the tool's log: its proxy and grip poses together, as logged.
+  const pose = (row, name) => ["x_m", "y_m", "z_m", "qw", "qx", "qy", "qz"].map((c) => row[log.column(`${name}_${c}`)]);
+  const same = (a, b) => a.every((v, i) => Math.abs(v - b[i]) < 1e-12);
+  const proxy = [...shown.proxy.position_m, ...shown.proxy.orientation_wxyz];
+  const grip = [...shown.grip.position_m, ...shown.grip.orientation_wxyz];
+  const row = log.rows.find((r) => same(pose(r, "proxy"), proxy) && same(pose(r, "grip"), grip));
+  check(row !== undefined,
+    `the page's proxy and grip poses are one row of haptic.tool.csv (tick ${row?.[log.column("tick")]})`);
+  const turn = (q) => 2 * Math.asin(Math.min(1, Math.abs(q[2])));
+  const gripTurn = turn(shown.grip.orientation_wxyz);
+  const proxyTurn = turn(shown.proxy.orientation_wxyz);
+  check(gripTurn > proxyTurn + 0.002, `the grip turned ${gripTurn.toFixed(3)} rad about y, the proxy held by the ` +
+    `walls to ${proxyTurn.toFixed(3)} rad`);
+  check(shown.torque_Nm[1] < -0.01, "the torque on the grip pushes the turn back: " +
+    `${shown.torque_Nm[1].toFixed(3)} N·m about y`);
+  // Drawn where the frame puts it: the tool's pixels move when the replay seeks back to the peg above the hole.
+  await page.evaluate(() => window.impetusView.lookAt([0, 0, 0.06], 0.05));
+  await sleep(300);
+  const at = (url) => decodePng(Buffer.from(url.slice(url.indexOf(",") + 1), "base64"));
+  const deep = at(await page.evaluate(() => window.impetusView.capture()));
+  await page.screenshot({ path: path.join(outDir, "tool.png") });
+  await page.evaluate((t) => window.impetusView.send({ seek: t }), scene.replay.start_s);
+  const start = scene.replay.start_s;
+  await waitFor("a seek back to the start", async () => (await view(page))?.latest?.worldTime_s === start);
+  const high = at(await page.evaluate(() => window.impetusView.capture()));
+  const changed = changedPixels(deep, high);
+  check(changed > 500, `${changed} pixels change between the peg in its hole and above it`);
+  check((await view(page)).rejectedFrames === 0, "no frame rejected by the page");
+  await procs.stop(viewer);
+}
+
+const cases = { live, replay, bodies, kill, "bad-input": badInput, clay, meshes, terrain, tool };
 await runCase("viewer_test", cases, which, build, outDir, shm);

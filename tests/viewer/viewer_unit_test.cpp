@@ -486,6 +486,62 @@ TEST_CASE("a replay reads a trial's scene and logs (every finger's), a malformed
 
 namespace impetus {
 
+TEST_CASE("a tool's replay carries its shape, and its grip's and proxy's poses from the tool log, into the messages") {
+  const fs::path dir = scratch("replay_tool");
+  std::ofstream(dir / "summary.json") << R"({"config": {"scene": ")" << IMPETUS_SOURCE_DIR
+                                      << R"(/scenes/peg_in_hole.json", "coupling": "local", "world_rate_hz": 20}})";
+  std::ofstream(dir / "world.csv") << "time_s,cube.x_m,cube.y_m,cube.z_m,cube.qw,cube.qx,cube.qy,cube.qz\n"
+                                   << "0.05,0.08,0,0.015,1,0,0,0\n0.1,0.08,0,0.015,1,0,0,0\n";
+  std::ofstream(dir / "haptic.csv")
+      << "time_s,finger_x_m,finger_y_m,finger_z_m,proxy_x_m,proxy_y_m,proxy_z_m,force_x_N,force_y_N,force_z_N\n"
+      << "0.0,0,0,0.1,0,0,0.1,0,0,0\n0.09,0,0,0.06,0,0,0.061,0,0,2\n";
+  // Without the tool's log the grip is shown as a finger's, and no tool.
+  CHECK(view::Replay(dir.string()).tool() == nullptr);
+
+  const std::string header =
+      "time_s,tick,grip_x_m,grip_y_m,grip_z_m,grip_qw,grip_qx,grip_qy,grip_qz,proxy_x_m,proxy_y_m,proxy_z_m,proxy_qw,"
+      "proxy_qx,proxy_qy,proxy_qz,force_x_N,force_y_N,force_z_N,torque_x_Nm,torque_y_Nm,torque_z_Nm,active_contacts,"
+      "flags\n";
+  std::ofstream(dir / "haptic.tool.csv") << header << "0.0,0,0,0,0.1,1,0,0,0,0,0,0.1,1,0,0,0,0,0,0,0,0,0,0,1\n"
+                                         << "0.09,90,0,0,0.06,0.8,0,0.6,0,0,0,0.061,1,0,0,0,0,0,2,0,-0.2,0,4,1\n";
+  const view::Replay replay(dir.string());
+  REQUIRE(replay.tool() != nullptr);
+  CHECK(replay.tool()->shape.kind == ShapeKind::box);
+  CHECK(replay.tool()->placement.position_m.z() == Approx(-0.03));
+  const view::ViewToolFrame& late = *replay.tool_frame(1);  // the row at or before 0.1 s
+  CHECK(late.valid);
+  CHECK(late.grip.orientation_wxyz[2] == 0.6);
+  CHECK(late.proxy.position_m[2] == 0.061);
+  CHECK(late.torque_Nm[1] == -0.2);
+
+  const std::string scene = view::scene_message(replay.scene(), dir.string(), std::nullopt, replay.tool());
+  const nlohmann::json tool = nlohmann::json::parse(scene).at("tool");
+  CHECK(tool.at("shape") == "box");
+  CHECK(tool.at("size_m")[2] == 0.04);
+  CHECK(tool.at("placement").at("position_m")[2] == Approx(-0.03));
+  CHECK(tool.at("placement").at("orientation_wxyz")[0] == 1.0);
+
+  auto snapshot = std::make_unique<WorldSnapshot>();
+  replay.snapshot(1, *snapshot);
+  std::string message;
+  view::encode_frame(*snapshot, true, 1.0, message, &late);
+  const std::vector<double> v = values_of(message);
+  const std::size_t before = view::kFrameHeaderValues + snapshot->body_count * view::kBodyValues +
+                             view::kEndpointValues;  // the tool follows the one endpoint (no planes, no dent)
+  REQUIRE(v.size() == before + view::kToolValues);
+  CHECK(v[13] == 1.0);
+  CHECK(v[before] == 1.0);            // valid
+  CHECK(v[before + 1 + 5] == 0.6);    // the grip's qy
+  CHECK(v[before + 8 + 2] == 0.061);  // the proxy's z
+  CHECK(v[before + 18 + 1] == -0.2);  // the torque's y
+
+  // A tool log without a column is named; a row without a pose (flags bit 0 clear) shows no tool.
+  std::ofstream(dir / "haptic.tool.csv") << "time_s,tick,grip_x_m\n0.0,0,0\n";
+  CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("haptic.tool.csv") && Catch::Contains("grip_y_m"));
+  std::ofstream(dir / "haptic.tool.csv") << header << "0.0,0,0,0,0.1,1,0,0,0,0,0,0.1,1,0,0,0,0,0,0,0,0,0,0,0\n";
+  CHECK_FALSE(view::Replay(dir.string()).tool_frame(1)->valid);
+}
+
 TEST_CASE("a replay page plays, pauses, seeks and changes speed on its own clock, bad controls are refused") {
   const fs::path dir = scratch("replay_feed");
   std::ofstream(dir / "summary.json") << R"({"config": {"scene": ")" << IMPETUS_SOURCE_DIR

@@ -21,6 +21,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { createTouch } from './touch.js';
+import { createTool, TOOL_VALUES } from './tool.js';
 
 // ---- Protocol (viewer/view_protocol.h) ------------------------------------------------------------------------------
 
@@ -45,6 +46,7 @@ const H_HAPTIC_SKIPPED = 9;
 const H_PLAYING = 10;
 const H_SPEED = 11;
 const H_DENT = 12;
+const H_TOOL = 13;
 
 // Endpoint offsets, from the endpoint's first value.
 const E_ID = 0;
@@ -165,6 +167,9 @@ const sceneRoot = new THREE.Group();
 world.add(sceneRoot);
 const endpointRoot = new THREE.Group();
 world.add(endpointRoot);
+const toolRoot = new THREE.Group();
+world.add(toolRoot);
+const toolVisual = createTool({ root: toolRoot, geometryOf: (shape) => solidGeometry(shape, 2), shapeOf });
 
 // A small frame at the world origin (x red, y green, z blue); buildFloor scales it with the grid.
 const axes = new THREE.AxesHelper(0.01);
@@ -628,6 +633,7 @@ function buildScene(message) {
   prev = null;
   latest = null;
   resetEndpoints();
+  toolVisual.build(message.tool);
   rebuildBodySelect(bodies);
   forceChart.reset(chartCapacity(message));
   positionChart.reset(chartCapacity(message));
@@ -749,8 +755,14 @@ function parseFrame(buffer) {
     dent = { offset, body, version, columns, rows };
     offset += DENT_VALUES + columns * rows;
   }
+  let tool = -1;
+  if (d[H_TOOL] === 1) {
+    if (!scene.tool) return null;
+    tool = offset;
+    offset += TOOL_VALUES;
+  }
   if (offset !== d.length) return null;
-  return { data: d, recv: performance.now(), endpoints, dent };
+  return { data: d, recv: performance.now(), endpoints, dent, tool };
 }
 
 // Until the user moves the camera, it follows the bodies: when a dynamic body leaves the view (a tapped cube sliding
@@ -866,6 +878,7 @@ function describeFrame(frame) {
       force_N: [d[o + E_FORCE], d[o + E_FORCE + 1], d[o + E_FORCE + 2]],
       planeCount: d[o + E_PLANE_COUNT],
     })),
+    tool: toolVisual.describe(d, frame.tool),
   };
 }
 
@@ -1479,6 +1492,7 @@ function placeAll(now) {
   const alpha = interpolationAlpha(now);
   drawBodies(alpha);
   drawEndpoints(alpha);
+  toolVisual.draw(latest.data, latest.tool, prev ? prev.data : null, prev ? prev.tool : -1, alpha);
 }
 
 function animate() {
