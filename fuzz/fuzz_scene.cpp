@@ -94,6 +94,9 @@ void check_scene(const impetus::Scene& scene) {
     FUZZ_CHECK(c.max_force_N > 0.0 && c.max_torque_Nm > 0.0);
     FUZZ_CHECK(scene.tool->shape.shape.kind != impetus::ShapeKind::mesh);
     FUZZ_CHECK(scene.tool->shape.placement.position_m.allFinite());
+    // A weight the device can hold (scene.cpp parse_tool).
+    FUZZ_CHECK(scene.tool->shape.mass_kg >= 0.0 && scene.tool->shape.weight_N.allFinite());
+    FUZZ_CHECK(scene.tool->shape.weight_N.norm() <= c.max_force_N);
     FUZZ_CHECK(std::isfinite(scene.tool->reach_m) && scene.tool->reach_m > 0.0);
     FUZZ_CHECK(haptic.reach_radius_m >= scene.tool->reach_m);
     FUZZ_CHECK(haptic.reach_radius_m <= impetus::SceneLimits::kMaxReachRadius_m);

@@ -323,11 +323,11 @@ SceneObject parse_object(const Node& node, const std::string& scene_dir) {
 
 // The keys a tool may have; its shape's own come from the shape module.
 constexpr std::string_view kToolKeys[] = {
-    "shape", "position_m", "orientation_wxyz", "stiffness_Npm", "damping_Nspm", "rotational_stiffness_Nmprad",
-    "rotational_damping_Nmsprad", "max_force_N", "max_torque_Nm"};
+    "shape", "position_m", "orientation_wxyz", "mass_kg", "density_kgpm3", "stiffness_Npm", "damping_Nspm",
+    "rotational_stiffness_Nmprad", "rotational_damping_Nmsprad", "max_force_N", "max_torque_Nm"};
 
 // A "tool" block (docs/scene-format.md): the shape in the grip's frame and the coupling, each value in its range.
-SceneTool parse_tool(const Node& node) {
+SceneTool parse_tool(const Node& node, const Vec3& gravity_mps2) {
   node.expect_object();
   const ShapeKind kind = parse_shape_kind(node.required("shape"));
   node.expect_keys({std::span<const std::string_view>(kToolKeys), shape_keys(kind)});
@@ -365,6 +365,33 @@ SceneTool parse_tool(const Node& node) {
   }
   if (node.has("max_torque_Nm")) {
     coupling.max_torque_Nm = node.child("max_torque_Nm").positive_up_to(SceneLimits::kMaxToolTorque_Nm, " N·m");
+  }
+  // Its mass (none given: weightless), and its weight under the scene's gravity. A device that cannot hold the weight
+  // up, or its moment about the grip, could not render the tool: refused rather than clamped on every tick.
+  if (node.has("mass_kg") && node.has("density_kgpm3")) {
+    node.child("density_kgpm3").fail("give either mass_kg or density_kgpm3, not both");
+  }
+  if (node.has("mass_kg")) {
+    tool.shape.mass_kg = node.child("mass_kg").in_range(0.0, SceneLimits::kMaxToolMass_kg, " kg");
+  } else if (node.has("density_kgpm3")) {
+    tool.shape.mass_kg = node.child("density_kgpm3").positive() * volume_m3(tool.shape.shape);
+    if (!(tool.shape.mass_kg <= SceneLimits::kMaxToolMass_kg)) {
+      node.child("density_kgpm3").fail("density × volume = " + readable(tool.shape.mass_kg) + " kg; a tool's mass " +
+                                       "must be at most " + readable(SceneLimits::kMaxToolMass_kg) + " kg");
+    }
+  }
+  tool.shape.weight_N = tool.shape.mass_kg * Eigen::Vector3d(gravity_mps2[0], gravity_mps2[1], gravity_mps2[2]);
+  const char* const mass_key = node.has("mass_kg") ? "mass_kg" : "density_kgpm3";
+  const double weight_N = tool.shape.weight_N.norm();
+  if (weight_N > coupling.max_force_N) {
+    node.child(mass_key).fail("the tool weighs " + readable(weight_N) + " N, more than max_force_N (" +
+                              readable(coupling.max_force_N) + " N): the device could not hold it up");
+  }
+  const double weight_torque_Nm = tool.shape.placement.position_m.norm() * weight_N;  // at most, turned any way
+  if (weight_torque_Nm > coupling.max_torque_Nm) {
+    node.child(mass_key).fail("the tool's weight turns the grip by up to " + readable(weight_torque_Nm) + " N·m " +
+                              "about its centre, more than max_torque_Nm (" + readable(coupling.max_torque_Nm) +
+                              " N·m): the device could not hold it level");
   }
   // The farthest the tool reaches from the grip's centre: its placement plus its bounding box's farthest corner.
   const Eigen::AlignedBox3d bounds = world_bounds(tool.shape.shape, BodyPose{});
@@ -415,7 +442,7 @@ Scene parse_scene(const nlohmann::json& document, const std::string& source_name
   if (root.has("physics")) scene.physics = parse_physics(root.child("physics"));
   if (root.has("haptic")) scene.haptic = parse_haptic(root.child("haptic"));
   if (root.has("tool")) {
-    scene.tool = parse_tool(root.child("tool"));
+    scene.tool = parse_tool(root.child("tool"), scene.gravity_mps2);
     // The world sends the planes of objects within the reach radius of the tool's grip: it must cover the tool, with
     // a finger's neighbourhood around its farthest point. Given, it is checked; not given, it is widened.
     const bool reach_given = root.has("haptic") && root.child("haptic").has("reach_radius_m");

@@ -60,6 +60,7 @@ struct SceneLimits {
   static constexpr double kMaxRotationalDamping_Nmsprad = limits::kMaxDamping_Nspm * 0.01;
   static constexpr double kMaxToolForce_N = 1e3;
   static constexpr double kMaxToolTorque_Nm = 100.0;
+  static constexpr double kMaxToolMass_kg = 10.0;  // a sledgehammer is 5 kg
   // A world step costs O(objects) in ODE's broadphase and our feature grid; 10^4 static spheres step in ~35 ms on
   // this class of machine (within a 20 Hz period) and 10^5 in tens of seconds (docs/reliability.md).
   static constexpr std::size_t kMaxObjects = 10'000;

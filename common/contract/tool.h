@@ -8,10 +8,14 @@
 
 namespace impetus {
 
-// The tool's shape placed in the grip's frame (its centre of mass and axes there), rigidly held by the endpoint.
+// The tool's shape placed in the grip's frame (its centre of mass and axes there), rigidly held by the endpoint, and
+// its weight.
 struct ToolShape {
   Shape shape;
   BodyPose placement;  // shape frame → grip frame (default: the grip's own)
+  double mass_kg = 0.0;  // 0: weightless (the hand and the objects carry nothing of it)
+  // The tool's mass times the scene's gravity, world frame, acting at the shape's centre (placement.position_m).
+  Eigen::Vector3d weight_N = Eigen::Vector3d::Zero();
 };
 
 // The 6-DoF spring–damper between the tool's proxy and the grip, and the device's limits on the wrench it renders.

@@ -37,7 +37,12 @@ Vector6d displacement(const BodyPose& proxy, const BodyPose& grip) {
 
 }  // namespace
 
-ToolProxy::ToolProxy(const ToolShape& tool, const ToolCoupling& coupling) : contacts_(tool), coupling_(coupling) {
+ToolProxy::ToolProxy(const ToolShape& tool, const ToolCoupling& coupling)
+    : contacts_(tool), coupling_(coupling), weight_N_(tool.weight_N), centre_of_mass_m_(tool.placement.position_m) {
+  if (!(tool.mass_kg >= 0.0) || !std::isfinite(tool.mass_kg)) {
+    throw std::invalid_argument("tool: mass_kg must be >= 0 and finite");
+  }
+  if (!tool.weight_N.allFinite()) throw std::invalid_argument("tool: weight_N must be finite");
   const ToolCoupling& c = coupling;
   require(std::isfinite(c.stiffness_Npm) && c.stiffness_Npm > 0.0, "stiffness_Npm", "must be > 0");
   require(std::isfinite(c.rotational_stiffness_Nmprad) && c.rotational_stiffness_Nmprad > 0.0,
@@ -91,12 +96,15 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
   grip_angular_velocity_radps_ = turn_between(grip_.orientation, grip.orientation) / dt_s;
   grip_ = grip;
 
-  // Nothing in the way: the proxy is the grip, and there is no wrench (a tool that leaves a surface lets go at once).
-  if (contacts_.path_clear(planes, proxy_, grip)) {
-    proxy_ = grip;
+  const BodyPose goal = goal_of(grip);
+  // Nothing in the way: the proxy is at its goal, and the wrench is the weight alone (a tool that leaves a surface
+  // lets go at once).
+  if (contacts_.path_clear(planes, proxy_, goal)) {
+    proxy_ = goal;
     previous_displacement_.setZero();
     held_count_ = 0;
     zero_output();
+    set_wrench(grip);  // finite: the weight is
     return result_;
   }
   const BodyPose proxy_before = proxy_;
@@ -110,7 +118,7 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
   double travelled_m = 0.0, turned_rad = 0.0;
   Vector6d last_move = Vector6d::Zero();
   for (int p = 0; p < kMaxToolPasses; ++p) {
-    const Vector6d target = -displacement(proxy_, grip);
+    const Vector6d target = -displacement(proxy_, goal);
     const BodyPose before = proxy_;
     Vector6d q;
     if (p > 0) {
@@ -130,27 +138,47 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
     if (failed_ || result_.active == 0 || moved_m <= kToolSettled_m) break;
   }
   release_held(last_move);
-  const Vector6d e = displacement(proxy_, grip);
+  const Vector6d e = displacement(proxy_, goal);
   damp(e, dt_s);
   previous_displacement_ = e;
-
-  // The wrench on the grip is the contacts' pushes, carried by the massless proxy: their sum, and their moments about
-  // the grip's centre at the points where the objects receive them (the tool's and the object's points of a contact
-  // differ only along its normal, so the world's torque and the hand's cancel exactly).
-  Eigen::Vector3d force_N = Eigen::Vector3d::Zero();
-  Eigen::Vector3d torque_Nm = Eigen::Vector3d::Zero();
-  for (int k = 0; k < force_count_; ++k) {
-    const ToolContactForce& f = forces_[static_cast<std::size_t>(k)];
-    force_N += f.force_N * f.normal;
-    torque_Nm += (f.tool_point_m - grip.position_m).cross(f.force_N * f.normal);
-  }
-  if (!force_N.allFinite() || !torque_Nm.allFinite() || !finite(proxy_)) {
+  if (!set_wrench(grip)) {
     ++counters_.faults;
     proxy_ = proxy_before;
     zero_output();
     result_.fault = true;
     return result_;
   }
+  share_reaction(planes, grip, dt_s);
+  return result_;
+}
+
+BodyPose ToolProxy::goal_of(const BodyPose& grip) const {
+  if (weight_N_.isZero()) return grip;
+  // The sag K⁻¹·W, the weight's torque taken about the grip's centre at the grip's orientation (the sag's own turn
+  // changes it by k_r⁻¹ times less: 10⁻³ rad for a 50 g tool at 3 cm).
+  const Eigen::Vector3d torque_Nm = (grip.orientation * centre_of_mass_m_).cross(weight_N_);
+  return {grip.position_m + weight_N_ / coupling_.stiffness_Npm,
+          turned(grip.orientation, torque_Nm / coupling_.rotational_stiffness_Nmprad)};
+}
+
+bool ToolProxy::set_wrench(const BodyPose& grip) {
+  // The contacts' pushes, carried by the massless proxy: their sum, and their moments about the grip's centre at the
+  // points where the objects receive them (the tool's and the object's points of a contact differ only along its
+  // normal, so the world's torque and the hand's cancel exactly). The weight acts at the proxy's centre of mass.
+  Eigen::Vector3d force_N = weight_N_;
+  Eigen::Vector3d weight_torque_Nm = Eigen::Vector3d::Zero();
+  if (!weight_N_.isZero()) {
+    const Eigen::Vector3d centre_m = proxy_.position_m + proxy_.orientation * centre_of_mass_m_;
+    weight_torque_Nm = (centre_m - grip.position_m).cross(weight_N_);
+  }
+  Eigen::Vector3d torque_Nm = weight_torque_Nm;
+  for (int k = 0; k < force_count_; ++k) {
+    const ToolContactForce& f = forces_[static_cast<std::size_t>(k)];
+    force_N += f.force_N * f.normal;
+    torque_Nm += (f.tool_point_m - grip.position_m).cross(f.force_N * f.normal);
+  }
+  if (!force_N.allFinite() || !torque_Nm.allFinite() || !finite(proxy_)) return false;
+  // The limits scale the whole wrench, the weight with the pushes, so the objects receive the scaled pushes.
   double scale = 1.0;
   if (force_N.norm() > coupling_.max_force_N) scale = coupling_.max_force_N / force_N.norm();
   if (scale * torque_Nm.norm() > coupling_.max_torque_Nm) scale = coupling_.max_torque_Nm / torque_Nm.norm();
@@ -160,10 +188,11 @@ const ToolResult& ToolProxy::solve(const PlaneSet& planes, const BodyPose& grip_
   }
   result_.force_N = scale * force_N;
   result_.torque_Nm = scale * torque_Nm;
+  result_.weight_force_N = scale * weight_N_;
+  result_.weight_torque_Nm = scale * weight_torque_Nm;
   result_.scale = scale;
   result_.proxy = proxy_;
-  share_reaction(planes, grip, dt_s);
-  return result_;
+  return true;
 }
 
 void ToolProxy::damp(const Vector6d& displacement_now, double dt_s) {

@@ -20,6 +20,13 @@
 // The wrench on the grip is Σ μ_i·a_i (its torque carried to the grip's centre), exactly the sum of the contacts'
 // pushes, so what the world receives equals what the hand feels.
 //
+// A tool with weight w (ToolShape::weight_N, acting at its centre of mass c) adds the potential −wᵀq to the proxy's
+// energy: the proxy's rest pose with nothing in the way is the grip moved by the sag K⁻¹·W, W = [w; (c − x_p) × w],
+// and every step above runs toward that goal pose instead of the grip. The contacts then carry the spring's wrench
+// less the weight (a tool resting on a table presses it with its weight, and the hand feels none of it), and the hand
+// feels the contacts' pushes plus the weight (a tool held in the air weighs w in the hand). The weight is a constant
+// force, whose work is a potential: it adds no energy to the loop.
+//
 // Stability (docs/tool.md): a massless proxy held by rigid unilateral constraints is passive, and the sampled
 // coupling then needs the device's physical damping above K·T/2 per DoF (Colgate & Schenkel; Adams & Hannaford's
 // virtual coupling): b > k·T/2 and b_r > k_r·T/2. The virtual damper B adds the damping a hand's grip lacks in turning.
@@ -48,6 +55,9 @@ struct ToolResult {
   BodyPose proxy;  // the proxy's grip pose
   Eigen::Vector3d force_N = Eigen::Vector3d::Zero();    // on the grip, after the limits
   Eigen::Vector3d torque_Nm = Eigen::Vector3d::Zero();  // on the grip about its centre, after the limits
+  // Of them, the tool's weight (after the limits' scale): the part the objects do not receive.
+  Eigen::Vector3d weight_force_N = Eigen::Vector3d::Zero();
+  Eigen::Vector3d weight_torque_Nm = Eigen::Vector3d::Zero();
   double scale = 1.0;        // the limits' scale of the wrench (1: within them)
   int constraints = 0;       // contacts the last pass considered
   int active = 0;            // of them, pushing (λ > 0)
@@ -83,8 +93,8 @@ struct ToolCounters {
 
 class ToolProxy {
  public:
-  // Throws std::invalid_argument for an unusable tool shape (ToolContacts) or coupling (stiffnesses > 0, dampings and
-  // limits ≥ 0 / > 0, all finite), naming the field.
+  // Throws std::invalid_argument for an unusable tool shape (ToolContacts), weight (finite, mass ≥ 0) or coupling
+  // (stiffnesses > 0, dampings and limits ≥ 0 / > 0, all finite), naming the field.
   ToolProxy(const ToolShape& tool, const ToolCoupling& coupling);
 
   // Puts the proxy on the grip, with no history (the device attached, a session restart).
@@ -137,9 +147,16 @@ class ToolProxy {
   void damp(const Vector6d& displacement_now, double dt_s);
   void share_reaction(const PlaneSet& planes, const BodyPose& grip, double dt_s);
   void zero_output();
+  // Where the proxy rests with nothing in the way: the grip moved by the weight's sag (the header).
+  BodyPose goal_of(const BodyPose& grip) const;
+  // The wrench on the grip: the contacts' pushes (forces_) and the weight at the proxy's centre of mass, scaled to
+  // the limits; the result's proxy, wrench and scale. False for a non-finite one (nothing set).
+  bool set_wrench(const BodyPose& grip);
 
   ToolContacts contacts_;
   ToolCoupling coupling_;
+  Eigen::Vector3d weight_N_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centre_of_mass_m_ = Eigen::Vector3d::Zero();  // in the grip's frame
   BodyPose proxy_;
   BodyPose grip_;  // at the last solve
   bool started_ = false;

@@ -95,11 +95,12 @@ std::pair<Vector3d, Vector3d> reaction_about(const ToolProxy& proxy, const Plane
   return {impulse_Ns, angular_Nms};
 }
 
-// The objects got the reaction of the last solve: −(F, τ)·Δt, the torque about the grip's centre.
+// The objects got the reaction of the last solve: −(F, τ)·Δt less the tool's weight, the torque about the grip's
+// centre.
 void check_reaction(const ToolProxy& proxy, const PlaneSet& planes, const BodyPose& grip, const ToolResult& result) {
   const auto [impulse_Ns, angular_Nms] = reaction_about(proxy, planes, grip.position_m);
-  CHECK((impulse_Ns + result.force_N * kTick_s).norm() < 1e-15);
-  CHECK((angular_Nms + result.torque_Nm * kTick_s).norm() < 1e-15);
+  CHECK((impulse_Ns + (result.force_N - result.weight_force_N) * kTick_s).norm() < 1e-15);
+  CHECK((angular_Nms + (result.torque_Nm - result.weight_torque_Nm) * kTick_s).norm() < 1e-15);
 }
 
 }  // namespace
@@ -190,6 +191,60 @@ TEST_CASE("tool: a cube pressed flat into the floor stays on it, pushes k times 
   CHECK(result.force_N.head<2>().norm() < 1e-9);
   CHECK(result.torque_Nm.norm() < 1e-9);
   CHECK(overlap_m(cube_tool(), result.proxy, planes) < 1e-9);
+}
+
+TEST_CASE("tool: a tool's weight hangs in the hand in the air, and resting on the floor presses the floor instead") {
+  // A 2 cm cube of 0.1 kg held 3 cm to the side of the grip: its weight pulls the hand down and turns it about −y.
+  ToolShape tool = cube_tool();
+  tool.placement.position_m = Vector3d(0.03, 0.0, 0.0);
+  tool.mass_kg = 0.1;
+  tool.weight_N = Vector3d(0.0, 0.0, -0.981);
+  const ToolCoupling coupling;
+  ToolProxy proxy(tool, coupling);
+  const PlaneSet planes = set_of({floor_plane()});
+
+  // In the air: the wrench is the weight and its moment, exactly; the proxy sags by K⁻¹ times them.
+  const BodyPose high = pose_at(Vector3d(0.0, 0.0, 0.1));
+  ToolResult result;
+  for (int tick = 0; tick < 10; ++tick) result = proxy.solve(planes, high, kTick_s);
+  CHECK(result.force_N == tool.weight_N);
+  CHECK(result.weight_force_N == tool.weight_N);
+  CHECK(result.torque_Nm.y() == Approx(0.03 * 0.981).epsilon(1e-3));  // x × (−z) = +y: the far end drops
+  CHECK(result.torque_Nm == result.weight_torque_Nm);
+  CHECK(result.proxy.position_m.z() == Approx(0.1 - 0.981 / coupling.stiffness_Npm).epsilon(1e-12));
+  CHECK(turn_between(high.orientation, result.proxy.orientation).y() ==
+        Approx(0.03 * 0.981 / coupling.rotational_stiffness_Nmprad).epsilon(1e-9));
+  CHECK(proxy.share_count() == 0);
+
+  // Lowered onto the floor and left there, the grip where the cube's face meets it: the floor carries the weight and
+  // its moment, and the hand feels nothing.
+  for (int tick = 1; tick <= 200; ++tick) {
+    const BodyPose grip = pose_at(Vector3d(0.0, 0.0, std::max(0.01, 0.1 - 1e-3 * tick)));
+    result = proxy.solve(planes, grip, kTick_s);
+    check_reaction(proxy, planes, grip, result);
+  }
+  const BodyPose resting = pose_at(Vector3d(0.0, 0.0, 0.01));
+  CHECK(result.force_N.norm() < 1e-9);
+  CHECK(result.torque_Nm.norm() < 1e-9);
+  const auto [impulse_Ns, angular_Nms] = reaction_about(proxy, planes, resting.position_m);
+  CHECK((impulse_Ns - tool.weight_N * kTick_s).norm() < 1e-12);
+  CHECK((angular_Nms - Vector3d(0.0, 0.03 * 0.981, 0.0) * kTick_s).norm() < 1e-12);
+  CHECK(result.proxy.position_m.z() == Approx(0.01).margin(1e-9));
+
+  // Pressed 1 mm further: the hand feels the spring (less than k·1 mm: pushed 3 cm off the grip's centre, the cube
+  // rocks onto its far edge, as a weightless one does), the floor the spring and the weight.
+  for (int tick = 0; tick < 50; ++tick) result = proxy.solve(planes, pose_at(Vector3d(0.0, 0.0, 0.009)), kTick_s);
+  CHECK(result.force_N.z() > 1.5);
+  check_reaction(proxy, planes, pose_at(Vector3d(0.0, 0.0, 0.009)), result);
+  CHECK(reaction_about(proxy, planes, Vector3d::Zero()).first.z() ==
+        Approx(-(result.force_N.z() + 0.981) * kTick_s).epsilon(1e-12));
+
+  // A negative mass or a non-finite weight is refused.
+  tool.mass_kg = -1.0;
+  CHECK_THROWS_WITH(ToolProxy(tool, coupling), Catch::Contains("mass_kg"));
+  tool.mass_kg = 0.1;
+  tool.weight_N.x() = std::nan("");
+  CHECK_THROWS_WITH(ToolProxy(tool, coupling), Catch::Contains("weight_N"));
 }
 
 // A cube pressed d into a face and turned by θ about a horizontal axis: it rocks onto an edge once the turn's torque

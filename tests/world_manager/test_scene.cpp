@@ -442,4 +442,28 @@ TEST_CASE("a tool block is parsed, its reach widens the world's, and bad values 
   require_error(document, "/haptic/reach_radius_m", "must cover the tool");
   document["tool"] = ball;
   CHECK(impetus::parse_scene(document, "ok.json").haptic.reach_radius_m == 0.05);  // given and enough: kept
+
+  // Its mass, or density × volume, weighs it under the scene's gravity; none given: weightless.
+  CHECK(impetus::parse_scene(with_tool(ball), "ok.json").tool->shape.weight_N.isZero());
+  json heavy = ball;
+  heavy["mass_kg"] = 0.2;
+  json moon = with_tool(heavy);
+  moon["gravity_mps2"] = {0, 0, -1.62};
+  const impetus::SceneTool weighed = *impetus::parse_scene(moon, "ok.json").tool;
+  CHECK(weighed.shape.mass_kg == 0.2);
+  CHECK(weighed.shape.weight_N.z() == Approx(-0.324));
+  heavy = ball;
+  heavy["density_kgpm3"] = 1000.0;
+  CHECK(impetus::parse_scene(with_tool(heavy), "ok.json").tool->shape.mass_kg ==
+        Approx(1000.0 * 4.0 / 3.0 * M_PI * 1e-6));
+  heavy["mass_kg"] = 0.1;
+  require_error(with_tool(heavy), "/tool/density_kgpm3", "not both");
+  heavy = ball;
+  heavy["mass_kg"] = 2.0;  // 19.6 N, over the default 10 N
+  require_error(with_tool(heavy), "/tool/mass_kg", "could not hold it up");
+  heavy["mass_kg"] = 0.5;
+  heavy["position_m"] = {0.2, 0, 0};  // 0.98 N·m at most, over the default 0.5 N·m
+  require_error(with_tool(heavy), "/tool/mass_kg", "could not hold it level");
+  heavy["mass_kg"] = -0.1;
+  require_error(with_tool(heavy), "/tool/mass_kg", "");
 }
