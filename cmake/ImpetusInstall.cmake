@@ -33,7 +33,8 @@ foreach(dir common world_manager haptic_controller spidar_sim loop)
 endforeach()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${IMPETUS_INSTALL_DATADIR}/scenes
         FILES_MATCHING PATTERN "*.json" PATTERN "*.obj" PATTERN "*.stl")  # scenes and the meshes they name
-install(FILES ${PROJECT_SOURCE_DIR}/common/spidar/desktop_spidar.json DESTINATION ${IMPETUS_INSTALL_DATADIR})
+install(FILES ${PROJECT_SOURCE_DIR}/common/spidar/desktop_spidar.json
+              ${PROJECT_SOURCE_DIR}/common/spidar/desktop_grip.json DESTINATION ${IMPETUS_INSTALL_DATADIR})
 install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/THIRD_PARTY.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR})
 

@@ -73,7 +73,9 @@ HapticNode::HapticNode(const HapticNodeOptions& options, WorldLinkClient& world,
   if (options.tool.has_value() != device.oriented() || (options.tool && fingers != 1)) {
     throw std::invalid_argument(options.tool ? "a tool needs a device with one oriented grip (--device grip), not a "
                                                "device of fingers"
-                                             : "an oriented device holds a tool: give the node the scene's tool");
+                                             : "an oriented device (grip) holds a tool: give the node the scene's "
+                                               "tool (the daemons cannot take one yet; the in-process tool loop, "
+                                               "Python's impetus.ToolSimulation, renders it: docs/tool.md)");
   }
   const ServoOptions servo = servo_options(options, device.limits());
   for (EndpointId k = 0; k < fingers; ++k) {

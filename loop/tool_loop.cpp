@@ -4,7 +4,8 @@
 #include "common/link/inproc/inproc_device_port.h"
 #include "common/link/inproc/inproc_world_link.h"
 #include "common/runtime/lockstep_schedule.h"
-#include "haptic_controller/device/grip_port_driver.h"
+#include "common/spidar/grip_geometry.h"
+#include "haptic_controller/device/device_registry.h"
 #include "haptic_controller/haptic_node.h"
 #include "haptic_controller/tool/tool_servo.h"
 #include "loop/in_process_rig.h"
@@ -52,6 +53,23 @@ const SceneTool& tool_of(const Scene& scene) {
 
 bool finite(const GripPose& pose) { return pose.position_m.allFinite() && pose.orientation.coeffs().allFinite(); }
 
+// The grip device's geometry, for its simulated end; std::invalid_argument naming the option for a spec that is not a
+// grip device or a file that does not describe one.
+SpidarGripGeometry grip_geometry(const std::string& spec) {
+  try {
+    return parse_grip_spec(spec).geometry;
+  } catch (const SpidarGeometryError& error) {
+    throw std::invalid_argument(std::string("device: ") + error.what());
+  }
+}
+
+// Its host end, built by the registry as a daemon builds its device; it must be oriented (it holds a tool).
+std::unique_ptr<HapticDevice> grip_driver(const std::string& spec, DevicePortHost& port) {
+  std::unique_ptr<HapticDevice> driver = parse_device(spec)->make_finger(port, ClockMode::lockstep, 1);
+  if (!driver->oriented()) throw std::invalid_argument("device: '" + spec + "' does not hold a tool (use grip)");
+  return driver;
+}
+
 }  // namespace
 
 // The nodes of the daemons, in one process (as loop/in_process_rig.h wires a finger's): the world node and the haptic
@@ -65,10 +83,10 @@ struct ToolLoop::Parts {
                                                                           limits::kDefaultHapticRate_Hz)}),
         client(attach(link, world)),
         port(kTick_s),
-        device(options.device, options.hand, options.start),
+        device(grip_geometry(options.device), options.hand, options.start),
         device_node(device, port, 1),
-        driver(options.device, port, ClockMode::lockstep, 1),
-        haptic(haptic_options(tool_of(world.world().scene()), options), client, driver),
+        driver(grip_driver(options.device, port)),
+        haptic(haptic_options(tool_of(world.world().scene()), options), client, *driver),
         coupling(options.coupling) {
     port.connect(device_node);
   }
@@ -111,7 +129,7 @@ struct ToolLoop::Parts {
   InProcessDevicePort port;
   GripSim device;
   GripNode device_node;
-  GripPortDriver driver;
+  std::unique_ptr<HapticDevice> driver;  // the grip's driver (grip_port_driver.h)
   HapticNode haptic;
   Coupling coupling;
 };
@@ -125,7 +143,8 @@ ToolLoop::ToolLoop(const ToolLoopOptions& options) {
     throw std::invalid_argument("scene: give a scene file or its text");
   }
   if (!finite(options.start)) throw std::invalid_argument("start: the grip's start pose must be finite");
-  if (const std::string problem = grip_point_problem(options.start.position_m, options.device); !problem.empty()) {
+  const SpidarGripGeometry geometry = grip_geometry(options.device);
+  if (const std::string problem = grip_point_problem(options.start.position_m, geometry); !problem.empty()) {
     throw std::invalid_argument("start: " + problem);
   }
   check_world_rate(options.world_rate_hz);
@@ -232,16 +251,13 @@ const nlohmann::json& ToolLoop::finish() {
     };
   }
   const ToolCounters& proxy = servo.proxy().counters();
-  const GripDriverCounters& driver = p.driver.driver().counters();
   summary_ = {
       {"ticks", ticks_},
       {"coupling", to_string(p.coupling)},
       {"world_rate_hz", 1.0 / world.world_period_s()},
       {"tool", {{"faults", servo.faults()}, {"clamps", proxy.clamps}, {"pinches", proxy.pinches},
                 {"unconverged", proxy.unconverged}}},
-      {"device", {{"readings", driver.readings}, {"bad_readings", driver.bad_readings},
-                  {"saturations", driver.saturations}, {"no_closure", driver.no_closure},
-                  {"most_iterations", driver.most_iterations}}},
+      {"device", p.driver->details()},
       {"ledger", ledger},
   };
   summary_.update(p.world.summary());

@@ -46,7 +46,9 @@ struct ToolLoopOptions {
   Coupling coupling = Coupling::local;
   std::optional<double> world_rate_hz;  // overrides the scene's; a haptic tick must divide its period
   GripHandParams hand;                  // the hand that holds the grip (common/hand/grip_hand.h)
-  SpidarGripGeometry device;            // the 8-string frame (common/spidar/grip_geometry.h)
+  // The device holding the grip, as the registry names it (haptic_controller/device/device_registry.h): "grip" (the
+  // built-in 8-string frame, common/spidar/grip_geometry.h) or "grip:FILE.json".
+  std::string device = "grip";
   GripPose start;                       // where the grip starts, at rest, and the target holds until moved
   // A directory (which must exist) for the nodes' logs, world.csv and haptic.csv (the grip's centre as the finger,
   // the proxy's as the proxy), as a trial writes them: `viewer --replay` plays them back with the summary.json written

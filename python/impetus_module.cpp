@@ -353,9 +353,11 @@ void pose_into(const impetus::GripPose& pose, double* position, double* wxyz) {
 class ToolClosedLoop {
  public:
   ToolClosedLoop(const std::string& scene, const std::string& scene_text, const std::string& coupling,
-                 std::optional<double> world_rate_hz, const std::array<double, 7>& start, const std::string& out_dir) {
+                 std::optional<double> world_rate_hz, const std::array<double, 7>& start, const std::string& out_dir,
+                 const std::string& device) {
     impetus::ToolLoopOptions options;
     options.out_dir = out_dir;
+    options.device = device;
     options.scene_path = scene;
     options.scene_text = scene_text;
     options.coupling = parse_coupling(coupling);
@@ -531,9 +533,9 @@ PYBIND11_MODULE(_impetus, module) {
       .def_property_readonly("warnings", &ClosedLoop::warnings);
   py::class_<ToolClosedLoop>(module, "ToolClosedLoop")
       .def(py::init<const std::string&, const std::string&, const std::string&, std::optional<double>,
-                    const std::array<double, 7>&, const std::string&>(),
+                    const std::array<double, 7>&, const std::string&, const std::string&>(),
            py::arg("scene"), py::arg("scene_text"), py::arg("coupling"), py::arg("world_rate_hz"), py::arg("start"),
-           py::arg("out_dir"))
+           py::arg("out_dir"), py::arg("device"))
       .def("step", &ToolClosedLoop::step, py::arg("ticks"), py::arg("targets"))
       .def("set_target", &ToolClosedLoop::set_target, py::arg("target"))
       .def("objects", &ToolClosedLoop::objects)

@@ -12,6 +12,7 @@
 
 #include "common/contract/frames.h"
 #include "common/contract/vec3.h"
+#include "common/spidar/device_file.h"
 
 #include <array>
 #include <cstdint>
@@ -46,11 +47,7 @@ struct SpidarGeometry {
 
 // A device description file (JSON, e.g. common/spidar/desktop_spidar.json): the fields of SpidarGeometry, each
 // optional (a missing one keeps its default above). Unknown keys and unusable values are errors naming the file and
-// the key. Throws SpidarGeometryError.
-class SpidarGeometryError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+// the key. Throws SpidarGeometryError (device_file.h).
 SpidarGeometry load_spidar_geometry(const std::string& path);
 
 // `spidar` (the built-in geometry above) or `spidar:FILE.json` (--device on haptic_controller and spidar_sim).

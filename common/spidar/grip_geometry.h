@@ -17,11 +17,14 @@
 // closure; tests/haptic_controller/test_grip.cpp checks both).
 
 #include "common/contract/vec3.h"
+#include "common/spidar/device_file.h"
 
 #include <Eigen/Core>
 
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <string>
 
 namespace impetus {
 
@@ -53,5 +56,20 @@ struct SpidarGripGeometry {
     return Eigen::Vector3d((k & 1) ? 1.0 : -1.0, (k & 2) ? 1.0 : -1.0, (k & 4) ? 1.0 : -1.0);
   }
 };
+
+// A grip device description file (JSON, e.g. common/spidar/desktop_grip.json): the fields of SpidarGripGeometry, each
+// optional (a missing one keeps its default above). Unknown keys and unusable values are errors naming the file and
+// the key (device_file.h). Throws SpidarGeometryError.
+SpidarGripGeometry load_grip_geometry(const std::string& path);
+
+// `grip` (the built-in geometry above) or `grip:FILE.json` (the device registry's "grip", Python's ToolSimulation).
+struct GripDevice {
+  SpidarGripGeometry geometry;
+  std::string source = "built-in";  // the file it came from, for messages
+};
+GripDevice parse_grip_spec(const std::string& spec);
+
+// A hash of the values (not the file's text): two descriptions with equal values are the same device.
+std::uint64_t grip_geometry_hash(const SpidarGripGeometry& geometry);
 
 }  // namespace impetus

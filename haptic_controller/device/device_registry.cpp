@@ -3,7 +3,9 @@
 
 #include "common/runtime/message_text.h"
 #include "common/spidar/geometry.h"
+#include "common/spidar/grip_geometry.h"
 #include "common/link/shm/shm_touch_port.h"
+#include "haptic_controller/device/grip_port_driver.h"
 #include "haptic_controller/device/spidar_driver.h"
 #include "haptic_controller/device/web_hand.h"
 
@@ -31,6 +33,28 @@ class SpidarType final : public DeviceType {
 
 std::unique_ptr<DeviceType> parse_spidar(const std::string& argument) {
   return std::make_unique<SpidarType>(parse_device_spec(argument.empty() ? "spidar" : "spidar:" + argument));
+}
+
+// The grip SPIDAR: eight strings from the corners of a cube hold a grip, whose pose they read and on which they render
+// force and torque (common/spidar/grip_geometry.h); one oriented finger, for a tool in the hand (docs/tool.md). Its
+// argument is a grip device file, the built-in geometry without one.
+class GripType final : public DeviceType {
+ public:
+  explicit GripType(GripDevice grip)
+      : grip_(std::move(grip)), description_{grip_geometry_hash(grip_.geometry), grip_.source} {}
+  const DeviceDescription& description() const override { return description_; }
+  std::unique_ptr<HapticDevice> make_finger(DevicePortHost& port, ClockMode clock,
+                                            std::uint64_t haptic_session) const override {
+    return std::make_unique<GripPortDriver>(grip_.geometry, port, clock, haptic_session);
+  }
+
+ private:
+  GripDevice grip_;
+  DeviceDescription description_;
+};
+
+std::unique_ptr<DeviceType> parse_grip(const std::string& argument) {
+  return std::make_unique<GripType>(parse_grip_spec(argument.empty() ? "grip" : "grip:" + argument));
 }
 
 // The web hand: a simulated hand steered from the viewer's page (web_hand.h); its argument is a hand file
@@ -63,6 +87,7 @@ std::unique_ptr<DeviceType> parse_web(const std::string& argument) {
 
 constexpr DeviceEntry kDevices[] = {
     {"spidar", "FILE.json", parse_spidar},
+    {"grip", "FILE.json", parse_grip},
     {"web", "FILE.json", parse_web},
 };
 

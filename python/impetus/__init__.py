@@ -577,14 +577,17 @@ class ToolSimulation(_Closable):
     start_m      where the grip starts, at rest (x, y, z, metres); start_wxyz its orientation (default level)
     coupling     "local" (default) or "impulse"; position coupling samples one point and is refused
     rate_hz      the world's rate (default: the scene's); a 1 ms tick must divide its period
-    out_dir      a directory for world.csv and haptic.csv (the grip's centre as the finger, the proxy's as the proxy)
-                 and, at close, summary.json: `viewer --replay OUT_DIR` plays the run back; None: no logs
+    out_dir      a directory for world.csv, haptic.csv (the grip's centre as the finger, the proxy's as the proxy)
+                 and haptic.tool.csv (the grip's and the proxy's poses, force and torque), and at close summary.json:
+                 `viewer --replay OUT_DIR` plays the run back, the tool drawn; None: no logs
+    device       the 8-string grip SPIDAR: "grip" (the built-in frame) or "grip:FILE.json" (a device file in the
+                 form of common/spidar/desktop_grip.json, docs/devices.md)
 
     The world steps every n ticks (n = 1000 / world rate), at ticks 0, n, 2n, ...
     """
 
     def __init__(self, scene, start_m, coupling="local", *, start_wxyz=(1.0, 0.0, 0.0, 0.0), rate_hz=None,
-                 out_dir=None):
+                 out_dir=None, device="grip"):
         import numpy as np
         self._np = np
         self._loop = None
@@ -598,9 +601,11 @@ class ToolSimulation(_Closable):
         self.out_dir = pathlib.Path(out_dir) if out_dir is not None else None
         if self.out_dir is not None:
             self.out_dir.mkdir(parents=True, exist_ok=True)
+        if not isinstance(device, str):
+            raise TypeError(f"device: must be 'grip' or 'grip:FILE.json', not {type(device).__name__}")
         self._scene_name = scene_path if not scene_text else "(dict)"
         self._loop = _impetus.ToolClosedLoop(scene_path, scene_text, coupling, _real("rate_hz", rate_hz, True), start,
-                                             str(self.out_dir) if self.out_dir is not None else "")
+                                             str(self.out_dir) if self.out_dir is not None else "", device)
         self.object_names = tuple(self._loop.object_names)
         self.tick_period_s = self._loop.tick_period_s
 

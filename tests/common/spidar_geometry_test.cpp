@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// The SPIDAR description file (common/spidar/geometry.h): the shipped file is the built-in device, bad files are
-// errors naming the file and key, and the hash tells devices apart.
+// The SPIDAR description files (common/spidar/geometry.h, grip_geometry.h): the shipped files are the built-in
+// devices, bad files are errors naming the file and key, and the hash tells devices apart.
 
 #include "common/spidar/geometry.h"
+#include "common/spidar/grip_geometry.h"
 
 #include <catch2/catch.hpp>
 
@@ -99,4 +100,47 @@ TEST_CASE("devices that differ in any value hash differently") {
   CHECK(geometry_hash(wider) != geometry_hash(base));
   CHECK(geometry_hash(moved) != geometry_hash(base));
   CHECK(geometry_hash(stronger) != geometry_hash(base));
+}
+
+TEST_CASE("a grip device file: the shipped one is the built-in grip, bad ones name the file and key") {
+  const GripDevice shipped =
+      parse_grip_spec("grip:" + std::string(IMPETUS_SOURCE_DIR) + "/common/spidar/desktop_grip.json");
+  CHECK(grip_geometry_hash(shipped.geometry) == grip_geometry_hash(SpidarGripGeometry{}));
+  CHECK(parse_grip_spec("grip").source == "built-in");
+  const std::string wider = write_file("grip_wider", R"({"frame_side_m": 0.6, "grip_radius_m": 0.03})");
+  const GripDevice read = parse_grip_spec("grip:" + wider);
+  CHECK(read.geometry.frame_side_m == 0.6);
+  CHECK(read.geometry.grip_radius_m == 0.03);
+  CHECK(read.geometry.tension_min_N == SpidarGripGeometry{}.tension_min_N);  // a missing key keeps its default
+  CHECK(read.source == wider);
+  CHECK(grip_geometry_hash(read.geometry) != grip_geometry_hash(SpidarGripGeometry{}));
+
+  const auto error_of_grip = [](const std::string& path) -> std::string {
+    try {
+      load_grip_geometry(path);
+    } catch (const SpidarGeometryError& error) {
+      return error.what();
+    }
+    return "";
+  };
+  struct Case {
+    std::string name, text, key, expected;
+  };
+  const Case cases[] = {
+      {"grip_typo", R"({"grip_radius": 0.02})", "grip_radius", "unknown key"},
+      {"grip_wide", R"({"grip_radius_m": 0.2})", "grip_radius_m", "at most 0.1"},  // a quarter of the 0.4 m frame
+      {"grip_inverted", R"({"tension_min_N": 5, "tension_max_N": 2})", "tension_max_N", "must exceed"},
+      {"grip_centre", R"({"centre_m": [0, "x", 0]})", "centre_m", "three numbers"},
+      {"grip_count", R"({"metres_per_count": -1})", "metres_per_count", "-1"},
+  };
+  for (const Case& test_case : cases) {
+    INFO(test_case.name);
+    const std::string path = write_file(test_case.name, test_case.text);
+    CHECK_THAT(error_of_grip(path), Catch::Contains(path) && Catch::Contains(test_case.key) &&
+                                        Catch::Contains(test_case.expected));
+    std::remove(path.c_str());
+  }
+  CHECK_THAT(error_of_grip("/nonexistent/grip.json"), Catch::Contains("/nonexistent/grip.json"));
+  CHECK_THROWS_WITH(parse_grip_spec("spidar"), Catch::Contains("'grip' or 'grip:FILE.json'"));
+  std::remove(wider.c_str());
 }

@@ -14,7 +14,8 @@ prefix="$scratch/prefix"
 cmake --install "$build" --prefix "$prefix" > "$scratch/install.log"
 for file in bin/impetus-world-manager bin/impetus-haptic-controller bin/impetus-spidar-sim lib/cmake/Impetus/ImpetusConfig.cmake lib/cmake/Impetus/ImpetusConfigVersion.cmake \
             lib/pkgconfig/impetus.pc include/impetus/loop/in_process_trial.h share/impetus/scenes/tap.json \
-            share/impetus/desktop_spidar.json bin/impetus-viewer share/impetus/viewer/web/index.html \
+            share/impetus/desktop_spidar.json share/impetus/desktop_grip.json bin/impetus-viewer \
+            share/impetus/viewer/web/index.html \
             share/impetus/viewer/web/node_modules/three/build/three.module.js; do
   [ -e "$prefix/$file" ] || { echo "install_test: $prefix/$file was not installed" >&2; exit 1; }
 done

@@ -136,6 +136,31 @@ class Example(unittest.TestCase):
         self.assertEqual(summary["device"]["bad_readings"], 0)
 
 
+class DeviceFile(unittest.TestCase):
+    def test_a_grip_device_file_is_the_frame_the_tool_is_held_in(self):
+        # The shipped file is the built-in frame: the same run, bit for bit. A wider frame with a finer count reads
+        # the grip as well, and still renders the floor's push through its own strings.
+        import tempfile
+        shipped = pathlib.Path(__file__).resolve().parents[2] / "common" / "spidar" / "desktop_grip.json"
+        runs = []
+        for device in ("grip", f"grip:{shipped}"):
+            with impetus.ToolSimulation(PEG, start_m=START, device=device) as sim:
+                runs.append(sim.step(targets=line(START, [0, 0, 0.045], 600)))
+        np.testing.assert_array_equal(runs[0].force_N, runs[1].force_N)
+        np.testing.assert_array_equal(runs[0].grip_m, runs[1].grip_m)
+        with tempfile.TemporaryDirectory() as scratch:
+            wide = pathlib.Path(scratch) / "wide_grip.json"
+            wide.write_text(json.dumps({"frame_side_m": 0.6, "metres_per_count": 5e-6}))
+            with impetus.ToolSimulation(PEG, start_m=START, device=f"grip:{wide}") as sim:
+                step = sim.step(targets=line(START, [0, 0, 0.045], 600))
+                step = sim.step(300)
+                summary = sim.close()
+        self.assertLess(np.abs(step.grip_m - step.hand_m).max(), 5e-6)  # within a count of the finer encoders
+        self.assertGreater(step.force_N[-1][2], 0.5)                     # the hole's floor pushes back
+        np.testing.assert_allclose(step.strings_force_N[-1], step.force_N[-2], atol=2e-3)
+        self.assertEqual(summary["device"]["bad_readings"], 0)
+
+
 class BadInput(unittest.TestCase):
     def test_named(self):
         cases = [
@@ -145,6 +170,9 @@ class BadInput(unittest.TestCase):
             (lambda: impetus.ToolSimulation(PEG, start_m=[0, 0, 0.9]), "start"),
             (lambda: impetus.ToolSimulation(PEG, start_m=START, start_wxyz=[1, 1, 0, 0]), "start_wxyz"),
             (lambda: impetus.ToolSimulation(PEG, start_m=START, rate_hz=30), "whole number of 1 ms ticks"),
+            (lambda: impetus.ToolSimulation(PEG, start_m=START, device="spidar"), "'grip' or 'grip:FILE.json'"),
+            (lambda: impetus.ToolSimulation(PEG, start_m=START, device="grip:/nonexistent/grip.json"),
+             "/nonexistent/grip.json"),
         ]
         for make, words in cases:
             with self.subTest(words=words):
