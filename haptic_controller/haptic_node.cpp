@@ -74,8 +74,7 @@ HapticNode::HapticNode(const HapticNodeOptions& options, WorldLinkClient& world,
     throw std::invalid_argument(options.tool ? "a tool needs a device with one oriented grip (--device grip), not a "
                                                "device of fingers"
                                              : "an oriented device (grip) holds a tool: give the node the scene's "
-                                               "tool (the daemons cannot take one yet; the in-process tool loop, "
-                                               "Python's impetus.ToolSimulation, renders it: docs/tool.md)");
+                                               "tool (haptic_controller --tool-from SCENE; docs/tool.md)");
   }
   const ServoOptions servo = servo_options(options, device.limits());
   for (EndpointId k = 0; k < fingers; ++k) {

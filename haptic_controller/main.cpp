@@ -5,6 +5,7 @@
 #include "common/link/dds/open_world_link.h"
 #include "common/mesh/mesh_object.h"
 #include "common/runtime/cli.h"
+#include "common/tool/tool_block.h"
 #include "haptic_controller/device/device_registry.h"
 #include "haptic_controller/device/hosted_device.h"
 #include "haptic_controller/haptic_node.h"
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   std::string world_shm;  // "": the same as --shm
   unsigned fingers = 1;
   std::string mesh_scene;
+  std::string tool_scene;
   LinkOptions link_options;
   CLI::App app{"haptic_controller: the 1 kHz haptic servo of Impetus. Interpolates the world's planes, renders the "
                "god-object force on the SPIDAR and integrates it into impulses for the world."};
@@ -56,12 +58,26 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-realtime-priority", options.realtime_priority, "no SCHED_FIFO and mlockall in real time");
   app.add_option("--meshes-from", mesh_scene, "the world's scene: its meshes are read, so the servo follows their "
                  "triangles between frames (else a mesh's planes are used as sent)");
+  app.add_option("--tool-from", tool_scene, "the world's scene: its \"tool\" block is the tool in the hand, held by "
+                 "an oriented device (--device grip; docs/tool.md)");
   if (const std::optional<int> status = parse_flags(app, "haptic_controller", argc, argv)) return *status;
 
   return run_node("haptic_controller", [&] {
     options.haptic_session = new_session_id();
     const std::unique_ptr<DeviceType> device_type = parse_device(device_spec);
-    if (!mesh_scene.empty()) load_scene_meshes(mesh_scene);
+    if (!mesh_scene.empty()) {
+      load_scene_meshes(mesh_scene);
+      if (tool_scene.empty() && load_scene_tool(mesh_scene)) {
+        std::fprintf(stderr, "haptic_controller: warning: %s has a tool (its \"tool\" block), and this controller "
+                     "renders point fingers: --device grip --tool-from SCENE renders the tool\n", mesh_scene.c_str());
+      }
+    }
+    if (!tool_scene.empty()) {
+      const std::optional<ToolBlock> tool = load_scene_tool(tool_scene);
+      if (!tool) throw std::invalid_argument("--tool-from " + tool_scene + ": the scene has no \"tool\" block");
+      options.tool = tool->shape;
+      options.tool_coupling = tool->coupling;
+    }
     if (link_options.kind == LinkKind::dds && !world_shm.empty()) {
       throw std::invalid_argument("--world-shm names a shared-memory world link; with --link dds the world is found "
                                   "by --dds-domain and --dds-partition");
@@ -86,10 +102,10 @@ int main(int argc, char** argv) {
     nlohmann::json summary = node.summary();
     if (nlohmann::json link = link_summary(*world, link_options); !link.is_null()) summary["haptic"]["dds"] = link;
     write_summary(summary_path, summary);
-    const ServoCounters& counters = node.servo().counters();
+    // The first endpoint's figures, a finger's or a tool's (its summary's top level).
+    const nlohmann::json& haptic = summary["haptic"];
     std::fprintf(stderr, "haptic_controller: %llu ticks, %llu faults, %llu force clamps, %llu saturations\n",
-                 static_cast<unsigned long long>(counters.ticks), static_cast<unsigned long long>(counters.faults),
-                 static_cast<unsigned long long>(counters.force_clamps),
+                 haptic.value("ticks", 0ull), haptic.value("faults", 0ull), haptic.value("force_clamps", 0ull),
                  static_cast<unsigned long long>(device->device().counters().saturations));
     if (node.duration_reached() && device_type->uses_device_ports()) {
       std::fprintf(stderr, "haptic_controller: warning: the trial stopped at --duration %g s, before the device's "

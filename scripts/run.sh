@@ -4,7 +4,7 @@
 # DIR, prints the outcome and writes DIR/summary.json. Exits non-zero if any process failed. Ctrl-C stops all three.
 #
 #   scripts/run.sh --scene FILE (--trajectory SPEC | --finger NAME=SPEC ... | --device web[:FILE.json])
-#                  [--device spidar:FILE.json]
+#                  [--device spidar:FILE.json | --device grip[:FILE.json]]
 #                  [--user SPEC ...] [--coupling impulse|position|local] [--passivity on|off]
 #                  [--rate HZ] [--phase TICKS] [--substeps N] [--engine ode|bullet]
 #                  [--clock realtime|lockstep] [--duration S] [--out DIR] [--quiet] [--no-logs]
@@ -20,6 +20,9 @@
 # `build/viewer/viewer --replay DIR` plays the trial back.
 #
 # --device spidar:FILE.json: the SPIDAR's geometry from a device file, for the haptic controller and spidar_sim alike.
+# --device grip: the scene's tool (its "tool" block) in the hand, held on the 8-string grip SPIDAR (docs/tool.md);
+# the trajectory may turn the grip (a CSV of t,x,y,z,qw,qx,qy,qz, e.g. scenes/peg_in_hole.csv); the tool's poses and
+# torque go to haptic.tool.csv.
 # --device web: a person steers the finger from the viewer's page instead of a trajectory (a simulated hand in the
 # haptic controller, no spidar_sim): real time, the viewer on, and the trial runs until Ctrl-C (or --duration). It
 # prints the address to open; FILE.json sets the hand (docs/touch.md).
@@ -68,12 +71,18 @@ while (($#)); do
 done
 [ -n "$scene" ] || die "--scene is required"
 [ -f "$scene" ] || die "--scene: no such file '$scene'"
-web=0
+web=0 grip=0
 case "$device" in
   web|web:*) web=1 ;;
+  grip|grip:?*) grip=1 ;;
   spidar|spidar:?*) ;;
-  *) die "--device must be spidar, spidar:FILE.json, web or web:FILE.json, not '$device'" ;;
+  *) die "--device must be spidar, spidar:FILE.json, grip, grip:FILE.json, web or web:FILE.json, not '$device'" ;;
 esac
+if ((grip)); then
+  ((${#fingers[@]} == 0 && ${#users[@]} == 0)) || die "--device grip holds one tool: give no --finger or --user"
+  [ "$coupling" != position ] || die "--device grip: position coupling samples one point, and a tool touches at \
+many; use local or impulse"
+fi
 if ((web)); then
   [ -z "$trajectory" ] && ((${#fingers[@]} == 0 && ${#users[@]} == 0)) || \
     die "--device web: the page steers the finger; give no --trajectory, --finger or --user"
@@ -120,6 +129,8 @@ add_log world_args world
 haptic_args=(--clock "$clock" --shm "$shm" --summary "$out/haptic.json" --meshes-from "$scene" "${haptic_extra[@]}")
 [ -n "$duration" ] && haptic_args+=(--duration "$duration")
 haptic_args+=(--device "$device")
+# The tool the grip holds is the scene's.
+((grip)) && haptic_args+=(--tool-from "$scene")
 add_log haptic_args haptic
 device_args=(--clock "$clock" --shm "$shm" --summary "$out/device.json" --device "$device")
 add_log device_args device

@@ -2,6 +2,7 @@
 #include "spidar_sim/device_node.h"
 
 #include "common/runtime/lockstep.h"
+#include "spidar_sim/grip_device_sim.h"
 #include "common/runtime/process.h"
 #include "common/runtime/realtime_clock.h"
 
@@ -21,20 +22,22 @@ constexpr std::size_t kLogRows = 2048;
 
 }  // namespace
 
-DeviceNode::DeviceNode(DeviceSim& sim, DevicePortClient& port, const std::string& log_path,
-                       std::uint64_t device_session)
+template <class Sim>
+DeviceNodeOf<Sim>::DeviceNodeOf(Sim& sim, DevicePortClient& port, const std::string& log_path,
+                                std::uint64_t device_session)
     : sim_(sim), port_(port), session_(device_session) {
   if (!log_path.empty()) {
-    log_.emplace(log_path, DeviceSim::log_header(), DeviceSim::format_log_row, kLogRows,
+    log_.emplace(log_path, Sim::log_header(), Sim::format_log_row, kLogRows,
                  port.clock() == ClockMode::lockstep ? LogOverflow::wait : LogOverflow::drop, "spidar_sim");
   }
 }
 
-void DeviceNode::tick(double dt_s) {
+template <class Sim>
+void DeviceNodeOf<Sim>::tick(double dt_s) {
   // Minimum tensions until a command arrives, and while the last one is stale (command_watchdog.h): what a haptic
   // side that sends nothing means (the strings stay taut).
-  std::array<double, kStringCount> tensions{};
-  tensions.fill(sim_.hardware().geometry().tension_min_N);
+  std::array<double, Sim::kStrings> tensions{};
+  tensions.fill(sim_.tension_min_N());
   DeviceCommand command;
   const bool received = port_.latest_command(command);
   if (received && (command.flags & kCommandWorldPresent) != 0) world_seen_ = true;
@@ -47,7 +50,7 @@ void DeviceNode::tick(double dt_s) {
     }
   }
   if (watchdog_.applies(received ? &command : nullptr, sim_.time_s())) {
-    tensions = first_strings<kStringCount>(command.tension_N);
+    tensions = first_strings<Sim::kStrings>(command.tension_N);
   }
   DeviceState state = sim_.tick(tensions, dt_s);
   state.device_session = session_;
@@ -56,7 +59,8 @@ void DeviceNode::tick(double dt_s) {
   ++ticks_;
 }
 
-bool DeviceNode::step_device() {
+template <class Sim>
+bool DeviceNodeOf<Sim>::step_device() {
   if (sim_.finished()) {
     // The last turn carries no new state: the host sees the detach and frees the slot.
     port_.detach();
@@ -69,19 +73,21 @@ bool DeviceNode::step_device() {
   return true;
 }
 
-void DeviceNode::publish_stats(const RealtimeClock* clock) {
+template <class Sim>
+void DeviceNodeOf<Sim>::publish_stats(const RealtimeClock* clock) {
   LoopStats stats = loop_stats_now(clock);
   stats.ticks = ticks_;
   stats.rejected_frames = port_.rejected_commands();
   port_.publish_stats(stats);
 }
 
-int DeviceNode::run() {
+template <class Sim>
+int DeviceNodeOf<Sim>::run() {
   if (port_.clock() == ClockMode::lockstep) {
     // While the haptic controller has the turn, this thread writes the log's rows.
     const LockstepIdleWork idle(
         [](void* node) {
-          auto& log = static_cast<DeviceNode*>(node)->log_;
+          auto& log = static_cast<DeviceNodeOf*>(node)->log_;
           return log && log->drain_one();
         },
         this);
@@ -130,7 +136,7 @@ int DeviceNode::run() {
       if (timing.index % kCheckEveryTicks == 0) host_alive = port_.host_alive();
       const bool was_holding = holding_for_world_;
       // After a host stall the finger is advanced by the real elapsed time, capped so one tick stays a tick.
-      tick(std::min(timing.elapsed_s, DeviceSim::kMaxTick_s));
+      tick(std::min(timing.elapsed_s, Sim::kMaxTick_s));
       if (was_holding && !holding_for_world_) {
         if (world_seen_) {
           std::fprintf(stderr, "spidar_sim: the haptic controller renders a world; playing the trajectory (held "
@@ -150,27 +156,21 @@ int DeviceNode::run() {
   return cut_short_ || (log_ && log_->failed()) ? 1 : 0;
 }
 
-nlohmann::json DeviceNode::summary() const {
-  const FingerParams& finger = sim_.finger().params();
-  const SpidarGeometry& geometry = sim_.hardware().geometry();
-  return {{"device",
-           {{"ticks", ticks_},
-            {"time_s", sim_.time_s()},
-            {"rejected_commands", port_.rejected_commands()},
-            {"stale_command_ticks", watchdog_.stale_ticks()},
-            {"held_for_world_s", held_s_},
-            {"world_seen", world_seen_},
-            {"channel_repairs", port_.channel_repairs()},
-            {"finger_mass_kg", finger.mass_kg},
-            {"hand_stiffness_Npm", finger.hand_stiffness_Npm},
-            {"hand_damping_Nspm", finger.hand_damping_Nspm},
-            {"motor_time_constant_s", sim_.hardware().params().motor_time_constant_s},
-            {"frame_side_m", geometry.frame_side_m},
-            {"metres_per_count", geometry.metres_per_count},
-            {"tension_min_N", geometry.tension_min_N},
-            {"tension_max_N", geometry.tension_max_N},
-            {"max_force_N", geometry.max_force_N}}}};
+template <class Sim>
+nlohmann::json DeviceNodeOf<Sim>::summary() const {
+  nlohmann::json device = {{"ticks", ticks_},
+                           {"time_s", sim_.time_s()},
+                           {"rejected_commands", port_.rejected_commands()},
+                           {"stale_command_ticks", watchdog_.stale_ticks()},
+                           {"held_for_world_s", held_s_},
+                           {"world_seen", world_seen_},
+                           {"channel_repairs", port_.channel_repairs()}};
+  device.update(sim_.summary_fields());
+  return {{"device", device}};
 }
+
+template class DeviceNodeOf<DeviceSim>;
+template class DeviceNodeOf<GripDeviceSim>;
 
 nlohmann::json fingers_summary(std::span<const std::unique_ptr<DeviceNode>> nodes,
                                std::span<const NamedFinger> fingers) {

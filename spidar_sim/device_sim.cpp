@@ -130,6 +130,20 @@ Eigen::Vector3d DeviceSim::steered_point(int k, int substeps) const {
   return now_m + (to_eigen(target_next_m_) - now_m) * (static_cast<double>(k) / substeps);
 }
 
+nlohmann::json DeviceSim::summary_fields() const {
+  const FingerParams& finger = finger_.params();
+  const SpidarGeometry& geometry = hardware_.geometry();
+  return {{"finger_mass_kg", finger.mass_kg},
+          {"hand_stiffness_Npm", finger.hand_stiffness_Npm},
+          {"hand_damping_Nspm", finger.hand_damping_Nspm},
+          {"motor_time_constant_s", hardware_.params().motor_time_constant_s},
+          {"frame_side_m", geometry.frame_side_m},
+          {"metres_per_count", geometry.metres_per_count},
+          {"tension_min_N", geometry.tension_min_N},
+          {"tension_max_N", geometry.tension_max_N},
+          {"max_force_N", geometry.max_force_N}};
+}
+
 const char* DeviceSim::log_header() {
   return "time_s,target_x_m,target_y_m,target_z_m,finger_x_m,finger_y_m,finger_z_m,"
          "finger_vx_mps,finger_vy_mps,finger_vz_mps,force_x_N,force_y_N,force_z_N,"

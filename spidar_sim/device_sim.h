@@ -16,6 +16,8 @@
 #include "common/hand/finger.h"
 #include "spidar_sim/spidar_hardware.h"
 
+#include <nlohmann/json.hpp>
+
 #include <array>
 #include <ostream>
 
@@ -63,6 +65,12 @@ class DeviceSim {
 
   // A realtime hiccup longer than this is a bug upstream, not a tick: the sub-step count would explode.
   static constexpr double kMaxTick_s = 1.0;
+  static constexpr int kStrings = kStringCount;
+  using LogRow = DeviceLogRow;
+
+  double tension_min_N() const { return hardware_.geometry().tension_min_N; }
+  // The finger's, hand's and device's parameters, for the device summary (device_node.h).
+  nlohmann::json summary_fields() const;
 
   const DeviceState& state() const { return state_; }
   double time_s() const { return time_s_; }

@@ -5,7 +5,8 @@
 // and hand (grip_sim.h) toward the target pose its owner steers, and publishes the eight encoder counts.
 //
 // Lockstep only, one tick per step_device() (the in-process port's turn): a closed loop steers it (loop/tool_loop.h).
-// spidar_sim playing the grip on shared memory in real time is not built yet. No allocation after construction.
+// spidar_sim plays the grip along a trajectory with a device node instead (grip_device_sim.h). No allocation after
+// construction.
 
 #include "common/link/device_port.h"
 #include "common/link/inproc/inproc_device_port.h"

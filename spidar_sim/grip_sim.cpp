@@ -125,7 +125,7 @@ const GripCounts& GripSim::tick(const GripTensions& commanded_N, double dt_s) {
   const int substeps = hand_.substeps_for(dt_s);
   const double h_s = dt_s / substeps;
   for (int s = 0; s < substeps; ++s) {
-    const double t_s = time_s_ + s * h_s;
+    const double t_s = trajectory_time_s() + s * h_s;
     const Trajectory::Sample sample = trajectory_->sample_at(t_s, segment_hint_);
     const GripPose aim{to_eigen(sample.position_m), trajectory_->orientation_at(t_s)};
     substep(aim, to_eigen(sample.velocity_mps), trajectory_->angular_velocity_at(t_s), h_s);
@@ -133,6 +133,11 @@ const GripCounts& GripSim::tick(const GripTensions& commanded_N, double dt_s) {
   time_s_ += dt_s;
   counts_ = strings_.encoder_counts(hand_.pose());
   return counts_;
+}
+
+GripPose GripSim::trajectory_target() const {
+  if (!trajectory_) return hand_.pose();
+  return {to_eigen(trajectory_->position_at(trajectory_time_s())), trajectory_->orientation_at(trajectory_time_s())};
 }
 
 GripWrench GripSim::wrench() const { return strings_.wrench_matrix(hand_.pose()) * as_vector(tensions_N_); }

@@ -41,8 +41,15 @@ class GripSim {
 
   // Advances one tick of the trajectory's hand (the second constructor; std::logic_error otherwise).
   const GripCounts& tick(const GripTensions& commanded_N, double dt_s);
-  // True once the session time reaches the end of the trajectory (the target then holds still).
-  bool finished() const { return trajectory_ && time_s_ >= trajectory_->duration_s(); }
+  // True once the trajectory's clock reaches its end (the target then holds still).
+  bool finished() const { return trajectory_ && trajectory_time_s() >= trajectory_->duration_s(); }
+  // Holds the trajectory for the next tick of dt_s: its clock stands still and the hand aims where it is now, as
+  // DeviceSim::hold_trajectory (a real-time device waiting for a world to touch, device_node.h).
+  void hold_trajectory(double dt_s) { trajectory_start_s_ += dt_s; }
+  // Session time less the time the trajectory was held.
+  double trajectory_time_s() const { return time_s_ - trajectory_start_s_; }
+  // Where the trajectory's hand aims now (the second constructor; the grip's pose otherwise).
+  GripPose trajectory_target() const;
 
   // Advances one tick of dt_s (finite, > 0; else std::invalid_argument) and returns the encoder counts at its end.
   const GripCounts& tick(const GripTensions& commanded_N, const GripPose& target,
@@ -70,6 +77,7 @@ class GripSim {
   GripTensions tensions_N_{};
   GripCounts counts_{};
   double time_s_ = 0.0;
+  double trajectory_start_s_ = 0.0;  // session time of the trajectory's time 0 (hold_trajectory)
   std::size_t segment_hint_ = 0;  // the trajectory's segment of the last sub-step (Trajectory::sample_at)
 };
 

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-// spidar_sim: a simulated SPIDAR and finger playing a scripted trajectory (docs/architecture.md §1.2 step 1, §4).
-// Parses the flags, attaches to a running haptic controller's device port and runs a DeviceNode until the trajectory
-// ends; then detaches cleanly and exits 0.
+// spidar_sim: a simulated SPIDAR and finger playing a scripted trajectory (docs/architecture.md §1.2 step 1, §4), or
+// the 8-string grip SPIDAR and the hand holding its grip playing a trajectory of poses (--device grip; docs/tool.md).
+// Parses the flags, attaches to a running haptic controller's device port and runs a device node until the
+// trajectory ends; then detaches cleanly and exits 0.
 
 #include "common/link/shm/shm_device_port.h"
 #include "common/runtime/cli.h"
+#include "common/spidar/grip_geometry.h"
+#include "spidar_sim/grip_device_sim.h"
 #include "spidar_sim/simulated_fingers.h"
 
 #include <memory>
@@ -53,7 +56,9 @@ int main(int argc, char** argv) {
                  "(10; 0 plays at once)")
       ->check(number_in(0.0, kMaxFlagSeconds));
   app.add_option("--device", device_spec,
-                 "spidar (the built-in geometry) or spidar:FILE.json; must match the haptic controller's");
+                 "spidar (the built-in geometry) or spidar:FILE.json, or the 8-string grip SPIDAR holding a tool: "
+                 "grip or grip:FILE.json (its trajectory may turn: t,x,y,z,qw,qx,qy,qz); must match the haptic "
+                 "controller's");
   app.add_option("--hand-stiffness", finger.hand_stiffness_Npm, "hand impedance stiffness, N/m (300)")
       ->check(positive_number(limits::kMaxStiffness_Npm));
   app.add_option("--hand-damping", finger.hand_damping_Nspm, "hand impedance damping, N·s/m (8)")
@@ -70,6 +75,27 @@ int main(int argc, char** argv) {
   }
 
   return run_node("spidar_sim", [&] {
+    if (device_spec == "grip" || device_spec.rfind("grip:", 0) == 0) {
+      // One grip, held by a hand whose linear impedance the hand flags set (the turn's stays the grip hand's).
+      for (const char* flag : {"--finger", "--finger-mass", "--motor-lag"}) {
+        if (app.count(flag) > 0) throw std::invalid_argument(std::string(flag) + " is not for --device grip");
+      }
+      const GripDevice grip = parse_grip_spec(device_spec);
+      GripHandParams hand;
+      hand.stiffness_Npm = finger.hand_stiffness_Npm;
+      hand.damping_Nspm = finger.hand_damping_Nspm;
+      GripDeviceSim sim(grip.geometry, hand, load_trajectory(trajectory_spec));
+      ShmDevicePortClient port(shm, clock, attach_timeout_s,
+                               DeviceDescription{grip_geometry_hash(grip.geometry), grip.source}, 0);
+      GripDeviceNode node(sim, port, log_path, new_session_id());
+      node.set_world_wait(world_wait_s);
+      std::fprintf(stderr, "spidar_sim: the grip attached to '%s' (%s)\n", port.name().c_str(), to_string(clock));
+      const int status = node.run();
+      write_summary(summary_path, node.summary());
+      std::fprintf(stderr, "spidar_sim: detached after %llu ticks (%.3f s simulated)\n",
+                   static_cast<unsigned long long>(node.ticks()), sim.time_s());
+      return status;
+    }
     const SpidarDevice spidar = parse_device_spec(device_spec);
     std::vector<std::unique_ptr<ShmDevicePortClient>> ports;  // declared first: they outlive the nodes that hold them
     SimulatedFingers rig(load_fingers(trajectory_spec, finger_specs), spidar.geometry, hardware, finger);

@@ -4,6 +4,7 @@
 #include "common/contract/limits.h"
 #include "common/runtime/json_node.h"
 #include "common/runtime/message_text.h"
+#include "common/tool/tool_block.h"
 #include "common/mesh/mesh_body.h"
 #include "common/mesh/mesh_object.h"
 #include "world_manager/deform/deformable_surface.h"
@@ -26,19 +27,7 @@ namespace {
 
 using nlohmann::json;
 
-// A quaternion read from text with ~7 significant digits is still unit to ~1e-7; 1e-6 accepts those and rejects
-// anything a normalisation would noticeably change.
-constexpr double kUnitQuaternionTolerance = 1e-6;
 using Node = JsonNode;
-
-std::array<double, 4> parse_unit_quaternion(const Node& node) {
-  const std::array<double, 4> q = node.numbers<4>();
-  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (std::abs(norm - 1.0) > kUnitQuaternionTolerance) {
-    node.fail("quaternion must be unit within 1e-6 (norm " + std::to_string(norm) + ")");
-  }
-  return q;
-}
 
 Material parse_material(const Node& node, Material material) {
   if (node.has("static_friction")) {
@@ -148,12 +137,6 @@ HapticParams parse_haptic(const Node& node) {
     haptic.finger_material = parse_material(node, haptic.finger_material);
   }
   return haptic;
-}
-
-ShapeKind parse_shape_kind(const Node& node) {
-  ShapeKind kind = ShapeKind::none;
-  if (!shape_kind_from_string(node.string(), kind)) node.fail("unknown shape, expected " + shape_kind_names());
-  return kind;
 }
 
 // The keys every object may have; its shape's own come from the shape module.
@@ -308,7 +291,7 @@ SceneObject parse_object(const Node& node, const std::string& scene_dir) {
       position.element(i).in_range(-SceneLimits::kMaxCoordinate_m, SceneLimits::kMaxCoordinate_m, " m");
     }
   }
-  if (node.has("orientation_wxyz")) object.orientation_wxyz = parse_unit_quaternion(node.child("orientation_wxyz"));
+  if (node.has("orientation_wxyz")) object.orientation_wxyz = node.child("orientation_wxyz").unit_quaternion();
   if (node.has("linear_velocity_mps")) {
     object.linear_velocity_mps = node.child("linear_velocity_mps").vector_up_to(SceneLimits::kMaxSpeed_mps, " m/s");
   }
@@ -321,84 +304,6 @@ SceneObject parse_object(const Node& node, const std::string& scene_dir) {
   return object;
 }
 
-// The keys a tool may have; its shape's own come from the shape module.
-constexpr std::string_view kToolKeys[] = {
-    "shape", "position_m", "orientation_wxyz", "mass_kg", "density_kgpm3", "stiffness_Npm", "damping_Nspm",
-    "rotational_stiffness_Nmprad", "rotational_damping_Nmsprad", "max_force_N", "max_torque_Nm"};
-
-// A "tool" block (docs/scene-format.md): the shape in the grip's frame and the coupling, each value in its range.
-SceneTool parse_tool(const Node& node, const Vec3& gravity_mps2) {
-  node.expect_object();
-  const ShapeKind kind = parse_shape_kind(node.required("shape"));
-  node.expect_keys({std::span<const std::string_view>(kToolKeys), shape_keys(kind)});
-  if (kind == ShapeKind::mesh) {
-    node.child("shape").fail("a tool cannot be a mesh yet: a tool touches by its shape's corners and edges "
-                             "(docs/tool.md), which a mesh does not give; use box, sphere, capsule or cylinder");
-  }
-  SceneTool tool;
-  tool.shape.shape = parse_shape(node, kind);
-  if (node.has("position_m")) {
-    const Vec3 at = node.child("position_m").vector_up_to(SceneLimits::kMaxToolReach_m, " m");
-    tool.shape.placement.position_m = Eigen::Vector3d(at[0], at[1], at[2]);
-  }
-  if (node.has("orientation_wxyz")) {
-    const std::array<double, 4> q = parse_unit_quaternion(node.child("orientation_wxyz"));
-    tool.shape.placement.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
-  }
-  ToolCoupling& coupling = tool.coupling;
-  if (node.has("stiffness_Npm")) {
-    coupling.stiffness_Npm = node.child("stiffness_Npm").positive_up_to(limits::kMaxStiffness_Npm, " N/m");
-  }
-  if (node.has("damping_Nspm")) {
-    coupling.damping_Nspm = node.child("damping_Nspm").in_range(0.0, limits::kMaxDamping_Nspm, " N·s/m");
-  }
-  if (node.has("rotational_stiffness_Nmprad")) {
-    coupling.rotational_stiffness_Nmprad = node.child("rotational_stiffness_Nmprad")
-                                               .positive_up_to(SceneLimits::kMaxRotationalStiffness_Nmprad, " N·m/rad");
-  }
-  if (node.has("rotational_damping_Nmsprad")) {
-    coupling.rotational_damping_Nmsprad = node.child("rotational_damping_Nmsprad")
-                                              .in_range(0.0, SceneLimits::kMaxRotationalDamping_Nmsprad, " N·m·s/rad");
-  }
-  if (node.has("max_force_N")) {
-    coupling.max_force_N = node.child("max_force_N").positive_up_to(SceneLimits::kMaxToolForce_N, " N");
-  }
-  if (node.has("max_torque_Nm")) {
-    coupling.max_torque_Nm = node.child("max_torque_Nm").positive_up_to(SceneLimits::kMaxToolTorque_Nm, " N·m");
-  }
-  // Its mass (none given: weightless), and its weight under the scene's gravity. A device that cannot hold the weight
-  // up, or its moment about the grip, could not render the tool: refused rather than clamped on every tick.
-  if (node.has("mass_kg") && node.has("density_kgpm3")) {
-    node.child("density_kgpm3").fail("give either mass_kg or density_kgpm3, not both");
-  }
-  if (node.has("mass_kg")) {
-    tool.shape.mass_kg = node.child("mass_kg").in_range(0.0, SceneLimits::kMaxToolMass_kg, " kg");
-  } else if (node.has("density_kgpm3")) {
-    tool.shape.mass_kg = node.child("density_kgpm3").positive() * volume_m3(tool.shape.shape);
-    if (!(tool.shape.mass_kg <= SceneLimits::kMaxToolMass_kg)) {
-      node.child("density_kgpm3").fail("density × volume = " + readable(tool.shape.mass_kg) + " kg; a tool's mass " +
-                                       "must be at most " + readable(SceneLimits::kMaxToolMass_kg) + " kg");
-    }
-  }
-  tool.shape.weight_N = tool.shape.mass_kg * Eigen::Vector3d(gravity_mps2[0], gravity_mps2[1], gravity_mps2[2]);
-  const char* const mass_key = node.has("mass_kg") ? "mass_kg" : "density_kgpm3";
-  const double weight_N = tool.shape.weight_N.norm();
-  if (weight_N > coupling.max_force_N) {
-    node.child(mass_key).fail("the tool weighs " + readable(weight_N) + " N, more than max_force_N (" +
-                              readable(coupling.max_force_N) + " N): the device could not hold it up");
-  }
-  const double weight_torque_Nm = tool.shape.placement.position_m.norm() * weight_N;  // at most, turned any way
-  if (weight_torque_Nm > coupling.max_torque_Nm) {
-    node.child(mass_key).fail("the tool's weight turns the grip by up to " + readable(weight_torque_Nm) + " N·m " +
-                              "about its centre, more than max_torque_Nm (" + readable(coupling.max_torque_Nm) +
-                              " N·m): the device could not hold it level");
-  }
-  // The farthest the tool reaches from the grip's centre: its placement plus its bounding box's farthest corner.
-  const Eigen::AlignedBox3d bounds = world_bounds(tool.shape.shape, BodyPose{});
-  tool.reach_m = tool.shape.placement.position_m.norm() +
-                 std::max(bounds.min().norm(), bounds.max().norm());
-  return tool;
-}
 
 }  // namespace
 
@@ -442,7 +347,7 @@ Scene parse_scene(const nlohmann::json& document, const std::string& source_name
   if (root.has("physics")) scene.physics = parse_physics(root.child("physics"));
   if (root.has("haptic")) scene.haptic = parse_haptic(root.child("haptic"));
   if (root.has("tool")) {
-    scene.tool = parse_tool(root.child("tool"), scene.gravity_mps2);
+    scene.tool = parse_tool_block(root.child("tool"), scene.gravity_mps2);
     // The world sends the planes of objects within the reach radius of the tool's grip: it must cover the tool, with
     // a finger's neighbourhood around its farthest point. Given, it is checked; not given, it is widened.
     const bool reach_given = root.has("haptic") && root.child("haptic").has("reach_radius_m");

@@ -10,6 +10,7 @@
 
 #include "common/contract/limits.h"
 #include "common/contract/tool.h"
+#include "common/tool/tool_block.h"
 #include "common/contract/vec3.h"
 #include "common/runtime/input_error.h"
 #include "common/shape/shape.h"
@@ -43,7 +44,7 @@ struct SceneLimits {
   static constexpr double kMaxMass_kg = 1e6;       // 1000 t
   static constexpr double kMaxSpeed_mps = 1e3;     // faster than a rifle bullet
   static constexpr double kMaxAngularSpeed_radps = 1e4;  // ~1600 turns per second
-  static constexpr double kMaxGravity_mps2 = 1e3;  // 100 g
+  static constexpr double kMaxGravity_mps2 = limits::kMaxGravity_mps2;
   static constexpr double kMaxFriction = 100.0;    // real pairs stay below ~2; 100 already holds like glue
   static constexpr double kMaxCfm = 1.0;           // ODE: CFM above 1 makes every contact softer than the body it holds
   // Bounds against typing errors, each 10^4–10^6 times off the default contact's (PhysicsParams); at the lowest
@@ -51,16 +52,7 @@ struct SceneLimits {
   static constexpr double kMinContactStiffness_Npm = 1.0;
   static constexpr double kMaxContactStiffness_Npm = 1e12;
   static constexpr double kMaxContactDamping_Nspm = 1e9;
-  static constexpr double kMaxReachRadius_m = 10.0;  // 30× a desktop device's workspace
-  // A tool's bounds. A hand-held tool is at most an arm's length; its rotational coupling at most the linear bound at
-  // a 10 cm lever (k·r²), as the defaults (common/contract/tool.h); forces past 1 kN and torques past 100 N·m are no
-  // hand-held device's.
-  static constexpr double kMaxToolReach_m = 1.0;
-  static constexpr double kMaxRotationalStiffness_Nmprad = limits::kMaxStiffness_Npm * 0.01;
-  static constexpr double kMaxRotationalDamping_Nmsprad = limits::kMaxDamping_Nspm * 0.01;
-  static constexpr double kMaxToolForce_N = 1e3;
-  static constexpr double kMaxToolTorque_Nm = 100.0;
-  static constexpr double kMaxToolMass_kg = 10.0;  // a sledgehammer is 5 kg
+  static constexpr double kMaxReachRadius_m = 10.0;  // 30× a desktop device's workspace (a tool's: tool_block.h)
   // A world step costs O(objects) in ODE's broadphase and our feature grid; 10^4 static spheres step in ~35 ms on
   // this class of machine (within a 20 Hz period) and 10^5 in tens of seconds (docs/reliability.md).
   static constexpr std::size_t kMaxObjects = 10'000;
@@ -189,15 +181,11 @@ struct PhysicsParams {
 
 // A tool in the hand (the scene's "tool" block; docs/tool.md): a rigid tool held by the first endpoint. The world
 // does not simulate it; the haptic side's tool servo renders it against the objects (haptic_controller/tool/).
-struct SceneTool {
-  ToolShape shape;
-  ToolCoupling coupling;
-  double reach_m = 0.0;  // a bound on the tool's farthest point from the grip's centre
-};
+using SceneTool = ToolBlock;
 
 struct Scene {
   std::string source_name;  // file the scene came from, for messages
-  Vec3 gravity_mps2{0.0, 0.0, -9.81};
+  Vec3 gravity_mps2{0.0, 0.0, -limits::kStandardGravity_mps2};
   Floor floor;
   std::vector<SceneObject> objects;  // an object's index is its object_id on the world link
   HapticParams haptic;

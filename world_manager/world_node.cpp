@@ -104,10 +104,6 @@ std::vector<std::string> WorldNode::warnings() const {
       out.emplace_back(text);
     }
   }
-  if (scene_.tool) {
-    out.emplace_back("the scene has a tool (its \"tool\" block), which only the in-process tool loop renders yet "
-                     "(Python's impetus.ToolSimulation, docs/tool.md); here every endpoint is a point finger");
-  }
   const std::size_t floor_id = scene_.objects.size();
   for (const RigidBodyEngine::Overlap& overlap : world_.start_overlaps()) {
     const std::string other = overlap.b == floor_id ? "the floor" : "'" + scene_.objects[overlap.b].name + "'";

@@ -28,4 +28,8 @@ inline constexpr double kMaxDamping_Nspm = 1e4;
 inline constexpr double kMinLength_m = 1e-4;
 inline constexpr double kMaxLength_m = 1e3;
 
+// Gravity: a scene's default is the Earth's (down, −z); at most 100 g, far beyond any planet a scene would model.
+inline constexpr double kStandardGravity_mps2 = 9.81;
+inline constexpr double kMaxGravity_mps2 = 1e3;
+
 }  // namespace impetus::limits

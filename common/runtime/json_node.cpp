@@ -120,6 +120,16 @@ double JsonNode::in_unit_interval() const {
   return x;
 }
 
+std::array<double, 4> JsonNode::unit_quaternion() const {
+  constexpr double kTolerance = 1e-6;
+  const std::array<double, 4> q = numbers<4>();
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (std::abs(norm - 1.0) > kTolerance) {
+    fail("quaternion must be unit within 1e-6 (norm " + std::to_string(norm) + ")");
+  }
+  return q;
+}
+
 int JsonNode::positive_int(int highest) const {
   if (!value_.is_number_integer()) fail("expected a whole number");
   // Compared as a double first: a huge integer must not wrap when converted.

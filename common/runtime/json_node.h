@@ -59,6 +59,9 @@ class JsonNode {
   double positive_up_to(double highest, const char* unit) const;
   std::array<double, 3> vector_up_to(double highest, const char* unit) const;  // Euclidean length at most `highest`
   double in_unit_interval() const;
+  // Four numbers w, x, y, z of norm 1 within 1e-6 (a quaternion written with ~7 significant digits is unit to ~1e-7:
+  // those pass, anything a normalisation would noticeably change does not).
+  std::array<double, 4> unit_quaternion() const;
   int positive_int(int highest) const;
   bool boolean() const;
   std::string string() const;

@@ -80,6 +80,12 @@ const ShapeTraits& traits(ShapeKind kind) { return ops(kind).traits; }
 
 std::span<const std::string_view> shape_keys(ShapeKind kind) { return ops(kind).keys; }
 
+ShapeKind parse_shape_kind(const JsonNode& node) {
+  ShapeKind kind = ShapeKind::none;
+  if (!shape_kind_from_string(node.string(), kind)) node.fail("unknown shape, expected " + shape_kind_names());
+  return kind;
+}
+
 Shape parse_shape(const JsonNode& object, ShapeKind kind) {
   Shape shape;
   shape.kind = kind;

@@ -89,6 +89,8 @@ const ShapeTraits& traits(ShapeKind kind);
 
 // The JSON keys of a kind's own dimensions in a scene object ("size_m"; "radius_m", "length_m").
 std::span<const std::string_view> shape_keys(ShapeKind kind);
+// A "shape" value: a kind's name, else an error naming the known ones.
+ShapeKind parse_shape_kind(const JsonNode& node);
 // Reads a kind's dimensions from a scene object, each checked against the scene's length limits; throws InputError
 // naming the key and the value.
 Shape parse_shape(const JsonNode& object, ShapeKind kind);

@@ -33,6 +33,8 @@ class GripPortDriver final : public HapticDevice {
   // The force and torque of commands[0] on the grip read last: bit 0 set if they were scaled to the motors.
   std::uint32_t command_fingers(std::uint64_t tick, const FingerCommand* commands) override;
   void end_session() override { port_.end_session(); }
+  // Said to the device in the commands' flags (kCommandWorldPresent): a scripted hand waits for it (device_node.h).
+  void note_world(bool present) override { command_.flags = present ? kCommandWorldPresent : 0; }
   DeviceCounters counters() const override;
   nlohmann::json details() const override;
 
