@@ -156,6 +156,12 @@ TEST_CASE("bad flag values give a clear message, a non-zero exit and no segment 
       {world + "--scene scenes/tap.json --link dds --dds-partition ''", "must not be empty"},
       {haptic + "--link dds --clock lockstep", "real time only"},
       {haptic + "--clock realtime --link dds --world-shm elsewhere", "--world-shm names a shared-memory world link"},
+      // A tool in the hand: the scene must have one, and a grip holds it; the grip's hand has no finger's flags.
+      {haptic + "--device grip --tool-from scenes/tap.json", "has no \"tool\" block"},
+      {haptic + "--device grip --tool-from scenes/missing.json", "missing.json"},
+      {haptic + "--device grip:nosuchgrip.json", "nosuchgrip.json"},
+      {device + "--device grip --trajectory tap --finger-mass 0.2", "--finger-mass is not for --device grip"},
+      {device + "--device grip --trajectory " + far_csv.string(), "frame"},
       {haptic + "--clock realtime --link dds --dds-partition impetus_test_nobody_" + std::to_string(getpid()),
        "no world manager answered on DDS domain 0 partition 'impetus_test_nobody_"},
   };
