@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
       ->needs("--touch");
   app.add_option("--meshes-from", options.meshes_from,
                  "live: the world's scene file; its meshes are read so the page draws their triangles (else a mesh "
-                 "is drawn as a ball that holds it)")
+                 "is drawn as a ball that holds it), and its tool, drawn in the hand that holds it")
       ->check(CLI::ExistingFile);
   app.add_option("--web", web_dir, "folder with the page (default: the installed or source viewer/web)")
       ->check(CLI::ExistingDirectory);

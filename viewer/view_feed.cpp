@@ -62,12 +62,13 @@ void LiveFeed::poll() {
   if (!reader_) return;
   if (reader_->read_scene(*scene_)) {
     have_scene_ = true;
-    scene_message_ = std::make_shared<const std::string>(scene_message(*scene_, where_, std::nullopt));
+    scene_message_ =
+        std::make_shared<const std::string>(scene_message(*scene_, where_, std::nullopt, tool_ ? &*tool_ : nullptr));
     ++scene_serial_;
   }
   if (have_scene_ && reader_->read_snapshot(*snapshot_) && snapshot_->body_count == scene_->body_count) {
     auto message = std::make_shared<std::string>();
-    encode_frame(*snapshot_, true, 1.0, *message);
+    encode_frame(*snapshot_, true, 1.0, *message, tool_ ? &tool_frame() : nullptr);
     frame_message_ = std::move(message);
     ++frame_serial_;
     ++snapshots_read_;
@@ -77,6 +78,21 @@ void LiveFeed::poll() {
     rejected_before_ += reader_->rejected();
     reader_.reset();
   }
+}
+
+const ViewToolFrame& LiveFeed::tool_frame() {
+  tool_frame_ = ViewToolFrame{};
+  for (std::uint32_t e = 0; e < snapshot_->endpoint_count; ++e) {
+    const ViewEndpoint& endpoint = snapshot_->endpoints[e];
+    if (endpoint.oriented == 0) continue;
+    tool_frame_.valid = endpoint.finger_valid != 0;
+    tool_frame_.grip = {endpoint.finger_m, endpoint.finger_wxyz};
+    tool_frame_.proxy = {endpoint.proxy_m, endpoint.proxy_wxyz};
+    tool_frame_.force_N = endpoint.force_N;
+    tool_frame_.torque_Nm = endpoint.torque_Nm;
+    break;
+  }
+  return tool_frame_;
 }
 
 std::shared_ptr<const std::string> LiveFeed::next_frame(Playback& playback, double /*elapsed_s*/) {

@@ -6,6 +6,7 @@
 #include "common/contract/world_view.h"
 #include "common/link/shm/shm_world_view.h"
 #include "viewer/replay.h"
+#include "viewer/view_encoding.h"
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -67,9 +68,14 @@ class LiveFeed final : public ViewFeed {
 
   std::uint64_t snapshots_read() const { return snapshots_read_; }
   std::uint64_t rejected() const;
+  // The tool in the hand the world's scene names (viewer --meshes-from SCENE; common/tool/tool_block.h): drawn at the
+  // pose of the first endpoint whose reports say they are a tool's (HapticReport::oriented).
+  void set_tool(const ToolShape& tool) { tool_ = tool; }
 
  private:
   void try_attach();
+  // The tool's poses in the snapshot (not valid when no endpoint is a tool's).
+  const ViewToolFrame& tool_frame();
 
   std::string where_;
   ViewReaderOpener open_;
@@ -85,6 +91,8 @@ class LiveFeed final : public ViewFeed {
   std::shared_ptr<const std::string> frame_message_;
   std::uint64_t frame_serial_ = 0;
   std::uint64_t snapshots_read_ = 0;
+  std::optional<ToolShape> tool_;
+  ViewToolFrame tool_frame_;
 };
 
 class ReplayFeed final : public ViewFeed {

@@ -17,7 +17,8 @@
 //       to at most that many (viewer/mesh_coarsening.h), with "coarsened_from": its own count and "cell_m", or
 //         {"drawn": "bound", "why": "..."}: the page draws a ball of radius_m about its centre instead.
 //       "replay": {"start_s": t0, "end_s": t1, "frame_count": n},          (replay only)
-//       "tool": {"shape": ..., "size_m": ..., "radius_m": ..., "length_m": ...,   (a replay of a tool in the hand)
+//       "tool": {"shape": ..., "size_m": ..., "radius_m": ..., "length_m": ...,   (a tool in the hand: a replay's, or
+//                                                  live the tool of the scene --meshes-from names)
 //                "placement": {"position_m": [x, y, z], "orientation_wxyz": [w, x, y, z]}}}   (shape → grip frame)
 //    Body k of every frame below is bodies[k]. A shape's axis of symmetry is its body z.
 //
@@ -38,7 +39,8 @@
 //      kDentValues values and C·R depths: body k, version (changes with the dent), columns C, rows R, x0, y0, dx, dy
 //      (m, the box's body frame: point (c, r) at (x0 + c·dx, y0 + r·dy) on the top face), then the depths below the
 //      face (m), row-major (r·C + c)
-//      then, if [13] is 1, the tool, kToolValues values: valid (1/0: a grip pose this frame), the grip's pose
+//      then, if [13] is 1, the tool, kToolValues values (live: the first endpoint whose reports are a tool's,
+//      HapticReport::oriented; none: valid 0): valid (1/0: a grip pose this frame), the grip's pose
 //      (x, y, z, qw, qx, qy, qz; grip → world), the proxy's pose (the tool as rendered, held out of the objects), the
 //      force on the grip x, y, z (N), the torque on the grip about its centre x, y, z (N·m)
 //    World frame right-handed, z up, SI units.

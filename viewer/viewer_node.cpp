@@ -8,6 +8,7 @@
 #include "common/link/shm/shm_touch_port.h"
 #include "common/mesh/mesh_object.h"
 #include "common/runtime/process.h"
+#include "common/tool/tool_block.h"
 #include "viewer/view_feed.h"
 #include "viewer/touch_control.h"
 #include "viewer/view_server.h"
@@ -97,6 +98,9 @@ int ViewerNode::run() {
       });
     } else {
       live_feed = std::make_unique<LiveFeed>(options_.shm);
+    }
+    if (!options_.meshes_from.empty()) {
+      if (const std::optional<ToolBlock> tool = load_scene_tool(options_.meshes_from)) live_feed->set_tool(tool->shape);
     }
     live = live_feed.get();
     feed = std::move(live_feed);

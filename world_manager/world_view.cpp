@@ -74,6 +74,10 @@ void take_snapshot(const World& world, std::span<const HapticReport* const> repo
     endpoint.finger_m = report->finger_m;
     endpoint.proxy_m = report->proxy_m;
     endpoint.force_N = report->force_N;
+    endpoint.oriented = report->oriented;
+    endpoint.torque_Nm = report->torque_Nm;
+    endpoint.finger_wxyz = report->finger_wxyz;
+    endpoint.proxy_wxyz = report->proxy_wxyz;
     // The planes nearest the proxy: those the finger can be touching. Selection on at most kMaxPlanes indices.
     std::array<std::uint32_t, kMaxPlanes> order{};
     const std::uint32_t count = std::min(frame.plane_count, kMaxPlanes);

@@ -205,6 +205,13 @@ struct HapticReport {
   // than around a finger that may have pushed deep into (or through) a thin object.
   Vec3 proxy_m{};
   Vec3 force_N{};                   // f_j, the force on the finger at this tick (for viewers; the world never uses it)
+  // A tool's (docs/tool.md; for viewers, as force_N): oriented = 1, the torque on the grip about its centre, and the
+  // grip's and the proxy's orientations (finger_m and proxy_m are their centres), unit quaternions w, x, y, z. A
+  // finger's: 0, zero, and the identity.
+  std::uint32_t oriented = 0;
+  Vec3 torque_Nm{};
+  std::array<double, 4> finger_wxyz{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 4> proxy_wxyz{1.0, 0.0, 0.0, 0.0};
   std::uint32_t finger_valid = 0;   // 0 while no device is attached: position coupling must not use finger_m
   std::uint32_t entry_count = 0;
   Vec3 static_impulse_Ns{};         // share of the reaction that went into static geometry (floor, fixed objects)

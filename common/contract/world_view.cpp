@@ -37,9 +37,11 @@ const char* snapshot_problem(const WorldSnapshot& snapshot) {
   for (std::uint32_t e = 0; e < snapshot.endpoint_count; ++e) {
     const ViewEndpoint& endpoint = snapshot.endpoints[e];
     if (endpoint.plane_count > kMaxViewPlanes) return "plane count over capacity";
-    if (!all_finite(endpoint.finger_m) || !all_finite(endpoint.proxy_m) || !all_finite(endpoint.force_N)) {
-      return "finger, proxy or force not finite";
+    if (!all_finite(endpoint.finger_m) || !all_finite(endpoint.proxy_m) || !all_finite(endpoint.force_N) ||
+        !all_finite(endpoint.torque_Nm)) {
+      return "finger, proxy, force or torque not finite";
     }
+    if (!unit(endpoint.finger_wxyz) || !unit(endpoint.proxy_wxyz)) return "finger or proxy orientation not unit";
     for (std::uint32_t p = 0; p < endpoint.plane_count; ++p) {
       if (!all_finite(endpoint.planes[p].point_m)) return "plane point not finite";
       if (!unit(endpoint.planes[p].normal)) return "plane normal not unit";

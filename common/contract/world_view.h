@@ -58,6 +58,13 @@ struct ViewEndpoint {
   Vec3 finger_m{};
   Vec3 proxy_m{};
   Vec3 force_N{};  // on the finger, at the report the world took for this step
+  // A tool's (HapticReport): oriented = 1, the torque on the grip, the grip's (finger's) and the proxy's orientations,
+  // unit.
+  std::uint32_t oriented = 0;
+  std::uint32_t reserved_oriented = 0;
+  Vec3 torque_Nm{};
+  std::array<double, 4> finger_wxyz{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 4> proxy_wxyz{1.0, 0.0, 0.0, 0.0};
   std::uint32_t plane_count = 0;  // <= kMaxViewPlanes
   std::uint32_t reserved = 0;
   std::array<ViewPlane, kMaxViewPlanes> planes{};

@@ -111,6 +111,10 @@ void visit_report_header(A& a, B& b, F&& f) {
   f(a.finger_velocity_mps, b.finger_velocity_mps);
   f(a.proxy_m, b.proxy_m);
   f(a.force_N, b.force_N);
+  f(a.oriented, b.oriented);
+  f(a.torque_Nm, b.torque_Nm);
+  f(a.finger_wxyz, b.finger_wxyz);
+  f(a.proxy_wxyz, b.proxy_wxyz);
   f(a.finger_valid, b.finger_valid);
   f(a.entry_count, b.entry_count);
   f(a.static_impulse_Ns, b.static_impulse_Ns);

@@ -64,6 +64,7 @@ void ToolServo::idle() {
   report.finger_valid = 0;
   report.finger_velocity_mps = {};
   report.force_N = {};
+  report.torque_Nm = {};
 }
 
 const ToolTickResult& ToolServo::tick(const BodyPose* grip, double now_s, double dt_s) {
@@ -122,6 +123,11 @@ const ToolTickResult& ToolServo::tick(const BodyPose* grip, double now_s, double
   report.finger_velocity_mps = to_vec3(velocity_mps);
   report.finger_valid = 1;
   report.force_N = to_vec3(solved.force_N);
+  report.torque_Nm = to_vec3(solved.torque_Nm);
+  const auto wxyz = [](const Eigen::Quaterniond& q) { return std::array<double, 4>{q.w(), q.x(), q.y(), q.z()}; };
+  report.oriented = 1;
+  report.finger_wxyz = wxyz(pose.orientation);
+  report.proxy_wxyz = wxyz(solved.proxy.orientation);
   accumulator_.add_shares(proxy_.shares(), proxy_.share_count(), ticks_);
   if (have_frame_) motion_->take_shares(accumulator_.last_shares(), accumulator_.last_share_count());
   return result_;

@@ -55,6 +55,29 @@ TEST_CASE("an encoded valid frame decodes to the same frame") {
   REQUIRE(decode(wire_report, report_copy) == FrameError::ok);
   CHECK(report_copy.endpoint == 3);
   CHECK(report_copy.entries[0].impulse_Ns == report.entries[0].impulse_Ns);
+  CHECK(report_copy.oriented == 0);  // a finger's: level
+  CHECK(report_copy.proxy_wxyz == std::array<double, 4>{1.0, 0.0, 0.0, 0.0});
+
+  // A tool's: its grip's and proxy's orientations and the torque, whole; an orientation that is not unit, a torque
+  // that is not finite, or a flag that is not 0 or 1 is refused.
+  report.oriented = 1;
+  report.finger_wxyz = {0.6, 0.0, 0.8, 0.0};
+  report.proxy_wxyz = {0.8, 0.6, 0.0, 0.0};
+  report.torque_Nm = {0.0, -0.04, 0.001};
+  encode(report, wire_report);
+  REQUIRE(decode(wire_report, report_copy) == FrameError::ok);
+  CHECK(report_copy.oriented == 1);
+  CHECK(report_copy.finger_wxyz == report.finger_wxyz);
+  CHECK(report_copy.proxy_wxyz == report.proxy_wxyz);
+  CHECK(report_copy.torque_Nm == report.torque_Nm);
+  for (int bad = 0; bad < 3; ++bad) {
+    HapticReport broken = report;
+    if (bad == 0) broken.proxy_wxyz = {1.0, 0.1, 0.0, 0.0};
+    if (bad == 1) broken.torque_Nm[1] = std::numeric_limits<double>::infinity();
+    if (bad == 2) broken.oriented = 2;
+    encode(broken, wire_report);
+    CHECK(decode(wire_report, report_copy) != FrameError::ok);
+  }
 }
 
 TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {

@@ -137,6 +137,72 @@ TEST_CASE("over DDS a live feed shows a world publishing in its partition, every
   CHECK(feed.rejected() == 0);
 }
 
+TEST_CASE("a tool's report reaches a live page: its grip's and proxy's poses and torque, over both transports") {
+  prepare_engines();
+  const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/peg_in_hole.json");
+  World world(scene, WorldOptions{});
+  HapticReport report{};
+  report.finger_valid = 1;
+  report.oriented = 1;
+  report.finger_m = {0.0, 0.0, 0.07};
+  report.proxy_m = {0.0, 0.0, 0.0705};
+  report.finger_wxyz = {0.6, 0.0, 0.8, 0.0};
+  report.proxy_wxyz = {0.8, 0.0, 0.6, 0.0};
+  report.force_N = {0.8, 0.0, -0.1};
+  report.torque_Nm = {0.0, -0.04, 0.0};
+  world.step(&report);
+  auto snapshot = std::make_unique<WorldSnapshot>();
+  take_snapshot(world, &report, LoopStats{}, nullptr, *snapshot);
+  REQUIRE(snapshot->endpoint_count == 1);
+  CHECK(snapshot->endpoints[0].oriented == 1);
+  CHECK(snapshot->endpoints[0].finger_wxyz == report.finger_wxyz);
+  CHECK(snapshot->endpoints[0].torque_Nm == report.torque_Nm);
+
+  // Shared memory passes it whole.
+  const std::string shm = "impetus_test_view_tool_" + std::to_string(getpid());
+  ShmWorldViewPublisher shm_publisher(shm);
+  shm_publisher.publish_snapshot(*snapshot);
+  ShmWorldViewReader reader(shm);
+  auto read = std::make_unique<WorldSnapshot>();
+  REQUIRE(reader.read_snapshot(*read));
+  CHECK(read->endpoints[0].proxy_wxyz == report.proxy_wxyz);
+  CHECK(read->endpoints[0].torque_Nm == report.torque_Nm);
+
+  // A live feed told the scene's tool sends it with the scene, and the endpoint's poses with each frame; over DDS the
+  // frame is the one shared memory would give.
+  DdsLinkOptions dds;
+  dds.partition = "impetus_test_view_tool_" + std::to_string(getpid());
+  DdsWorldViewPublisher publisher(dds);
+  auto described = std::make_unique<ViewScene>();
+  describe_scene(scene, Coupling::local, 20.0, 1, *described);
+  publisher.publish_scene(*described);
+  view::LiveFeed feed(describe(dds), [dds]() -> std::unique_ptr<WorldViewReader> {
+    return std::make_unique<DdsWorldViewReader>(dds);
+  });
+  feed.set_tool(scene.tool->shape);
+  view::Playback playback;
+  std::shared_ptr<const std::string> frame;
+  for (int attempt = 0; attempt < 400 && frame == nullptr; ++attempt) {
+    publisher.publish_snapshot(*snapshot);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    feed.poll();
+    frame = feed.next_frame(playback, 0.0);
+  }
+  REQUIRE(feed.scene() != nullptr);
+  CHECK(nlohmann::json::parse(*feed.scene()).at("tool").at("size_m")[2] == 0.04);
+  REQUIRE(frame != nullptr);
+  view::ViewToolFrame tool;
+  tool.valid = true;
+  tool.grip = {report.finger_m, report.finger_wxyz};
+  tool.proxy = {report.proxy_m, report.proxy_wxyz};
+  tool.force_N = report.force_N;
+  tool.torque_Nm = report.torque_Nm;
+  std::string expected;
+  view::encode_frame(*snapshot, true, 1.0, expected, &tool);
+  CHECK(*frame == expected);
+  CHECK(feed.rejected() == 0);
+}
+
 TEST_CASE("a pressed clay slab's snapshot carries its dent, and both transports pass it whole") {
   prepare_engines();
   const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/clay.json");

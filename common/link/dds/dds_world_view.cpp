@@ -93,6 +93,10 @@ void DdsWorldViewPublisher::publish_snapshot(const WorldSnapshot& snapshot) {
     to.finger_m = to_dds(from.finger_m);
     to.proxy_m = to_dds(from.proxy_m);
     to.force_N = to_dds(from.force_N);
+    to.oriented = from.oriented;
+    to.torque_Nm = to_dds(from.torque_Nm);
+    std::copy(from.finger_wxyz.begin(), from.finger_wxyz.end(), to.finger_wxyz);
+    std::copy(from.proxy_wxyz.begin(), from.proxy_wxyz.end(), to.proxy_wxyz);
     to.plane_count = std::min(from.plane_count, kMaxViewPlanes);
     for (std::uint32_t p = 0; p < to.plane_count; ++p) {
       to.planes[p].point_m = to_dds(from.planes[p].point_m);
@@ -232,6 +236,10 @@ bool DdsWorldViewReader::read_snapshot(WorldSnapshot& out) {
     to.finger_m = from_dds(from.finger_m);
     to.proxy_m = from_dds(from.proxy_m);
     to.force_N = from_dds(from.force_N);
+    to.oriented = from.oriented;
+    to.torque_Nm = from_dds(from.torque_Nm);
+    std::copy(std::begin(from.finger_wxyz), std::end(from.finger_wxyz), to.finger_wxyz.begin());
+    std::copy(std::begin(from.proxy_wxyz), std::end(from.proxy_wxyz), to.proxy_wxyz.begin());
     to.plane_count = std::min(from.plane_count, kMaxViewPlanes);
     for (std::uint32_t p = 0; p < to.plane_count; ++p) {
       to.planes[p].point_m = from_dds(from.planes[p].point_m);

@@ -71,7 +71,7 @@ const char* to_string(FrameError error) {
     case FrameError::checksum: return "checksum mismatch";
     case FrameError::count_out_of_range: return "count out of range";
     case FrameError::not_finite: return "non-finite number";
-    case FrameError::normal_not_unit: return "normal is not a unit vector";
+    case FrameError::normal_not_unit: return "normal or orientation is not of unit length";
     case FrameError::bad_period: return "world period is not positive, or a round trip is negative";
     case FrameError::bad_coupling: return "unknown coupling";
     case FrameError::bad_friction: return "friction coefficient negative or dynamic > static";
@@ -190,11 +190,17 @@ FrameError validate(const wire::HapticReport& report) {
   if (report.checksum != frame_checksum(report)) return FrameError::checksum;
   if (report.entry_count > kMaxImpulseEntries) return FrameError::count_out_of_range;
   if (!finite(report.haptic_time_s) || !all_finite(report.finger_m) || !all_finite(report.finger_velocity_mps) ||
-      !all_finite(report.proxy_m) || !all_finite(report.force_N) ||
+      !all_finite(report.proxy_m) || !all_finite(report.force_N) || !all_finite(report.torque_Nm) ||
       !all_finite(report.static_impulse_Ns) || !finite(report.link_round_trip_s)) {
     return FrameError::not_finite;
   }
+  // The grip's and the proxy's orientations must be unit quaternions, to the normals' tolerance.
+  for (const auto* q : {&report.finger_wxyz, &report.proxy_wxyz}) {
+    const double norm = std::sqrt((*q)[0] * (*q)[0] + (*q)[1] * (*q)[1] + (*q)[2] * (*q)[2] + (*q)[3] * (*q)[3]);
+    if (!(std::fabs(norm - 1.0) <= kUnitNormalTolerance)) return FrameError::normal_not_unit;
+  }
   if (report.link_round_trip_s < 0.0) return FrameError::bad_period;
+  if (report.oriented > 1) return FrameError::count_out_of_range;  // a flag: 0 or 1
   for (std::uint32_t k = 0; k < report.entry_count; ++k) {
     const wire::ObjectImpulse& entry = report.entries[k];
     if (!all_finite(entry.impulse_Ns) || !all_finite(entry.angular_impulse_Nms) ||

@@ -117,6 +117,11 @@ struct HapticReport {
   Vec3 finger_velocity_mps{};
   Vec3 proxy_m{};
   Vec3 force_N{};
+  std::uint32_t oriented = 0;
+  std::uint32_t reserved_oriented = 0;
+  Vec3 torque_Nm{};
+  std::array<double, 4> finger_wxyz{};
+  std::array<double, 4> proxy_wxyz{};
   std::uint32_t finger_valid = 0;
   std::uint32_t entry_count = 0;
   Vec3 static_impulse_Ns{};
