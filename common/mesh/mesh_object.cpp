@@ -49,16 +49,7 @@ std::string scene_folder(const std::string& scene_source) {
 }
 
 std::size_t load_scene_meshes(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw InputError(path + ": cannot open scene file");
-  std::stringstream text;
-  text << file.rdbuf();
-  nlohmann::json document;
-  try {
-    document = nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::exception& error) {
-    throw InputError(path + ": not JSON: " + error.what());
-  }
+  const nlohmann::json document = read_scene_document(path);
   const JsonNode root(document, "", path);
   if (!root.has("objects") || !document["objects"].is_array()) return 0;
   const JsonNode objects = root.child("objects");

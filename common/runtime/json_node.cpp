@@ -4,6 +4,8 @@
 #include "common/runtime/message_text.h"
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 namespace impetus {
 namespace {
@@ -118,6 +120,18 @@ double JsonNode::in_unit_interval() const {
   const double x = number();
   if (x < 0.0 || x > 1.0) fail("must be in [0, 1]");
   return x;
+}
+
+nlohmann::json read_scene_document(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw InputError(path + ": cannot open scene file");
+  std::stringstream text;
+  text << file.rdbuf();
+  try {
+    return nlohmann::json::parse(text.str());
+  } catch (const nlohmann::json::exception& error) {
+    throw InputError(path + ": not JSON: " + excerpt(error.what()));
+  }
 }
 
 std::array<double, 4> JsonNode::unit_quaternion() const {

@@ -23,6 +23,10 @@ namespace impetus {
 // Longest quote of a value or a key in a message: enough to find it in the file.
 inline constexpr std::size_t kMaxQuotedChars = 80;
 
+// The JSON document of the scene file at `path`, for a process that reads only part of it (the haptic controller's
+// meshes and tool, the viewer's). Throws InputError naming the file if it cannot be read or is not JSON.
+nlohmann::json read_scene_document(const std::string& path);
+
 // A short quote of a value for an error message: a scalar as written (at most kMaxQuotedChars), an array or object by
 // its size. Dumping a container would recurse once per nesting level and could quote megabytes.
 std::string quote_json(const nlohmann::json& value);

@@ -7,9 +7,20 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 
 namespace impetus::device_file {
+
+std::uint64_t hash_values(std::initializer_list<double> values) {
+  std::uint64_t hash = 0xcbf29ce484222325ull;
+  for (double value : values) {
+    unsigned char bytes[sizeof(double)];
+    std::memcpy(bytes, &value, sizeof bytes);
+    for (unsigned char byte : bytes) hash = (hash ^ byte) * 0x100000001b3ull;
+  }
+  return hash;
+}
 
 void fail(const std::string& path, const std::string& key, const std::string& reason) {
   throw SpidarGeometryError(path + ": " + key + ": " + reason);

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include <cstdint>
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
@@ -20,6 +21,15 @@ class SpidarGeometryError : public std::runtime_error {
 };
 
 namespace device_file {
+
+// Bounds every device file's values share: a string frame of 10 m is a room-sized SPIDAR; an encoder count above
+// 1 cm cannot resolve a contact; 1 kN is beyond any string and motor a person should be tied to.
+inline constexpr double kMaxFrameSide_m = 10.0;
+inline constexpr double kMaxMetresPerCount = 0.01;
+inline constexpr double kMaxForce_N = 1000.0;
+
+// FNV-1a over the values' bytes in their order: a device's hash of its values, not of its file's text.
+std::uint64_t hash_values(std::initializer_list<double> values);
 
 // The file's JSON object; throws for a file that cannot be read, is not JSON, or is not an object.
 nlohmann::json read(const std::string& path);

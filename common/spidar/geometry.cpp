@@ -14,12 +14,8 @@ SpidarGeometry load_spidar_geometry(const std::string& path) {
   const nlohmann::json document = device_file::read(path);
   device_file::check_keys(document, path, {"frame_side_m", "centre_m", "metres_per_count", "tension_min_N",
                                            "tension_max_N", "max_force_N"});
+  using device_file::kMaxForce_N, device_file::kMaxFrameSide_m, device_file::kMaxMetresPerCount;
   SpidarGeometry geometry;
-  // Bounds: a string frame of 10 m is a room-sized SPIDAR; an encoder count above 1 cm cannot resolve a contact;
-  // 1 kN is beyond any string and motor a person should be tied to.
-  constexpr double kMaxFrameSide_m = 10.0;
-  constexpr double kMaxMetresPerCount = 0.01;
-  constexpr double kMaxForce_N = 1000.0;
   geometry.frame_side_m = positive(document, path, "frame_side_m", geometry.frame_side_m, kMaxFrameSide_m);
   geometry.metres_per_count =
       positive(document, path, "metres_per_count", geometry.metres_per_count, kMaxMetresPerCount);
@@ -47,17 +43,9 @@ SpidarDevice parse_device_spec(const std::string& spec) {
 }
 
 std::uint64_t geometry_hash(const SpidarGeometry& geometry) {
-  // FNV-1a over the values' bytes, in a fixed order.
-  const double values[] = {geometry.frame_side_m,     geometry.centre_m[0],  geometry.centre_m[1],
-                           geometry.centre_m[2],      geometry.metres_per_count, geometry.tension_min_N,
-                           geometry.tension_max_N,    geometry.max_force_N};
-  std::uint64_t hash = 0xcbf29ce484222325ull;
-  for (double value : values) {
-    unsigned char bytes[sizeof(double)];
-    std::memcpy(bytes, &value, sizeof bytes);
-    for (unsigned char byte : bytes) hash = (hash ^ byte) * 0x100000001b3ull;
-  }
-  return hash;
+  return device_file::hash_values({geometry.frame_side_m, geometry.centre_m[0], geometry.centre_m[1],
+                                   geometry.centre_m[2], geometry.metres_per_count, geometry.tension_min_N,
+                                   geometry.tension_max_N, geometry.max_force_N});
 }
 
 }  // namespace impetus

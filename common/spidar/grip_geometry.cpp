@@ -14,12 +14,8 @@ SpidarGripGeometry load_grip_geometry(const std::string& path) {
   const nlohmann::json document = device_file::read(path);
   device_file::check_keys(document, path, {"frame_side_m", "centre_m", "grip_radius_m", "metres_per_count",
                                            "tension_min_N", "tension_max_N"});
+  using device_file::kMaxForce_N, device_file::kMaxFrameSide_m, device_file::kMaxMetresPerCount;
   SpidarGripGeometry geometry;
-  // Bounds, as the 4-string device's (geometry.cpp): a 10 m frame is room-sized, a count above 1 cm cannot resolve
-  // a contact, 1 kN is beyond any string a person should be tied to.
-  constexpr double kMaxFrameSide_m = 10.0;
-  constexpr double kMaxMetresPerCount = 0.01;
-  constexpr double kMaxForce_N = 1000.0;
   geometry.frame_side_m = positive(document, path, "frame_side_m", geometry.frame_side_m, kMaxFrameSide_m);
   geometry.centre_m = device_file::point(document, path, "centre_m", geometry.centre_m, kMaxFrameSide_m);
   // The grip moves only where its centre is farther than its radius from every face (grip_sim.h
@@ -50,24 +46,11 @@ GripDevice parse_grip_spec(const std::string& spec) {
 }
 
 std::uint64_t grip_geometry_hash(const SpidarGripGeometry& geometry) {
-  // FNV-1a over the values' bytes, in a fixed order (as geometry_hash, geometry.cpp), after a tag so that a grip
-  // device never hashes as a 4-string one of the same numbers.
-  const double values[] = {8.0,
-                           geometry.frame_side_m,
-                           geometry.centre_m[0],
-                           geometry.centre_m[1],
-                           geometry.centre_m[2],
-                           geometry.grip_radius_m,
-                           geometry.metres_per_count,
-                           geometry.tension_min_N,
-                           geometry.tension_max_N};
-  std::uint64_t hash = 0xcbf29ce484222325ull;
-  for (double value : values) {
-    unsigned char bytes[sizeof(double)];
-    std::memcpy(bytes, &value, sizeof bytes);
-    for (unsigned char byte : bytes) hash = (hash ^ byte) * 0x100000001b3ull;
-  }
-  return hash;
+  // The values after a tag (its string count), so that a grip device never hashes as a 4-string one of the same
+  // numbers.
+  return device_file::hash_values({8.0, geometry.frame_side_m, geometry.centre_m[0], geometry.centre_m[1],
+                                   geometry.centre_m[2], geometry.grip_radius_m, geometry.metres_per_count,
+                                   geometry.tension_min_N, geometry.tension_max_N});
 }
 
 }  // namespace impetus

@@ -7,9 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <fstream>
 #include <span>
-#include <sstream>
 #include <string_view>
 
 namespace impetus {
@@ -96,16 +94,7 @@ ToolBlock parse_tool_block(const JsonNode& node, const Vec3& gravity_mps2) {
 }
 
 std::optional<ToolBlock> load_scene_tool(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw InputError(path + ": cannot open scene file");
-  std::stringstream text;
-  text << file.rdbuf();
-  nlohmann::json document;
-  try {
-    document = nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::exception& error) {
-    throw InputError(path + ": not JSON: " + excerpt(error.what()));
-  }
+  const nlohmann::json document = read_scene_document(path);
   const JsonNode root(document, "", path);
   root.expect_object();
   if (!root.has("tool")) return std::nullopt;

@@ -121,6 +121,16 @@ async function live(procs, browser) {
     `used ${(100 * viewerCpu).toFixed(1)} % of a core serving one page`);
 }
 
+// Plays a replay at 10 times its speed to its end; the page's last frame.
+async function playToEnd(page, scene) {
+  await page.evaluate(() => window.impetusView.send({ speed: 10 }));
+  const end = scene.replay.end_s;
+  return waitFor("the end of the replay", async () => {
+    const state = await view(page);
+    return state?.latest && Math.abs(state.latest.worldTime_s - end) < 1e-9 ? state.latest : null;
+  }, 30000, 100);
+}
+
 // A lockstep trial replayed: the replay reaches the trial's final pose.
 async function replay(procs, browser) {
   const trial = path.join(outDir, "trial");
@@ -130,12 +140,7 @@ async function replay(procs, browser) {
   const page = await openPage(browser, viewer.url);
   const scene = await waitFor("the replay's scene", async () => (await view(page))?.scene);
   check(scene.mode === "replay", "the page is in replay mode");
-  await page.evaluate(() => window.impetusView.send({ speed: 10 }));
-  const end = scene.replay.end_s;
-  const last = await waitFor("the end of the replay", async () => {
-    const state = await view(page);
-    return state?.latest && Math.abs(state.latest.worldTime_s - end) < 1e-9 ? state.latest : null;
-  }, 30000, 100);
+  const last = await playToEnd(page, scene);
   const cube = last.bodies.find((b) => b.name === "cube");
   const final = summary.objects.cube.position;
   const errorMm = 1000 * distance(cube.position_m, final);
@@ -509,12 +514,7 @@ with impetus.ToolSimulation(impetus.shipped_scene("peg_in_hole"), start_m=[0, 0,
   check(scene.tool?.shape === "box" && scene.tool.size_m.join() === "0.01,0.01,0.04",
     `the scene message carries the tool: a ${scene.tool?.shape} of ${scene.tool?.size_m?.join(" × ")} m`);
   check(Math.abs(scene.tool.placement.position_m[2] + 0.03) < 1e-12, "placed 3 cm below the grip, as the scene has it");
-  await page.evaluate(() => window.impetusView.send({ speed: 10 }));
-  const end = scene.replay.end_s;
-  const last = await waitFor("the end of the replay", async () => {
-    const state = await view(page);
-    return state?.latest && Math.abs(state.latest.worldTime_s - end) < 1e-9 ? state.latest : null;
-  }, 30000, 100);
+  const last = await playToEnd(page, scene);
   const shown = last.tool;
   check(shown?.valid && shown.drawn, "the tool is drawn at the end of the replay");
   // The frame shows a row of the tool's log: its proxy and grip poses together, as logged.

@@ -50,6 +50,25 @@ std::vector<double> values_of(const std::string& message) {
 
 }  // namespace
 
+namespace {
+
+// The first frame a live feed over DDS shows of `snapshot`: snapshots are best effort, so it is published again, as
+// a world does every step, until one is shown (nullptr after 2 s).
+std::shared_ptr<const std::string> first_frame(view::LiveFeed& feed, DdsWorldViewPublisher& publisher,
+                                               const WorldSnapshot& snapshot) {
+  view::Playback playback;
+  std::shared_ptr<const std::string> frame;
+  for (int attempt = 0; attempt < 400 && frame == nullptr; ++attempt) {
+    publisher.publish_snapshot(snapshot);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    feed.poll();
+    frame = feed.next_frame(playback, 0.0);
+  }
+  return frame;
+}
+
+}  // namespace
+
 TEST_CASE("the world's snapshot carries every body's pose and the finger, the shm view passes it whole") {
   prepare_engines();
   const Scene scene = load_scene(std::string(IMPETUS_SOURCE_DIR) + "/scenes/tap.json");
@@ -118,15 +137,7 @@ TEST_CASE("over DDS a live feed shows a world publishing in its partition, every
   view::LiveFeed feed(describe(dds), [dds]() -> std::unique_ptr<WorldViewReader> {
     return std::make_unique<DdsWorldViewReader>(dds);
   });
-  // Snapshots are best effort: keep publishing, as a world does every step, until one is shown.
-  view::Playback playback;
-  std::shared_ptr<const std::string> frame;
-  for (int attempt = 0; attempt < 400 && frame == nullptr; ++attempt) {
-    publisher.publish_snapshot(*snapshot);
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    feed.poll();
-    frame = feed.next_frame(playback, 0.0);
-  }
+  const std::shared_ptr<const std::string> frame = first_frame(feed, publisher, *snapshot);
   REQUIRE(feed.scene() != nullptr);
   CHECK(feed.scene()->find(scene.objects[0].name) != std::string::npos);
   REQUIRE(frame != nullptr);
@@ -180,14 +191,7 @@ TEST_CASE("a tool's report reaches a live page: its grip's and proxy's poses and
     return std::make_unique<DdsWorldViewReader>(dds);
   });
   feed.set_tool(scene.tool->shape);
-  view::Playback playback;
-  std::shared_ptr<const std::string> frame;
-  for (int attempt = 0; attempt < 400 && frame == nullptr; ++attempt) {
-    publisher.publish_snapshot(*snapshot);
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    feed.poll();
-    frame = feed.next_frame(playback, 0.0);
-  }
+  const std::shared_ptr<const std::string> frame = first_frame(feed, publisher, *snapshot);
   REQUIRE(feed.scene() != nullptr);
   CHECK(nlohmann::json::parse(*feed.scene()).at("tool").at("size_m")[2] == 0.04);
   REQUIRE(frame != nullptr);
