@@ -2,9 +2,9 @@
 #include "spidar_sim/device_node.h"
 
 #include "common/runtime/lockstep.h"
-#include "spidar_sim/grip_device_sim.h"
 #include "common/runtime/process.h"
 #include "common/runtime/realtime_clock.h"
+#include "spidar_sim/grip_device_sim.h"
 
 #include <algorithm>
 #include <cstdio>
