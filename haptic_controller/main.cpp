@@ -3,12 +3,11 @@
 // the world link and runs a HapticNode on them; writes the haptic half of summary.json at exit.
 
 #include "common/link/dds/open_world_link.h"
-#include "common/mesh/mesh_object.h"
 #include "common/runtime/cli.h"
-#include "common/tool/tool_block.h"
 #include "haptic_controller/device/device_registry.h"
 #include "haptic_controller/device/hosted_device.h"
 #include "haptic_controller/haptic_node.h"
+#include "haptic_controller/scene_inputs.h"
 
 #include <memory>
 #include <optional>
@@ -65,19 +64,7 @@ int main(int argc, char** argv) {
   return run_node("haptic_controller", [&] {
     options.haptic_session = new_session_id();
     const std::unique_ptr<DeviceType> device_type = parse_device(device_spec);
-    if (!mesh_scene.empty()) {
-      load_scene_meshes(mesh_scene);
-      if (tool_scene.empty() && load_scene_tool(mesh_scene)) {
-        std::fprintf(stderr, "haptic_controller: warning: %s has a tool (its \"tool\" block), and this controller "
-                     "renders point fingers: --device grip --tool-from SCENE renders the tool\n", mesh_scene.c_str());
-      }
-    }
-    if (!tool_scene.empty()) {
-      const std::optional<ToolBlock> tool = load_scene_tool(tool_scene);
-      if (!tool) throw std::invalid_argument("--tool-from " + tool_scene + ": the scene has no \"tool\" block");
-      options.tool = tool->shape;
-      options.tool_coupling = tool->coupling;
-    }
+    read_scene_inputs(mesh_scene, tool_scene, options);
     if (link_options.kind == LinkKind::dds && !world_shm.empty()) {
       throw std::invalid_argument("--world-shm names a shared-memory world link; with --link dds the world is found "
                                   "by --dds-domain and --dds-partition");

@@ -6,9 +6,8 @@
 
 #include "common/link/shm/shm_device_port.h"
 #include "common/runtime/cli.h"
-#include "common/spidar/grip_geometry.h"
-#include "spidar_sim/grip_device_sim.h"
 #include "spidar_sim/simulated_fingers.h"
+#include "spidar_sim/simulated_grip.h"
 
 #include <memory>
 #include <string>
@@ -75,26 +74,12 @@ int main(int argc, char** argv) {
   }
 
   return run_node("spidar_sim", [&] {
-    if (device_spec == "grip" || device_spec.rfind("grip:", 0) == 0) {
-      // One grip, held by a hand whose linear impedance the hand flags set (the turn's stays the grip hand's).
+    if (names_grip(device_spec)) {
       for (const char* flag : {"--finger", "--finger-mass", "--motor-lag"}) {
         if (app.count(flag) > 0) throw std::invalid_argument(std::string(flag) + " is not for --device grip");
       }
-      const GripDevice grip = parse_grip_spec(device_spec);
-      GripHandParams hand;
-      hand.stiffness_Npm = finger.hand_stiffness_Npm;
-      hand.damping_Nspm = finger.hand_damping_Nspm;
-      GripDeviceSim sim(grip.geometry, hand, load_trajectory(trajectory_spec));
-      ShmDevicePortClient port(shm, clock, attach_timeout_s,
-                               DeviceDescription{grip_geometry_hash(grip.geometry), grip.source}, 0);
-      GripDeviceNode node(sim, port, log_path, new_session_id());
-      node.set_world_wait(world_wait_s);
-      std::fprintf(stderr, "spidar_sim: the grip attached to '%s' (%s)\n", port.name().c_str(), to_string(clock));
-      const int status = node.run();
-      write_summary(summary_path, node.summary());
-      std::fprintf(stderr, "spidar_sim: detached after %llu ticks (%.3f s simulated)\n",
-                   static_cast<unsigned long long>(node.ticks()), sim.time_s());
-      return status;
+      return run_simulated_grip({device_spec, trajectory_spec, shm, clock, attach_timeout_s, world_wait_s, log_path,
+                                 summary_path, finger});
     }
     const SpidarDevice spidar = parse_device_spec(device_spec);
     std::vector<std::unique_ptr<ShmDevicePortClient>> ports;  // declared first: they outlive the nodes that hold them

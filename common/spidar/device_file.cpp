@@ -12,6 +12,15 @@
 
 namespace impetus::device_file {
 
+std::string spec_file(const std::string& spec, const std::string& name, const std::string& message) {
+  if (spec == name) return {};
+  const std::string prefix = name + ":";
+  if (spec.rfind(prefix, 0) != 0 || spec.size() == prefix.size()) {
+    throw SpidarGeometryError(message + ", got '" + excerpt(spec, 80) + "'");
+  }
+  return spec.substr(prefix.size());
+}
+
 std::uint64_t hash_values(std::initializer_list<double> values) {
   std::uint64_t hash = 0xcbf29ce484222325ull;
   for (double value : values) {

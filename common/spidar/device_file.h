@@ -28,6 +28,10 @@ inline constexpr double kMaxFrameSide_m = 10.0;
 inline constexpr double kMaxMetresPerCount = 0.01;
 inline constexpr double kMaxForce_N = 1000.0;
 
+// The file a device spec names: "" for `name` alone (the built-in device), FILE for "name:FILE"; throws for anything
+// else, with `message` (what the spec must be) and the spec quoted.
+std::string spec_file(const std::string& spec, const std::string& name, const std::string& message);
+
 // FNV-1a over the values' bytes in their order: a device's hash of its values, not of its file's text.
 std::uint64_t hash_values(std::initializer_list<double> values);
 

@@ -32,13 +32,10 @@ SpidarGeometry load_spidar_geometry(const std::string& path) {
 
 SpidarDevice parse_device_spec(const std::string& spec) {
   SpidarDevice device;
-  if (spec == "spidar") return device;
-  const std::string prefix = "spidar:";
-  if (spec.rfind(prefix, 0) != 0 || spec.size() == prefix.size()) {
-    throw SpidarGeometryError("--device must be 'spidar' or 'spidar:FILE.json', got '" + spec + "'");
-  }
-  device.source = spec.substr(prefix.size());
-  device.geometry = load_spidar_geometry(device.source);
+  const std::string file = device_file::spec_file(spec, "spidar", "--device must be 'spidar' or 'spidar:FILE.json'");
+  if (file.empty()) return device;
+  device.source = file;
+  device.geometry = load_spidar_geometry(file);
   return device;
 }
 

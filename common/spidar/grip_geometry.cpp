@@ -35,13 +35,10 @@ SpidarGripGeometry load_grip_geometry(const std::string& path) {
 
 GripDevice parse_grip_spec(const std::string& spec) {
   GripDevice device;
-  if (spec == "grip") return device;
-  const std::string prefix = "grip:";
-  if (spec.rfind(prefix, 0) != 0 || spec.size() == prefix.size()) {
-    throw SpidarGeometryError("the device must be 'grip' or 'grip:FILE.json', got '" + excerpt(spec, 80) + "'");
-  }
-  device.source = spec.substr(prefix.size());
-  device.geometry = load_grip_geometry(device.source);
+  const std::string file = device_file::spec_file(spec, "grip", "the device must be 'grip' or 'grip:FILE.json'");
+  if (file.empty()) return device;
+  device.source = file;
+  device.geometry = load_grip_geometry(file);
   return device;
 }
 
