@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -82,6 +83,16 @@ double distance_to_segment(const Eigen::Vector3d& point, const Eigen::Vector3d& 
 
 namespace tool_detail {
 
+// A body's edge placed in the world: from from_m along along_m, and the ball about its middle that holds it.
+struct PlacedEdge {
+  const ContactEdge* edge;
+  int index;
+  Eigen::Vector3d from_m;
+  Eigen::Vector3d along_m;
+  Eigen::Vector3d middle_m;
+  double half_reach_m;  // half its length plus its radius
+};
+
 // A body placed in the world, as the contacts see it: its shape, centre, turn (body → world), bounding radius,
 // samples and edges.
 struct PlacedBody {
@@ -101,18 +112,27 @@ struct PlacedBody {
     const SurfacePoint body = nearest_surface_point_body(*shape, rotation.transpose() * (world_m - centre_m));
     return {point(body.point_m), rotation * body.normal, body.signed_distance_m};
   }
-  // The edges (indices) that pass within `within_m` of a ball of `radius_m` about `centre_m`.
+  // The edges that pass within `within_m` of a ball of `radius_m` about `centre_m`, placed in the world; the least
+  // amount by which another missed `within_m` lowers `missed_m`.
   int edges_near(const Eigen::Vector3d& centre_m, double radius_m, double within_m,
-                 std::array<int, kMaxContactEdges>& near) const {
+                 std::array<PlacedEdge, kMaxContactEdges>& near, double& missed_m) const {
     const Eigen::Vector3d here_m = local(centre_m);  // in the body's frame, where its edges are given
     int count = 0;
     for (int k = 0; k < edge_count; ++k) {
       const ContactEdge& edge = (*edges)[static_cast<std::size_t>(k)];
-      if (distance_to_segment(here_m, edge.from_m, edge.to_m) - edge.radius_m - radius_m <= within_m) {
-        near[static_cast<std::size_t>(count++)] = k;
+      const double beyond_m = distance_to_segment(here_m, edge.from_m, edge.to_m) - edge.radius_m - radius_m - within_m;
+      if (beyond_m > 0.0) {
+        missed_m = std::min(missed_m, beyond_m);
+        continue;
       }
+      near[static_cast<std::size_t>(count++)] = placed_edge(k);
     }
     return count;
+  }
+  PlacedEdge placed_edge(int k) const {
+    const ContactEdge& edge = (*edges)[static_cast<std::size_t>(k)];
+    const Eigen::Vector3d from_m = point(edge.from_m), along_m = rotation * (edge.to_m - edge.from_m);
+    return {&edge, k, from_m, along_m, from_m + 0.5 * along_m, 0.5 * along_m.norm() + edge.radius_m};
   }
 };
 
@@ -121,6 +141,7 @@ struct PlacedBody {
 namespace {
 
 using tool_detail::PlacedBody;
+using tool_detail::PlacedEdge;
 using Kind = ToolConstraint::Kind;
 
 // A contact's point on the object is its point on the tool moved back by the gap along the normal: the two differ
@@ -187,14 +208,14 @@ ToolConstraint object_sample_on_tool(std::int32_t index, const ContactPlane& pla
 // such normal (not an edge contact). The closest points of two lines are apart along that normal, so |gap| is their
 // distance: the bound keeps a pair whose lines cross far behind each other (a peg's edge in a hole and the hole's
 // outer rim) from being taken for an edge the tool is deep into.
-bool edge_pair(std::int32_t index, const ContactPlane& plane, const PlacedBody& tool, int i, const PlacedBody& object,
-               int j, double within_m, ToolConstraint& out) {
-  const ContactEdge& tool_edge = (*tool.edges)[static_cast<std::size_t>(i)];
-  const ContactEdge& object_edge = (*object.edges)[static_cast<std::size_t>(j)];
-  const Eigen::Vector3d p_m = tool.point(tool_edge.from_m);
-  const Eigen::Vector3d d_m = tool.rotation * (tool_edge.to_m - tool_edge.from_m);
-  const Eigen::Vector3d q_m = object.point(object_edge.from_m);
-  const Eigen::Vector3d e_m = object.rotation * (object_edge.to_m - object_edge.from_m);
+bool edge_pair(std::int32_t index, const ContactPlane& plane, const PlacedBody& tool, const PlacedEdge& tool_placed,
+               const PlacedBody& object, const PlacedEdge& object_placed, double within_m, ToolConstraint& out) {
+  const ContactEdge& tool_edge = *tool_placed.edge;
+  const ContactEdge& object_edge = *object_placed.edge;
+  const Eigen::Vector3d& p_m = tool_placed.from_m;
+  const Eigen::Vector3d& d_m = tool_placed.along_m;
+  const Eigen::Vector3d& q_m = object_placed.from_m;
+  const Eigen::Vector3d& e_m = object_placed.along_m;
   double s = 0.0, t = 0.0;
   if (!crossing(p_m, d_m, q_m, e_m, s, t)) return false;
   const Eigen::Vector3d on_tool_m = p_m + s * d_m, on_object_m = q_m + t * e_m;
@@ -222,42 +243,49 @@ bool edge_pair(std::int32_t index, const ContactPlane& plane, const PlacedBody& 
                  on_object_m + object_edge.radius_m * normal,
                  gap_m,
                  Kind::edges,
-                 static_cast<std::int16_t>(i),
-                 static_cast<std::int16_t>(j)});
+                 static_cast<std::int16_t>(tool_placed.index),
+                 static_cast<std::int16_t>(object_placed.index)});
   return true;
 }
 
 // Every pair of the tool's and the object's edges near each other (`within_m`: how far apart, or how deep, a contact
 // may be and still act) that cross as an edge contact (edge_pair): visit(the constraint); with `open_pairs`, also
-// those within reach that do not cross yet, as open constraints (gap kOpenGap_m).
+// those within reach that do not cross yet, as open constraints (gap kOpenGap_m). The least amount by which a pair
+// left out missed `within_m` lowers `missed_m`.
 template <typename Visit>
 void visit_crossings(std::int32_t index, const ContactPlane& plane, const PlacedBody& tool, const PlacedBody& object,
-                     double within_m, bool open_pairs, Visit&& visit) {
-  std::array<int, kMaxContactEdges> tool_near{}, object_near{};
-  const int tool_count = tool.edges_near(object.centre_m, object.radius_m, within_m, tool_near);
+                     double within_m, bool open_pairs, double& missed_m, Visit&& visit) {
+  std::array<PlacedEdge, kMaxContactEdges> tool_near, object_near;
+  const int tool_count = tool.edges_near(object.centre_m, object.radius_m, within_m, tool_near, missed_m);
   if (tool_count == 0) return;
-  const int object_count = object.edges_near(tool.centre_m, tool.radius_m, within_m, object_near);
+  const int object_count = object.edges_near(tool.centre_m, tool.radius_m, within_m, object_near, missed_m);
   for (int a = 0; a < tool_count; ++a) {
-    const int i = tool_near[static_cast<std::size_t>(a)];
+    const PlacedEdge& tool_edge = tool_near[static_cast<std::size_t>(a)];
     for (int b = 0; b < object_count; ++b) {
-      const int j = object_near[static_cast<std::size_t>(b)];
+      const PlacedEdge& object_edge = object_near[static_cast<std::size_t>(b)];
+      // Two edges are no nearer than their middles' distance less the balls about them that hold them.
+      const double apart_m =
+          (tool_edge.middle_m - object_edge.middle_m).norm() - tool_edge.half_reach_m - object_edge.half_reach_m;
+      if (apart_m > within_m) {
+        missed_m = std::min(missed_m, apart_m - within_m);
+        continue;
+      }
       ToolConstraint constraint;
-      if (edge_pair(index, plane, tool, i, object, j, within_m, constraint)) {
+      if (edge_pair(index, plane, tool, tool_edge, object, object_edge, within_m, constraint)) {
         visit(constraint);
       } else if (open_pairs) {
         // Not crossing here, but within reach: a move may bring their crossing onto both (a corner sliding onto the
         // other's edge). Listed open, for a later pass to measure again.
-        const ContactEdge& tool_edge = (*tool.edges)[static_cast<std::size_t>(i)];
-        const ContactEdge& object_edge = (*object.edges)[static_cast<std::size_t>(j)];
         const double distance_m =
-            segment_distance(tool.point(tool_edge.from_m), tool.rotation * (tool_edge.to_m - tool_edge.from_m),
-                             object.point(object_edge.from_m),
-                             object.rotation * (object_edge.to_m - object_edge.from_m)) -
-            tool_edge.radius_m - object_edge.radius_m;
-        if (distance_m > within_m) continue;
-        constraint = {index, plane.object_id, Eigen::Vector3d::UnitZ(), tool.point(tool_edge.from_m),
-                      object.point(object_edge.from_m), kOpenGap_m, Kind::edges, static_cast<std::int16_t>(i),
-                      static_cast<std::int16_t>(j)};
+            segment_distance(tool_edge.from_m, tool_edge.along_m, object_edge.from_m, object_edge.along_m) -
+            tool_edge.edge->radius_m - object_edge.edge->radius_m;
+        if (distance_m > within_m) {
+          missed_m = std::min(missed_m, distance_m - within_m);
+          continue;
+        }
+        constraint = {index, plane.object_id, Eigen::Vector3d::UnitZ(), tool_edge.from_m, object_edge.from_m,
+                      kOpenGap_m, Kind::edges, static_cast<std::int16_t>(tool_edge.index),
+                      static_cast<std::int16_t>(object_edge.index)};
         visit(constraint);
       }
     }
@@ -388,7 +416,8 @@ bool ToolContacts::path_clear(const PlaneSet& planes, const BodyPose& from, cons
     }
     // Crossing edges that overlap where the way ends, no deeper than the tool travelled (it started clear).
     bool overlap = false;
-    visit_crossings(static_cast<std::int32_t>(j), plane, end_tool, placed, travel_m, false,
+    double missed_m = 0.0;  // not needed here
+    visit_crossings(static_cast<std::int32_t>(j), plane, end_tool, placed, travel_m, false, missed_m,
                     [&](const ToolConstraint& constraint) { overlap = overlap || constraint.gap_m < 0.0; });
     if (overlap) return false;
   }
@@ -397,62 +426,82 @@ bool ToolContacts::path_clear(const PlaneSet& planes, const BodyPose& from, cons
 
 int ToolContacts::gather(const PlaneSet& planes, const BodyPose& grip, const ToolReach& reach) {
   count_ = 0;
+  missed_m_ = std::numeric_limits<double>::infinity();
+  const std::uint64_t overflow_before = overflow_;
   const BodyPose pose_now = tool_pose(grip);
   const PlacedBody tool = placed_tool(pose_now);
   // How far any point of the tool can travel in this solve: from the lever of its farthest point.
   const double tool_reach_m = reach.at((pose_now.position_m - grip.position_m).norm() + shape_radius_m_);
+  // Each test below leaves a feature out when a bound on its gap exceeds the reach; by how much, the least of them.
+  const auto within = [&](double gap_bound_m, double reach_m) {
+    if (gap_bound_m <= reach_m) return true;
+    missed_m_ = std::min(missed_m_, gap_bound_m - reach_m);
+    return false;
+  };
+  const auto add_within = [&](const ToolConstraint& constraint) {
+    const double lever_m = (constraint.tool_point_m - grip.position_m).norm();
+    if (within(constraint.gap_m, reach.at(lever_m))) add(constraint, lever_m, reach);
+  };
   for (std::uint32_t j = 0; j < planes.count; ++j) {
     const ContactPlane& plane = planes.planes[j];
     const auto index = static_cast<std::int32_t>(j);
     if (!plane.shaped() || !plane.shape_traits().convex) {
       // A half-space as sent: the tool's samples stay in front of it, within the part of it that describes its
       // object (a mesh's plane, extent_m), or all of it (the floor).
-      if (plane.normal.dot(pose_now.position_m - plane.point_m) - shape_radius_m_ > tool_reach_m) continue;
+      if (!within(plane.normal.dot(pose_now.position_m - plane.point_m) - shape_radius_m_, tool_reach_m)) continue;
       const double extent_m = plane.describes_within_m();
       for (int k = 0; k < sample_count_; ++k) {
         const ToolConstraint constraint = tool_sample_on_plane(index, plane, tool, k);
-        const double lever_m = (constraint.tool_point_m - grip.position_m).norm();
-        if (constraint.gap_m > reach.at(lever_m)) continue;
         if (extent_m > 0.0 && (constraint.object_point_m - plane.point_m).norm() > extent_m) continue;
-        add(constraint, lever_m, reach);
+        add_within(constraint);
       }
       continue;
     }
     const CachedSamples& object = object_features(plane);
     const PlacedBody placed = placed_object(plane, object);
-    if ((placed.centre_m - pose_now.position_m).norm() - shape_radius_m_ - object.radius_m > tool_reach_m) continue;
+    if (!within((placed.centre_m - pose_now.position_m).norm() - shape_radius_m_ - object.radius_m, tool_reach_m)) {
+      continue;
+    }
 
     // The tool's samples against the object's surface; first whether the object's bounding ball is in reach, in the
     // tool's own frame (no sample moved into the world for that).
     const Eigen::Vector3d object_in_tool_m = tool.local(placed.centre_m);
     for (int k = 0; k < sample_count_; ++k) {
       const ContactSample& sample = samples_[static_cast<std::size_t>(k)];
-      if ((sample.point_m - object_in_tool_m).norm() - sample.radius_m - object.radius_m > tool_reach_m) continue;
-      const ToolConstraint constraint = tool_sample_on_body(index, plane, tool, placed, k);
-      const double lever_m = (constraint.tool_point_m - grip.position_m).norm();
-      if (constraint.gap_m <= reach.at(lever_m)) add(constraint, lever_m, reach);
+      if (!within((sample.point_m - object_in_tool_m).norm() - sample.radius_m - object.radius_m, tool_reach_m)) {
+        continue;
+      }
+      add_within(tool_sample_on_body(index, plane, tool, placed, k));
     }
     // The object's samples against the tool's surface, the same way round.
     const Eigen::Vector3d tool_in_object_m = placed.local(pose_now.position_m);
     for (int k = 0; k < object.count; ++k) {
       const ContactSample& sample = object.samples[static_cast<std::size_t>(k)];
-      if ((sample.point_m - tool_in_object_m).norm() - sample.radius_m - shape_radius_m_ > tool_reach_m) continue;
-      const ToolConstraint constraint = object_sample_on_tool(index, plane, tool, placed, k);
-      const double lever_m = (constraint.tool_point_m - grip.position_m).norm();
-      if (constraint.gap_m <= reach.at(lever_m)) add(constraint, lever_m, reach);
+      if (!within((sample.point_m - tool_in_object_m).norm() - sample.radius_m - shape_radius_m_, tool_reach_m)) {
+        continue;
+      }
+      add_within(object_sample_on_tool(index, plane, tool, placed, k));
     }
     // The edges that cross.
-    visit_crossings(index, plane, tool, placed, tool_reach_m, true, [&](const ToolConstraint& constraint) {
-      const double lever_m = (constraint.tool_point_m - grip.position_m).norm();
-      if (constraint.gap_m <= reach.at(lever_m) || constraint.gap_m == kOpenGap_m) add(constraint, lever_m, reach);
+    visit_crossings(index, plane, tool, placed, tool_reach_m, true, missed_m_, [&](const ToolConstraint& constraint) {
+      if (constraint.gap_m == kOpenGap_m) {
+        add(constraint, (constraint.tool_point_m - grip.position_m).norm(), reach);
+      } else {
+        add_within(constraint);
+      }
     });
   }
+  // A list that had to drop constraints depends on the reach through their ranking: not complete for a larger one.
+  if (overflow_ != overflow_before) missed_m_ = 0.0;
   return count_;
 }
 
 void ToolContacts::refresh(const PlaneSet& planes, const BodyPose& grip, const ToolReach& reach) {
   const BodyPose pose_now = tool_pose(grip);
   const PlacedBody tool = placed_tool(pose_now);
+  // Gathered object by object: each object is placed once for its run of constraints.
+  PlacedBody placed{};
+  std::int32_t placed_plane = -1;
   for (int k = 0; k < count_; ++k) {
     ToolConstraint& c = constraints_[static_cast<std::size_t>(k)];
     const ContactPlane& plane = planes.planes[static_cast<std::size_t>(c.plane)];
@@ -460,13 +509,16 @@ void ToolContacts::refresh(const PlaneSet& planes, const BodyPose& grip, const T
       c = tool_sample_on_plane(c.plane, plane, tool, c.tool_feature);
       continue;
     }
-    const PlacedBody placed = placed_object(plane, object_features(plane));
+    if (c.plane != placed_plane) {
+      placed = placed_object(plane, object_features(plane));
+      placed_plane = c.plane;
+    }
     switch (c.kind) {
       case Kind::tool_sample: c = tool_sample_on_body(c.plane, plane, tool, placed, c.tool_feature); break;
       case Kind::object_sample: c = object_sample_on_tool(c.plane, plane, tool, placed, c.object_feature); break;
       case Kind::edges:
-        if (!edge_pair(c.plane, plane, tool, c.tool_feature, placed, c.object_feature,
-                       reach.at((c.tool_point_m - grip.position_m).norm()), c)) {
+        if (!edge_pair(c.plane, plane, tool, tool.placed_edge(c.tool_feature), placed,
+                       placed.placed_edge(c.object_feature), reach.at((c.tool_point_m - grip.position_m).norm()), c)) {
           c.gap_m = kOpenGap_m;
         }
         break;

@@ -68,6 +68,9 @@ class ToolContacts {
   // The constraints at grip pose `grip` that `reach` can close, nearest first when there are more than
   // kMaxToolConstraints (the farthest dropped and counted in overflow()).
   int gather(const PlaneSet& planes, const BodyPose& grip, const ToolReach& reach);
+  // Whether gathering again at the same pose with the reach's linear part grown by `growth_m` would list the same
+  // constraints: every feature the last gather left out missed its reach by more than that.
+  bool complete_for_growth(double growth_m) const { return missed_m_ > growth_m + kGrowthRounding_m; }
   // The same constraints (the same features of the same objects) measured again at grip pose `grip`: for the god-
   // object's later passes in a tick, whose moves stay within the reach they were gathered for.
   void refresh(const PlaneSet& planes, const BodyPose& grip, const ToolReach& reach);
@@ -115,6 +118,11 @@ class ToolContacts {
   std::array<ToolConstraint, kMaxToolConstraints> constraints_{};
   std::array<double, kMaxToolConstraints> slack_m_{};  // gap − reach at the constraint's lever (≤ 0)
   int count_ = 0;
+  // The least amount by which a feature the last gather left out missed its reach (0 when that gather dropped
+  // constraints for room: a larger reach may rank them differently).
+  double missed_m_ = 0.0;
+  // Rounding room for complete_for_growth: the reach grown and the bounds compared are each rounded once.
+  static constexpr double kGrowthRounding_m = 1e-12;
   std::uint64_t overflow_ = 0;
   std::array<CachedSamples, kMaxServoPlanes> cache_{};
   int cached_ = 0;

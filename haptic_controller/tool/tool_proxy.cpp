@@ -277,7 +277,9 @@ Vector6d ToolProxy::pass(const PlaneSet& planes, const Vector6d& target, bool ga
     }
     if (deepest_m > 0.0) {
       reach.linear_m += 2.0 * deepest_m;
-      count = contacts_.gather(planes, proxy_, reach);
+      // Gathered again only if a feature left out missed the reach by less than it grew (most such overlaps are the
+      // last pass's linearised turn, nanometres deep).
+      if (!contacts_.complete_for_growth(2.0 * deepest_m)) count = contacts_.gather(planes, proxy_, reach);
     }
     gathered_ = reach;
     ++result_.gathers;

@@ -699,3 +699,46 @@ TEST_CASE("tool: an object's jump into the pressed tool is let out over the rele
     CHECK(first_N - before_N < coupling.stiffness_Npm * 0.3e-3 + coupling.damping_Nspm * 0.3e-3 / kTick_s + 0.01);
   }
 }
+
+// A gather that says a grown reach would list nothing more (ToolContacts::complete_for_growth, which lets the
+// god-object skip gathering again for an overlap) lists exactly what gathering again with that reach lists, at every
+// pose of a wander through the clutter; and the claim is not empty: grown past it, the list does grow.
+TEST_CASE("tool: a gather complete for a grown reach lists what gathering again with it lists") {
+  const PlaneSet planes = impetus::test::clutter();
+  for (const ToolShape& tool : {peg_tool(), impetus::test::probe_tool()}) {
+    CAPTURE(to_string(tool.shape.kind));
+    ToolProxy proxy(tool, ToolCoupling{});
+    ToolContacts contacts(tool);
+    int compared = 0, grew = 0, mismatched = 0;
+    impetus::test::wander(proxy, planes, Vector3d(0.0, 0.0, 0.05), 4000, [] {},
+                          [&](int tick, const BodyPose& grip, const ToolResult&) {
+      if (tick % 10 != 0) return;
+      const ToolReach reach{2e-3, 0.02};
+      const int count = contacts.gather(planes, grip, reach);
+      std::vector<ToolConstraint> first(count);
+      for (int k = 0; k < count; ++k) first[static_cast<std::size_t>(k)] = contacts[k];
+      for (const double growth_m : {1e-6, 1e-4, 1e-3, 1e-2}) {
+        const bool complete = contacts.complete_for_growth(growth_m);
+        ToolContacts again(tool);
+        const int grown = again.gather(planes, grip, ToolReach{reach.linear_m + growth_m, reach.angular_rad});
+        bool same = grown == count;
+        for (int k = 0; same && k < count; ++k) {
+          const ToolConstraint& a = first[static_cast<std::size_t>(k)];
+          const ToolConstraint& b = again[k];
+          same = a.plane == b.plane && a.kind == b.kind && a.tool_feature == b.tool_feature &&
+                 a.object_feature == b.object_feature && a.gap_m == b.gap_m;
+        }
+        if (complete) {
+          ++compared;
+          mismatched += same ? 0 : 1;
+        } else {
+          grew += grown > count ? 1 : 0;
+        }
+      }
+    });
+    CAPTURE(compared, grew, mismatched);
+    CHECK(compared > 100);
+    CHECK(grew > 100);
+    CHECK(mismatched == 0);
+  }
+}
