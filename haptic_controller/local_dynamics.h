@@ -15,6 +15,11 @@
 //     v ← v + g·h                                               drift: gravity ...
 //     for each contact n (unilateral):                          ... the supports ...
 //       P = max(0, −v·n);  v ← v + P·n                          (normal impulse per unit mass)
+//       a support not reached yet (LocalContact gap_m > 0: the floor below a body that does not touch it) lets the
+//       body approach by what is left of the gap, g = gap + u·n, within the substep: P = max(0, −v·n − g/h). The
+//       body lands on it at the substep's end, as in the world; without it, a body the fingers set down over a
+//       delayed link was held in the air by the model a round trip after the world's had landed, and the fingers
+//       lifted the world's off the floor and threw it (docs/latency.md, the grasp)
 //       a loose contact (no kContactHolds: a neighbour that can give way, world_manager/features/contact_graph.h) takes at
 //       most the weight it carries, P ≤ max(0, −g·n)·h: it holds the body up but yields to the finger's push
 //       v_t = v − (v·n)·n;  v ← v − min(|v_t|, μ·P)·v_t/|v_t|   ... and their Coulomb friction (cube on a floor:
@@ -141,6 +146,8 @@ struct LocalBody {
   // the body shares with it) and inverse mass (0: none, static or unknown).
   std::array<Eigen::Vector3d, kMaxLocalContacts> neighbour_velocity_mps{};
   std::array<double, kMaxLocalContacts> neighbour_inverse_mass_per_kg{};
+  // How far each support was from the body at the frame along its normal (LocalContact::gap_m; 0: touching).
+  std::array<double, kMaxLocalContacts> contact_gap_m{};
   std::uint32_t contact_count = 0;
   double sphere_radius_m = 0.0;  // > 0 for a ball (ShapeTraits::round): its supports touch it at com − r·n
   // Its shape and its axes at the frame (columns, world frame). A flat-faced body's supports touch it at the four

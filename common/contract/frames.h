@@ -52,7 +52,8 @@ inline constexpr std::uint32_t kPlaneDeformable = 1u << 1;
 inline constexpr std::uint32_t kContactHolds = 1u << 0;
 
 // One contact of a dynamic object with the rest of the world, as the world saw it in its last substep: a unilateral
-// constraint for the haptic side's local model (haptic_controller/local_dynamics.h).
+// constraint for the haptic side's local model (haptic_controller/local_dynamics.h). Or one it is about to have: the
+// floor below a body that does not touch it yet, gap_m away (the model's body stops there, as the world's will).
 struct LocalContact {
   Vec3 normal{};          // unit; the direction the contact pushes the object (out of the other body)
   double friction = 0.0;  // Coulomb coefficient of the pair, dimensionless, >= 0
@@ -61,6 +62,9 @@ struct LocalContact {
   Vec3 other_velocity_mps{};
   double other_inverse_mass_per_kg = 0.0;
   std::uint32_t flags = 0;  // kContactHolds
+  // How far the object is from the other side along the normal (m, >= 0): 0 for a contact the world saw, more for a
+  // support it has not reached yet.
+  double gap_m = 0.0;
 };
 
 // One plane of paper §3.1: the nearest surface point of an object to the finger and the outward normal there, plus

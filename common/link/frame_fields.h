@@ -22,6 +22,7 @@ void visit_contact(A& a, B& b, F&& f) {
   f(a.other_velocity_mps, b.other_velocity_mps);
   f(a.other_inverse_mass_per_kg, b.other_inverse_mass_per_kg);
   f(a.flags, b.flags);
+  f(a.gap_m, b.gap_m);
 }
 
 template <class A, class B, class F>

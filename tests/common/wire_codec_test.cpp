@@ -116,6 +116,14 @@ TEST_CASE("frame decoding rejects each kind of bad frame with its reason") {
           f.planes[0].local_contacts[0].normal = {0, 0, 1};
           f.planes[0].local_contacts[0].other_inverse_mass_per_kg = -1.0;
         }) == FrameError::bad_mass);
+  const auto floor_ahead = [](PlaneFrame& f, double gap_m) {
+    f.planes[0].local_contact_count = 1;
+    f.planes[0].local_contacts[0].normal = {0, 0, 1};
+    f.planes[0].local_contacts[0].gap_m = gap_m;
+  };
+  CHECK(rejected([&](PlaneFrame& f) { floor_ahead(f, 0.02); }) == FrameError::ok);
+  CHECK(rejected([&](PlaneFrame& f) { floor_ahead(f, -1e-3); }) == FrameError::bad_gap);
+  CHECK(rejected([&](PlaneFrame& f) { floor_ahead(f, nan); }) == FrameError::not_finite);
   CHECK(rejected([&](PlaneFrame& f) { f.reach_radius_m = nan; }) == FrameError::not_finite);
   // A box's plane carries the box: orthonormal axes and sizes within the scene's limits, or the frame is refused.
   const auto box = [](PlaneFrame& f) {

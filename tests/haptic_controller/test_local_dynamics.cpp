@@ -201,6 +201,46 @@ TEST_CASE("local dynamics: a support blocks the push (a cube against a wall does
   REQUIRE(planes.planes[0].point_m.x() == 0.0);
 }
 
+// The floor a body has not reached (LocalContact::gap_m, world_manager/couplings/local_coupling.h): the model's body
+// falls as a free body until it has covered the gap, then lands and stays, as the world's does. Over a delayed link
+// the model may run a round trip on from its frame, so the landing must be its own.
+TEST_CASE("local dynamics: a body above a floor it has not reached falls the gap and lands on it, not through it") {
+  for (const double gap_m : {0.003, 0.02}) {
+    CAPTURE(gap_m);
+    Plane face = cube_face();
+    face.velocity_mps = {0, 0, -0.05};  // set down at 5 cm/s
+    add_support(face, Vector3d::UnitZ(), 0.5);
+    face.local_contacts[0].gap_m = gap_m;
+    Plane without = cube_face();
+    without.velocity_mps = face.velocity_mps;
+    LocalDynamics model, free_model;
+    model.on_plane_frame(grounded_frame(face), nullptr, Vector3d::Zero());
+    free_model.on_plane_frame(grounded_frame(without), nullptr, Vector3d::Zero());
+    double lowest_m = 0.0, landed_s = -1.0, free_landed_s = -1.0;
+    for (int tick = 1; tick <= 200; ++tick) {
+      model.advance(kTick_s);
+      free_model.advance(kTick_s);
+      const double fallen_m = -model.find(1)->displacement_m.z();
+      lowest_m = std::max(lowest_m, fallen_m);
+      if (landed_s < 0.0 && fallen_m >= gap_m - 1e-12) landed_s = tick * kTick_s;
+      if (free_landed_s < 0.0 && -free_model.find(1)->displacement_m.z() >= gap_m) free_landed_s = tick * kTick_s;
+      // Before the substep it lands in it falls as the free body does, to rounding.
+      if (free_landed_s < 0.0 && tick % 5 == 0) {
+        REQUIRE(model.find(1)->displacement_m.z() == Approx(free_model.find(1)->displacement_m.z()).margin(1e-12));
+      }
+    }
+    // It comes to the floor by the end of the substep in which the free body would pass it (5 ms), no farther (to
+    // rounding), and stays on it: no bounce, no sinking.
+    CHECK(landed_s >= free_landed_s);
+    CHECK(landed_s <= free_landed_s + 0.005);
+    CHECK(lowest_m == Approx(gap_m).margin(1e-12));
+    CHECK(-model.find(1)->displacement_m.z() == Approx(gap_m).margin(1e-12));
+    CHECK(model.find(1)->velocity_mps.z() == Approx(0.0).margin(1e-12));
+    // The free body went on through where the floor is.
+    CHECK(-free_model.find(1)->displacement_m.z() > gap_m + 0.01);
+  }
+}
+
 TEST_CASE("local dynamics: a loose neighbour gives way to the push but carries the weight") {
   // The cube rests on a neighbour below and touches one on its +x side; neither is held (a pile of loose balls).
   Plane face = cube_face();

@@ -8,6 +8,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <limits>
 
 #include <algorithm>
@@ -136,6 +137,58 @@ TEST_CASE("local coupling: a cube resting on the floor sends its floor contact, 
   auto other = make_world(scene, impulse);
   const impetus::PlaneFrame& plain = other->step(&report);
   for (std::uint32_t k = 0; k < plain.plane_count; ++k) CHECK(plain.planes[k].local_contact_count == 0);
+}
+
+TEST_CASE("local coupling: a body above the floor sends the floor as a support it has not reached, gap_m below its "
+          "lowest point") {
+  // A 5 cm box turned 0.3 rad about x, falling from 20 cm; a ball beside it resting on a static box (its support
+  // faces up, so the floor is not added).
+  const double turn_rad = 0.3;
+  const json box{{"name", "box"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", true},
+                 {"mass_kg", 0.2}, {"position_m", {0, 0, 0.2}},
+                 {"orientation_wxyz", {std::cos(turn_rad / 2), std::sin(turn_rad / 2), 0, 0}},
+                 {"dynamic_friction", 0.8}, {"static_friction", 1.0}};
+  const json shelf{{"name", "shelf"}, {"shape", "box"}, {"size_m", {0.1, 0.1, 0.1}}, {"dynamic", false},
+                   {"position_m", {0.2, 0, 0.05}}};
+  const json ball{{"name", "ball"}, {"shape", "sphere"}, {"radius_m", 0.01}, {"dynamic", true}, {"mass_kg", 0.01},
+                  {"position_m", {0.2, 0, 0.11}}};
+  const json document{{"gravity_mps2", {0, 0, -9.81}},
+                      {"floor", {{"height_m", 0.0}, {"static_friction", 0.5}, {"dynamic_friction", 0.4}}},
+                      {"haptic", {{"reach_radius_m", 0.3}}},
+                      {"objects", {box, shelf, ball}}};
+  const impetus::Scene scene = impetus::parse_scene(document, "falling.json");
+  auto world = make_world(scene, local_options());
+  HapticReport report = make_report(3, 50, {0.1, 0.0, 0.15}, true);
+  report.proxy_m = report.finger_m;
+  world->step(&report);  // the ball settles onto the shelf
+  report.tick = 100;
+  const impetus::PlaneFrame& frame = world->step(&report);
+  const impetus::Plane* falling = nullptr;
+  const impetus::Plane* resting = nullptr;
+  for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
+    if (frame.planes[k].object_id == 0) falling = &frame.planes[k];
+    if (frame.planes[k].object_id == 2) resting = &frame.planes[k];
+  }
+  REQUIRE(falling != nullptr);
+  REQUIRE(falling->local_contact_count == 1);
+  const impetus::LocalContact& floor = falling->local_contacts[0];
+  CHECK(impetus::to_eigen(floor.normal) == Vector3d::UnitZ());
+  CHECK((floor.flags & impetus::kContactHolds) != 0);
+  CHECK(floor.friction == Approx(std::sqrt(0.8 * 0.4)));  // the pair's, as the engine combines it
+  // Its lowest corner, from the world's pose of the box: the gap to the floor.
+  const impetus::ObjectState& state = world->states()[0];
+  double lowest_m = std::numeric_limits<double>::infinity();
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vector3d local(corner & 1 ? 0.025 : -0.025, corner & 2 ? 0.025 : -0.025, corner & 4 ? 0.025 : -0.025);
+    lowest_m = std::min(lowest_m, (state.pose.position_m + state.pose.orientation * local).z());
+  }
+  CHECK(lowest_m > 0.1);
+  CHECK(floor.gap_m == Approx(lowest_m).epsilon(1e-12));
+  CHECK(impetus::test::transport_verdict(frame) == impetus::FrameError::ok);
+  // The ball on the shelf has the shelf's support, facing up: the floor below the shelf is not added.
+  REQUIRE(resting != nullptr);
+  REQUIRE(resting->local_contact_count == 1);
+  CHECK(resting->local_contacts[0].gap_m == 0.0);
 }
 
 TEST_CASE("local coupling: a light ball pushed into the floor in the last tick is held by the floor, not driven in") {

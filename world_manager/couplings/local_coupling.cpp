@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "world_manager/couplings/local_coupling.h"
 
+#include "common/shape/shape.h"
 #include "world_manager/couplings/substep_spread.h"
+#include "world_manager/features/contact_graph.h"
 
 #include <algorithm>
 #include <cmath>
@@ -150,7 +152,32 @@ void LocalCoupling::annotate(PlaneFrame& frame) {
     plane.local_contact_count = 0;
     if ((plane.flags & kPlaneDynamic) == 0 || plane.object_id < 0) continue;
     plane.local_contact_count = contacts.local_contacts(plane.object_id, context_.states, plane.local_contacts);
+    if (static_cast<std::size_t>(plane.object_id) < context_.states.size()) {
+      floor_ahead(static_cast<std::size_t>(plane.object_id), plane);
+    }
   }
+}
+
+void LocalCoupling::floor_ahead(std::size_t id, Plane& plane) const {
+  const Floor& floor = context_.scene.floor;
+  if (!floor.present || plane.local_contact_count >= kMaxLocalContacts) return;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // the floor is the plane z = height_m, solid below
+  // A contact the world saw along the floor's normal (the floor itself, or a support that faces the same way and
+  // holds the body above it) already stops the model's body.
+  for (std::uint32_t c = 0; c < plane.local_contact_count; ++c) {
+    if (to_eigen(plane.local_contacts[c].normal).dot(up) > ContactGraph::kSameContactCosine) return;
+  }
+  const SceneObject& object = context_.scene.objects[id];
+  const BodyPose& pose = context_.states[id].pose;
+  // The body's lowest point: its centre's height less the support function toward the floor (common/shape/shape.h),
+  // exact for every kind; a mesh's from its vertices.
+  const double lowest_m = pose.position_m.z() - support_m(object.shape, pose.orientation.conjugate() * (-up));
+  LocalContact& contact = plane.local_contacts[plane.local_contact_count++];
+  contact = LocalContact{};
+  contact.normal = to_vec3(up);
+  contact.friction = combine_friction(object.material.dynamic_friction, floor.material.dynamic_friction);
+  contact.flags = kContactHolds;
+  contact.gap_m = std::max(0.0, lowest_m - floor.height_m);
 }
 
 }  // namespace impetus

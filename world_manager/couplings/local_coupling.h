@@ -38,10 +38,15 @@ class LocalCoupling final : public CouplingStrategy {
   void after_step() override { apply_slot(context_.substeps); }
   bool needs_contacts() const override { return true; }
   // Each dynamic object's plane carries the contacts the object had in the last substep, the constraints of the
-  // haptic side's local model.
+  // haptic side's local model; and the floor, gap_m below it, if it does not touch the floor yet (floor_ahead).
   void annotate(PlaneFrame& frame) override;
 
  private:
+  // The floor as a support object `id` has not reached: the model must stop the body where the world will, not a
+  // round trip after the world's body landed (a body set down by fingers over a delayed link, whose model still held
+  // it in the air, was lifted off the floor by them and thrown). Appended to `plane`'s contacts when there is room
+  // and no contact already pushes up along the floor's normal.
+  void floor_ahead(std::size_t id, Plane& plane) const;
   void schedule(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment, const RenderWindow& window);
   void apply_slot(int slot);
 

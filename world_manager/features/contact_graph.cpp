@@ -8,9 +8,6 @@
 namespace impetus {
 namespace {
 
-// Two contact normals of one object closer than this (cosine) are one constraint for the local model: the four
-// corner contacts of a box resting on the floor are one support.
-constexpr double kSameContactCosine = 0.999;
 // Rounding slack of the friction-cone test: ODE's box–box normals are axis-aligned to ~1e-16, and a push exactly along
 // a frictionless contact's normal must count as held.
 constexpr double kConeSlack = 1e-9;
@@ -121,7 +118,7 @@ std::uint32_t ContactGraph::local_contacts(std::int32_t body, std::span<const Ob
     bool merged = false;
     for (std::uint32_t c = 0; c < count && !merged; ++c) {
       LocalContact& known = out[c];
-      if (to_eigen(known.normal).dot(edge.normal) > kSameContactCosine) {
+      if (to_eigen(known.normal).dot(edge.normal) > ContactGraph::kSameContactCosine) {
         known.friction = std::max(known.friction, edge.friction);
         if (held) known.flags |= kContactHolds;
         if (other_inverse_mass_per_kg < known.other_inverse_mass_per_kg) {  // the heavier body

@@ -38,6 +38,9 @@ namespace impetus {
 class ContactGraph {
  public:
   static constexpr std::int32_t kStatic = -1;  // the other side is static geometry (floor, fixed objects)
+  // Two contact normals of one object closer than this (cosine) are one constraint for the local model: the four
+  // corner contacts of a box resting on the floor are one support.
+  static constexpr double kSameContactCosine = 0.999;
 
   // Forget the contacts of the last substep (not those of sleeping bodies); bodies are 0 … body_count − 1.
   void reset(std::size_t body_count);

@@ -30,7 +30,7 @@
 namespace impetus {
 
 inline constexpr std::uint64_t kSegmentMagic = 0x31535554'45504D49ull;  // "IMPETUS1" in little-endian bytes
-inline constexpr std::uint32_t kLayoutVersion = 25;  // bump on any change to wire_frames.h or a *Layout struct
+inline constexpr std::uint32_t kLayoutVersion = 26;  // bump on any change to wire_frames.h or a *Layout struct
 
 enum class SegmentKind : std::uint32_t { world_link = 1, device_port = 2, world_view = 3, touch_port = 4 };
 const char* to_string(SegmentKind kind);

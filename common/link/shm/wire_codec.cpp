@@ -81,6 +81,7 @@ const char* to_string(FrameError error) {
     case FrameError::bad_mass: return "a local contact's inverse mass is negative";
     case FrameError::bad_shape: return "a plane's shape is unknown or out of range, or its body axes not orthonormal";
     case FrameError::bad_port: return "the passivity layer's flag is not 0 or 1, or its returned energy is negative";
+    case FrameError::bad_gap: return "a local contact's gap is negative";
   }
   return "unknown frame error";
 }
@@ -166,10 +167,11 @@ FrameError validate(const wire::PlaneFrame& frame) {
     for (std::uint32_t c = 0; c < plane.local_contact_count; ++c) {
       const wire::LocalContact& contact = plane.local_contacts[c];
       if (!all_finite(contact.normal) || !finite(contact.friction) || !all_finite(contact.other_velocity_mps) ||
-          !finite(contact.other_inverse_mass_per_kg)) {
+          !finite(contact.other_inverse_mass_per_kg) || !finite(contact.gap_m)) {
         return FrameError::not_finite;
       }
       if (contact.other_inverse_mass_per_kg < 0.0) return FrameError::bad_mass;
+      if (contact.gap_m < 0.0) return FrameError::bad_gap;
       const double length = std::sqrt(contact.normal[0] * contact.normal[0] + contact.normal[1] * contact.normal[1] +
                                       contact.normal[2] * contact.normal[2]);
       if (std::fabs(length - 1.0) > kUnitNormalTolerance) return FrameError::normal_not_unit;

@@ -29,6 +29,7 @@ struct LocalContact {
   double other_inverse_mass_per_kg = 0.0;
   std::uint32_t flags = 0;
   std::uint32_t reserved = 0;  // keeps the layout in whole 64-bit words (checksum)
+  double gap_m = 0.0;
 };
 
 struct Plane {
@@ -166,6 +167,7 @@ enum class FrameError : std::uint32_t {
   bad_shape,
   bad_yield,
   bad_port,
+  bad_gap,
 };
 const char* to_string(FrameError error);
 
