@@ -236,6 +236,11 @@ def parse_ms(text, name):
     return values
 
 
+# The delay up to which --check holds local coupling to no energy gain (ms, one way): every tap, loss, catch, stack
+# and grasp cell of docs/latency.md is within its tolerance there.
+PASSIVE_UP_TO_MS = 20.0
+
+
 def ms_label(delay_ms):
     return f"{delay_ms:g}"
 
@@ -306,8 +311,8 @@ def main():
     parser.add_argument("--quiet", action="store_true", help="no progress bar (it shows only on a terminal anyway)")
     parser.add_argument("--plot", action=argparse.BooleanOptionalAction, default=True)
     parser.add_argument("--check", action="store_true",
-                        help="exit 1 unless every number is finite and the ledger is exact in every impulse and local "
-                             "trial")
+                        help="exit 1 unless every number is finite, the ledger is exact in every impulse and local "
+                             "trial, and no local trial up to 20 ms gains energy beyond its tolerance")
     args = parser.parse_args()
     if args.quick:
         args.delays_ms, args.phases = "0,20", 2
@@ -626,6 +631,16 @@ def main():
                 where = f"{scene} {coupling} {ms_label(delay)} ms" + (f" {loss_label(key[4])}" if len(key) > 4 else "")
                 failures.append(f"{where} phase {phase}: the impulse applied differs from the impulse rendered by "
                                 f"{error:.3g} (relative)")
+        # Passivity: local coupling (without the layer) gains no energy beyond a trial's tolerance up to
+        # PASSIVE_UP_TO_MS of one-way delay, in every scene (docs/latency.md; the grasp's gain beyond it is open).
+        for key, row in trials.items():
+            scene, coupling, delay, phase = key[:4]
+            if coupling != "local" or delay > PASSIVE_UP_TO_MS or "energy_gain_J" not in row:
+                continue
+            if not row["energy_gain_J"] <= row["energy_tolerance_J"]:
+                failures.append(f"{scene} local {ms_label(delay)} ms phase {phase}: energy gain "
+                                f"{1e3 * row['energy_gain_J']:.2f} mJ over the tolerance "
+                                f"{1e3 * row['energy_tolerance_J']:.2f} mJ")
         if failures:
             print("CHECK FAILED: " + "; ".join(failures))
             sys.exit(1)
