@@ -15,8 +15,8 @@
 //     v ← v + g·h                                               drift: gravity ...
 //     for each contact n (unilateral):                          ... the supports ...
 //       P = max(0, −v·n);  v ← v + P·n                          (normal impulse per unit mass)
-//       a support not reached yet (LocalContact gap_m > 0: the floor below a body that does not touch it) lets the
-//       body approach by what is left of the gap, g = gap + u·n, within the substep: P = max(0, −v·n − g/h). The
+//       a support not reached yet (LocalContact gap_m > 0: the floor or a table below a body resting on nothing) lets
+//       the body approach by what is left of the gap, g = gap + u·n, within the substep: P = max(0, −v·n − g/h). The
 //       body lands on it at the substep's end, as in the world; without it, a body the fingers set down over a
 //       delayed link was held in the air by the model a round trip after the world's had landed, and the fingers
 //       lifted the world's off the floor and threw it (docs/latency.md, the grasp)

@@ -53,7 +53,8 @@ inline constexpr std::uint32_t kContactHolds = 1u << 0;
 
 // One contact of a dynamic object with the rest of the world, as the world saw it in its last substep: a unilateral
 // constraint for the haptic side's local model (haptic_controller/local_dynamics.h). Or one it is about to have: the
-// floor below a body that does not touch it yet, gap_m away (the model's body stops there, as the world's will).
+// floor, or a table's top, below a body that rests on nothing yet, gap_m away (the model's body stops there, as the
+// world's will).
 struct LocalContact {
   Vec3 normal{};          // unit; the direction the contact pushes the object (out of the other body)
   double friction = 0.0;  // Coulomb coefficient of the pair, dimensionless, >= 0

@@ -139,23 +139,28 @@ TEST_CASE("local coupling: a cube resting on the floor sends its floor contact, 
   for (std::uint32_t k = 0; k < plain.plane_count; ++k) CHECK(plain.planes[k].local_contact_count == 0);
 }
 
-TEST_CASE("local coupling: a body above the floor sends the floor as a support it has not reached, gap_m below its "
-          "lowest point") {
-  // A 5 cm box turned 0.3 rad about x, falling from 20 cm; a ball beside it resting on a static box (its support
-  // faces up, so the floor is not added).
+TEST_CASE("local coupling: a body resting on nothing sends what it would land on, the floor or a table under its "
+          "whole bounds, gap_m below its lowest point") {
+  // A 5 cm box turned 0.3 rad about x falling from 20 cm over the floor; a 3 cm cube falling over a static shelf (a
+  // 10 cm box), wholly over its top; another over the shelf's edge; and a ball resting on the shelf (its support faces
+  // up, so nothing is added).
   const double turn_rad = 0.3;
   const json box{{"name", "box"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", true},
                  {"mass_kg", 0.2}, {"position_m", {0, 0, 0.2}},
                  {"orientation_wxyz", {std::cos(turn_rad / 2), std::sin(turn_rad / 2), 0, 0}},
                  {"dynamic_friction", 0.8}, {"static_friction", 1.0}};
   const json shelf{{"name", "shelf"}, {"shape", "box"}, {"size_m", {0.1, 0.1, 0.1}}, {"dynamic", false},
-                   {"position_m", {0.2, 0, 0.05}}};
+                   {"position_m", {0.2, 0, 0.05}}, {"dynamic_friction", 0.3}, {"static_friction", 0.3}};
   const json ball{{"name", "ball"}, {"shape", "sphere"}, {"radius_m", 0.01}, {"dynamic", true}, {"mass_kg", 0.01},
-                  {"position_m", {0.2, 0, 0.11}}};
+                  {"position_m", {0.23, 0.03, 0.11}}};
+  const auto cube = [](const char* name, double x_m) {
+    return json{{"name", name}, {"shape", "box"}, {"size_m", {0.03, 0.03, 0.03}}, {"dynamic", true},
+                {"mass_kg", 0.05}, {"position_m", {x_m, 0, 0.3}}, {"dynamic_friction", 0.8}, {"static_friction", 1.0}};
+  };
   const json document{{"gravity_mps2", {0, 0, -9.81}},
                       {"floor", {{"height_m", 0.0}, {"static_friction", 0.5}, {"dynamic_friction", 0.4}}},
-                      {"haptic", {{"reach_radius_m", 0.3}}},
-                      {"objects", {box, shelf, ball}}};
+                      {"haptic", {{"reach_radius_m", 0.4}}},
+                      {"objects", {box, shelf, ball, cube("over", 0.2), cube("edge", 0.25)}}};
   const impetus::Scene scene = impetus::parse_scene(document, "falling.json");
   auto world = make_world(scene, local_options());
   HapticReport report = make_report(3, 50, {0.1, 0.0, 0.15}, true);
@@ -163,29 +168,44 @@ TEST_CASE("local coupling: a body above the floor sends the floor as a support i
   world->step(&report);  // the ball settles onto the shelf
   report.tick = 100;
   const impetus::PlaneFrame& frame = world->step(&report);
-  const impetus::Plane* falling = nullptr;
-  const impetus::Plane* resting = nullptr;
-  for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
-    if (frame.planes[k].object_id == 0) falling = &frame.planes[k];
-    if (frame.planes[k].object_id == 2) resting = &frame.planes[k];
+  const auto plane_of = [&](std::int32_t id) -> const impetus::Plane* {
+    for (std::uint32_t k = 0; k < frame.plane_count; ++k) {
+      if (frame.planes[k].object_id == id) return &frame.planes[k];
+    }
+    return nullptr;
+  };
+  // The lowest corner of box `id` (half size `half_m`), from the world's pose.
+  const auto lowest_m = [&](std::size_t id, double half_m) {
+    const impetus::ObjectState& state = world->states()[id];
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vector3d local(corner & 1 ? half_m : -half_m, corner & 2 ? half_m : -half_m, corner & 4 ? half_m : -half_m);
+      lowest = std::min(lowest, (state.pose.position_m + state.pose.orientation * local).z());
+    }
+    return lowest;
+  };
+  struct Expected {
+    std::int32_t id;
+    double half_m, surface_m, friction;
+  };
+  for (const Expected& expected : {Expected{0, 0.025, 0.0, std::sqrt(0.8 * 0.4)},    // the floor
+                                   Expected{3, 0.015, 0.1, std::sqrt(0.8 * 0.3)},    // the shelf's top
+                                   Expected{4, 0.015, 0.0, std::sqrt(0.8 * 0.4)}}) {  // over its edge: the floor
+    CAPTURE(expected.id);
+    const impetus::Plane* falling = plane_of(expected.id);
+    REQUIRE(falling != nullptr);
+    REQUIRE(falling->local_contact_count == 1);
+    const impetus::LocalContact& support = falling->local_contacts[0];
+    CHECK(impetus::to_eigen(support.normal) == Vector3d::UnitZ());
+    CHECK((support.flags & impetus::kContactHolds) != 0);
+    CHECK(support.friction == Approx(expected.friction));  // the pair's, as the engine combines it
+    const double lowest = lowest_m(static_cast<std::size_t>(expected.id), expected.half_m);
+    CHECK(lowest > expected.surface_m + 0.05);
+    CHECK(support.gap_m == Approx(lowest - expected.surface_m).epsilon(1e-12));
   }
-  REQUIRE(falling != nullptr);
-  REQUIRE(falling->local_contact_count == 1);
-  const impetus::LocalContact& floor = falling->local_contacts[0];
-  CHECK(impetus::to_eigen(floor.normal) == Vector3d::UnitZ());
-  CHECK((floor.flags & impetus::kContactHolds) != 0);
-  CHECK(floor.friction == Approx(std::sqrt(0.8 * 0.4)));  // the pair's, as the engine combines it
-  // Its lowest corner, from the world's pose of the box: the gap to the floor.
-  const impetus::ObjectState& state = world->states()[0];
-  double lowest_m = std::numeric_limits<double>::infinity();
-  for (int corner = 0; corner < 8; ++corner) {
-    const Vector3d local(corner & 1 ? 0.025 : -0.025, corner & 2 ? 0.025 : -0.025, corner & 4 ? 0.025 : -0.025);
-    lowest_m = std::min(lowest_m, (state.pose.position_m + state.pose.orientation * local).z());
-  }
-  CHECK(lowest_m > 0.1);
-  CHECK(floor.gap_m == Approx(lowest_m).epsilon(1e-12));
   CHECK(impetus::test::transport_verdict(frame) == impetus::FrameError::ok);
-  // The ball on the shelf has the shelf's support, facing up: the floor below the shelf is not added.
+  // The ball on the shelf has the shelf's support, facing up: nothing is added below it.
+  const impetus::Plane* resting = plane_of(2);
   REQUIRE(resting != nullptr);
   REQUIRE(resting->local_contact_count == 1);
   CHECK(resting->local_contacts[0].gap_m == 0.0);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 namespace impetus {
 
@@ -15,7 +16,28 @@ LocalCoupling::LocalCoupling(const CouplingContext& context)
     : CouplingStrategy(context),
       impulse_Ns_(context.scene.objects.size()),
       angular_Nms_(context.scene.objects.size()),
-      is_scheduled_(context.scene.objects.size(), false) {}
+      is_scheduled_(context.scene.objects.size(), false) {
+  for (std::size_t id = 0; id < context.scene.objects.size(); ++id) {
+    const SceneObject& box = context.scene.objects[id];
+    if (box.dynamic || box.deformable || box.shape.kind != ShapeKind::box) continue;
+    // Where the scene puts it: a static body does not move (the world's states are not filled yet here).
+    const Eigen::Vector3d centre_m = to_eigen(box.position_m);
+    const Eigen::Matrix3d axes = Eigen::Quaterniond(box.orientation_wxyz[0], box.orientation_wxyz[1],
+                                                    box.orientation_wxyz[2], box.orientation_wxyz[3])
+                                     .normalized()
+                                     .toRotationMatrix();
+    for (int i = 0; i < 3; ++i) {
+      for (const double sign : {1.0, -1.0}) {
+        const Eigen::Vector3d normal = sign * axes.col(i);
+        // Level to the contact graph's own tolerance: a face tilted more is a slope, met only as a contact.
+        if (!(normal.z() > ContactGraph::kSameContactCosine)) continue;
+        const int u = (i + 1) % 3, v = (i + 2) % 3;
+        top_faces_.push_back({id, centre_m + normal * (0.5 * box.shape.box_size_m[i]), normal, axes.col(u),
+                              axes.col(v), 0.5 * box.shape.box_size_m[u], 0.5 * box.shape.box_size_m[v]});
+      }
+    }
+  }
+}
 
 void LocalCoupling::take_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment,
                                  bool moment_finite, const RenderWindow& window) {
@@ -153,31 +175,58 @@ void LocalCoupling::annotate(PlaneFrame& frame) {
     if ((plane.flags & kPlaneDynamic) == 0 || plane.object_id < 0) continue;
     plane.local_contact_count = contacts.local_contacts(plane.object_id, context_.states, plane.local_contacts);
     if (static_cast<std::size_t>(plane.object_id) < context_.states.size()) {
-      floor_ahead(static_cast<std::size_t>(plane.object_id), plane);
+      support_ahead(static_cast<std::size_t>(plane.object_id), plane);
     }
   }
 }
 
-void LocalCoupling::floor_ahead(std::size_t id, Plane& plane) const {
-  const Floor& floor = context_.scene.floor;
-  if (!floor.present || plane.local_contact_count >= kMaxLocalContacts) return;
+void LocalCoupling::support_ahead(std::size_t id, Plane& plane) const {
+  if (plane.local_contact_count >= kMaxLocalContacts) return;
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // the floor is the plane z = height_m, solid below
-  // A contact the world saw along the floor's normal (the floor itself, or a support that faces the same way and
-  // holds the body above it) already stops the model's body.
+  // A contact the world saw that pushes the body up (the floor, a table, a body it rests on) already stops it.
   for (std::uint32_t c = 0; c < plane.local_contact_count; ++c) {
     if (to_eigen(plane.local_contacts[c].normal).dot(up) > ContactGraph::kSameContactCosine) return;
   }
   const SceneObject& object = context_.scene.objects[id];
   const BodyPose& pose = context_.states[id].pose;
-  // The body's lowest point: its centre's height less the support function toward the floor (common/shape/shape.h),
-  // exact for every kind; a mesh's from its vertices.
-  const double lowest_m = pose.position_m.z() - support_m(object.shape, pose.orientation.conjugate() * (-up));
+  // How far the body is above a level plane through `point_m` with normal `normal`: its centre's height less the
+  // support function toward the plane (common/shape/shape.h), exact for every kind; a mesh's from its vertices.
+  const auto height_above = [&](const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal) {
+    return normal.dot(pose.position_m - point_m) - support_m(object.shape, pose.orientation.conjugate() * (-normal));
+  };
+  double best_gap_m = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d best_normal = up;
+  double best_friction = 0.0;
+  const Floor& floor = context_.scene.floor;
+  if (floor.present) {
+    best_gap_m = height_above(Eigen::Vector3d(0.0, 0.0, floor.height_m), up);
+    best_friction = combine_friction(object.material.dynamic_friction, floor.material.dynamic_friction);
+  }
+  // A top face holds the body only where the face is: every corner of the body's bounds must lie over it (a body
+  // partly over the edge may tip off in the world, and a model that held it would push back what the world lets go).
+  const Eigen::AlignedBox3d bounds = world_bounds(object.shape, pose);
+  for (const TopFace& face : top_faces_) {
+    bool over = true;
+    for (int k = 0; k < 8 && over; ++k) {
+      const Eigen::Vector3d offset = bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)) - face.centre_m;
+      over = std::abs(offset.dot(face.axis_u)) <= face.half_u_m && std::abs(offset.dot(face.axis_v)) <= face.half_v_m;
+    }
+    if (!over) continue;
+    const double gap_m = height_above(face.centre_m, face.normal);
+    // Below the face's plane the body is beside or under the box, not on it (kOnSurface_m: rounding).
+    if (gap_m < -kOnSurface_m || !(gap_m < best_gap_m)) continue;
+    best_gap_m = gap_m;
+    best_normal = face.normal;
+    best_friction = combine_friction(object.material.dynamic_friction,
+                                     context_.scene.objects[face.object].material.dynamic_friction);
+  }
+  if (!std::isfinite(best_gap_m)) return;
   LocalContact& contact = plane.local_contacts[plane.local_contact_count++];
   contact = LocalContact{};
-  contact.normal = to_vec3(up);
-  contact.friction = combine_friction(object.material.dynamic_friction, floor.material.dynamic_friction);
+  contact.normal = to_vec3(best_normal);
+  contact.friction = best_friction;
   contact.flags = kContactHolds;
-  contact.gap_m = std::max(0.0, lowest_m - floor.height_m);
+  contact.gap_m = std::max(0.0, best_gap_m);
 }
 
 }  // namespace impetus

@@ -38,15 +38,23 @@ class LocalCoupling final : public CouplingStrategy {
   void after_step() override { apply_slot(context_.substeps); }
   bool needs_contacts() const override { return true; }
   // Each dynamic object's plane carries the contacts the object had in the last substep, the constraints of the
-  // haptic side's local model; and the floor, gap_m below it, if it does not touch the floor yet (floor_ahead).
+  // haptic side's local model; and what it would land on, gap_m below it, if it rests on nothing yet (support_ahead).
   void annotate(PlaneFrame& frame) override;
 
  private:
-  // The floor as a support object `id` has not reached: the model must stop the body where the world will, not a
-  // round trip after the world's body landed (a body set down by fingers over a delayed link, whose model still held
-  // it in the air, was lifted off the floor by them and thrown). Appended to `plane`'s contacts when there is room
-  // and no contact already pushes up along the floor's normal.
-  void floor_ahead(std::size_t id, Plane& plane) const;
+  // The level face a static box turns up (a table's top): the plane through `centre_m` with normal `normal`, bounded
+  // by ±half_u_m along axis_u and ±half_v_m along axis_v.
+  struct TopFace {
+    std::size_t object;
+    Eigen::Vector3d centre_m, normal, axis_u, axis_v;
+    double half_u_m, half_v_m;
+  };
+  // What object `id` would land on if it fell, when it rests on nothing: the nearest below it of the floor and the
+  // top faces of static boxes whose whole face lies under the body's bounds. The model must stop the body where the
+  // world will, not a round trip after the world's body landed (a body set down by fingers over a delayed link, whose
+  // model still held it in the air, was lifted off the floor by them and thrown). Appended to `plane`'s contacts when
+  // there is room and no contact already pushes up.
+  void support_ahead(std::size_t id, Plane& plane) const;
   void schedule(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta& moment, const RenderWindow& window);
   void apply_slot(int slot);
 
@@ -57,6 +65,7 @@ class LocalCoupling final : public CouplingStrategy {
   // The objects with impulse scheduled in this step: a step costs the objects pushed, not the objects that exist.
   std::vector<std::size_t> scheduled_;
   std::vector<bool> is_scheduled_;
+  std::vector<TopFace> top_faces_;  // of the scene's static boxes, taken once
 };
 
 }  // namespace impetus
