@@ -200,10 +200,11 @@ def tap_trial(out_dir, trajectory, label, rate_hz, phase_ticks, delay_ms, loss=(
             "link_dropped": summary.link["dropped"]}
 
 
-def grasp_trial(out_dir, label, phase_ticks, delay_ms):
-    """One grasp trial; returns its row of measurements."""
+def grasp_trial(out_dir, label, phase_ticks, delay_ms, scene=GRASP_SCENE):
+    """One grasp trial (of `scene`, the grasp's by default: another must hold the same cube where the fingers'
+    paths expect it); returns its row of measurements, with the cube's height at the end (final_z_m)."""
     coupling, layer = coupling_and_layer(label)
-    summary = run_trial(out_dir, GRASP_SCENE, GRASP_FINGERS, coupling, None, phase_ticks,
+    summary = run_trial(out_dir, scene, GRASP_FINGERS, coupling, None, phase_ticks,
                         link_delay_s=delay_ms * 1e-3, passivity=layer)
     world = logs.read_log(out_dir / logs.WORLD)
     t, z = world["time_s"], world["cube.z_m"]
@@ -216,8 +217,8 @@ def grasp_trial(out_dir, label, phase_ticks, delay_ms):
         held = force[(haptic["time_s"] >= GRASP_HOLD_S[0]) & (haptic["time_s"] <= GRASP_HOLD_S[1])]
         ripple.append(float(held.max() - held.min()))
         largest = max(largest, float(force.max()))
-    gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(GRASP_SCENE), devices, phase_ticks)
-    return {"lift_mm": 1e3 * (hold[0] - z[0]), "lift_end_mm": 1e3 * (hold[-1] - z[0]),
+    gain_J, tolerance_J = energy_gain(out_dir, summary, Scene(scene), devices, phase_ticks)
+    return {"lift_mm": 1e3 * (hold[0] - z[0]), "lift_end_mm": 1e3 * (hold[-1] - z[0]), "final_z_m": float(z[-1]),
             "slip_mm": 1e3 * (hold.max() - hold.min()),
             "hold_force_p2p_N": max(ripple), "max_force_N": largest, "energy_gain_J": gain_J,
             "layer_withheld_J": layer_cost_J(summary),
