@@ -477,8 +477,8 @@ def main():
     with open(args.out / "latency_trials.csv", "w", newline="") as f:
         trial_fields = ["scene", "coupling", "delay_ms", "loss", "loss_burst", "phase_ticks", "delay_ticks", "caught",
                         "arrival_mps", "leaving_mps", "settle_m", "held", "displacement_m", "stop_x_m", "lift_mm",
-                        "lift_end_mm", "slip_mm", "hold_force_p2p_N", "energy_gain_J", "energy_tolerance_J",
-                        "max_force_N", "layer_withheld_J",
+                        "lift_end_mm", "final_z_m", "slip_mm", "hold_force_p2p_N", "energy_gain_J",
+                        "energy_tolerance_J", "max_force_N", "layer_withheld_J",
                         "contacts", "ledger_error", "lost_frames", "lost_reports", "link_dropped"]
         writer = csv.DictWriter(f, fieldnames=trial_fields, restval="")
         writer.writeheader()
