@@ -35,6 +35,12 @@ void fail(const std::string& path, const std::string& key, const std::string& re
   throw SpidarGeometryError(path + ": " + key + ": " + reason);
 }
 
+void tension_range(const std::string& path, double tension_min_N, double tension_max_N) {
+  if (!(tension_min_N < tension_max_N)) {
+    fail(path, "tension_max_N", "must exceed tension_min_N (" + readable(tension_min_N) + " N)");
+  }
+}
+
 nlohmann::json read(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw SpidarGeometryError(path + ": cannot open the device file");

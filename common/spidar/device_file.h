@@ -45,6 +45,9 @@ double positive(const nlohmann::json& document, const std::string& path, const c
 // The point [x, y, z] under `key`, each within ±bound_m, or `fallback` if there is none.
 Vec3 point(const nlohmann::json& document, const std::string& path, const char* key, const Vec3& fallback,
            double bound_m);
+// Throws, naming tension_max_N, unless tension_min_N < tension_max_N: a string must be able to pull harder than its
+// least tension.
+void tension_range(const std::string& path, double tension_min_N, double tension_max_N);
 [[noreturn]] void fail(const std::string& path, const std::string& key, const std::string& reason);
 
 }  // namespace device_file

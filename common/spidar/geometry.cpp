@@ -23,10 +23,7 @@ SpidarGeometry load_spidar_geometry(const std::string& path) {
   geometry.tension_max_N = positive(document, path, "tension_max_N", geometry.tension_max_N, kMaxForce_N);
   geometry.max_force_N = positive(document, path, "max_force_N", geometry.max_force_N, kMaxForce_N);
   geometry.centre_m = device_file::point(document, path, "centre_m", geometry.centre_m, kMaxFrameSide_m);
-  if (!(geometry.tension_min_N < geometry.tension_max_N)) {
-    device_file::fail(path, "tension_max_N",
-                      "must exceed tension_min_N (" + std::to_string(geometry.tension_min_N) + " N)");
-  }
+  device_file::tension_range(path, geometry.tension_min_N, geometry.tension_max_N);
   return geometry;
 }
 

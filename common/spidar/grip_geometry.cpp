@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "common/spidar/grip_geometry.h"
 
-#include "common/runtime/message_text.h"
-
 #include <nlohmann/json.hpp>
 
 #include <cstring>
@@ -26,10 +24,7 @@ SpidarGripGeometry load_grip_geometry(const std::string& path) {
       positive(document, path, "metres_per_count", geometry.metres_per_count, kMaxMetresPerCount);
   geometry.tension_min_N = positive(document, path, "tension_min_N", geometry.tension_min_N, kMaxForce_N);
   geometry.tension_max_N = positive(document, path, "tension_max_N", geometry.tension_max_N, kMaxForce_N);
-  if (!(geometry.tension_min_N < geometry.tension_max_N)) {
-    device_file::fail(path, "tension_max_N",
-                      "must exceed tension_min_N (" + readable(geometry.tension_min_N) + " N)");
-  }
+  device_file::tension_range(path, geometry.tension_min_N, geometry.tension_max_N);
   return geometry;
 }
 

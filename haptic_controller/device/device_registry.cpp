@@ -14,47 +14,39 @@
 namespace impetus {
 namespace {
 
-// The SPIDAR: four strings per finger from alternate corners of a cube (common/spidar/geometry.h); its argument is a
-// device file, the built-in geometry without one.
-class SpidarType final : public DeviceType {
+// A device a file describes (or the built-in geometry, without one): its geometry, its content hash and its source
+// are its description, and each finger is a `Driver` over that geometry.
+template <typename Device, typename Driver>
+class FileDeviceType final : public DeviceType {
  public:
-  explicit SpidarType(SpidarDevice spidar)
-      : spidar_(std::move(spidar)), description_{geometry_hash(spidar_.geometry), spidar_.source} {}
+  FileDeviceType(Device device, std::uint64_t hash)
+      : device_(std::move(device)), description_{hash, device_.source} {}
   const DeviceDescription& description() const override { return description_; }
   std::unique_ptr<HapticDevice> make_finger(DevicePortHost& port, ClockMode clock,
                                             std::uint64_t haptic_session) const override {
-    return std::make_unique<SpidarDriver>(spidar_.geometry, port, clock, haptic_session);
+    return std::make_unique<Driver>(device_.geometry, port, clock, haptic_session);
   }
 
  private:
-  SpidarDevice spidar_;
+  Device device_;
   DeviceDescription description_;
 };
 
+// The SPIDAR: four strings per finger from alternate corners of a cube (common/spidar/geometry.h); its argument is a
+// device file, the built-in geometry without one.
 std::unique_ptr<DeviceType> parse_spidar(const std::string& argument) {
-  return std::make_unique<SpidarType>(parse_device_spec(argument.empty() ? "spidar" : "spidar:" + argument));
+  SpidarDevice spidar = parse_device_spec(argument.empty() ? "spidar" : "spidar:" + argument);
+  const std::uint64_t hash = geometry_hash(spidar.geometry);
+  return std::make_unique<FileDeviceType<SpidarDevice, SpidarDriver>>(std::move(spidar), hash);
 }
 
 // The grip SPIDAR: eight strings from the corners of a cube hold a grip, whose pose they read and on which they render
 // force and torque (common/spidar/grip_geometry.h); one oriented finger, for a tool in the hand (docs/tool.md). Its
 // argument is a grip device file, the built-in geometry without one.
-class GripType final : public DeviceType {
- public:
-  explicit GripType(GripDevice grip)
-      : grip_(std::move(grip)), description_{grip_geometry_hash(grip_.geometry), grip_.source} {}
-  const DeviceDescription& description() const override { return description_; }
-  std::unique_ptr<HapticDevice> make_finger(DevicePortHost& port, ClockMode clock,
-                                            std::uint64_t haptic_session) const override {
-    return std::make_unique<GripPortDriver>(grip_.geometry, port, clock, haptic_session);
-  }
-
- private:
-  GripDevice grip_;
-  DeviceDescription description_;
-};
-
 std::unique_ptr<DeviceType> parse_grip(const std::string& argument) {
-  return std::make_unique<GripType>(parse_grip_spec(argument.empty() ? "grip" : "grip:" + argument));
+  GripDevice grip = parse_grip_spec(argument.empty() ? "grip" : "grip:" + argument);
+  const std::uint64_t hash = grip_geometry_hash(grip.geometry);
+  return std::make_unique<FileDeviceType<GripDevice, GripPortDriver>>(std::move(grip), hash);
 }
 
 // The web hand: a simulated hand steered from the viewer's page (web_hand.h); its argument is a hand file
