@@ -149,6 +149,18 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
   auto was_touched = [&](std::int32_t id) {
     return std::find(touched_ids.begin(), touched_ids.begin() + touched_count, id) != touched_ids.begin() + touched_count;
   };
+  // Which objects still hold a depth the replay revealed (header, "Frame boundaries"): it stays held into this frame.
+  std::array<std::int32_t, kMaxPlanes> revealed_ids{};
+  std::uint32_t revealed_count = 0;
+  for (std::uint32_t k = 0; k < plane_count_; ++k) {
+    if (blends_[k].revealed && blends_[k].normal_weight < 1.0) {
+      revealed_ids[revealed_count++] = frame_.planes[k].object_id;
+    }
+  }
+  auto was_revealed = [&](std::int32_t id) {
+    return std::find(revealed_ids.begin(), revealed_ids.begin() + revealed_count, id) !=
+           revealed_ids.begin() + revealed_count;
+  };
 
   copy_used(frame, frame_);
   plane_count_ = std::min(frame.plane_count, kMaxPlanes);
@@ -218,13 +230,31 @@ void LocalDynamics::on_plane_frame(const PlaneFrame& frame, const PlaneSet* disp
     const Eigen::Vector3d point = to_eigen(plane.point_m);
     const Eigen::Vector3d normal = to_eigen(plane.normal);
     PlaneBlend& blend = blends_[k];
-    blend = PlaneBlend{point, normal, 0.0, false};
+    blend = PlaneBlend{point, normal, 0.0, false, false, point, normal};
     const int match = displayed ? find_plane(*displayed, plane.object_id, occurrence_of(frame_, k)) : -1;
-    if (match < 0) continue;  // a new plane starts at the world's value
+    if (match < 0) {
+      // A new plane starts at the world's value, unless the replay has carried its body over the proxy (header,
+      // "Delay": a round trip on, past a finger no frame had shown it near). Then the part of the proxy's depth the
+      // replay made starts held and closes only as the finger withdraws (header, "Frame boundaries"), so a depth the
+      // finger never pressed into is not turned into a push; the world's own part is pushed out, as without delay.
+      const Plane& at_frame = frame.planes[k];
+      const double frame_depth_m = to_eigen(at_frame.normal).dot(proxy_m - to_eigen(at_frame.point_m));
+      const double held_m = normal.dot(proxy_m - point) - std::min(0.0, frame_depth_m);
+      if (body_of_plane_[k] >= 0 && last_replayed_ticks_ > 0 && held_m < 0.0) {
+        blend.from_point_m = point + held_m * normal;
+        blend.last_point_m = blend.from_point_m;
+        blend.hold_normal = true;
+        blend.revealed = true;
+      }
+      continue;
+    }
     const ContactPlane& before = displayed->planes[static_cast<std::size_t>(match)];
     blend.from_point_m = before.point_m;
     blend.from_normal = before.normal;
+    blend.last_point_m = before.point_m;
+    blend.last_normal = before.normal;
     blend.hold_normal = body_of_plane_[k] >= 0 && (before.point_m - point).dot(normal) < 0.0;
+    blend.revealed = blend.hold_normal && was_revealed(plane.object_id);
     if (body_of_plane_[k] >= 0 && was_touched(plane.object_id)) {
       const double error_m = std::fabs(normal.dot(proxy_m - point) - before.normal.dot(proxy_m - before.point_m));
       last_model_error_m_ = std::max(last_model_error_m_, error_m);
@@ -496,10 +526,19 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
         // Passivity: the gap toward the finger (offset_normal_m < 0) closes no further than the last proxy, so the
         // blend never pushes the finger out. Signed distance of the proxy to the plane as a function of w_n:
         //     d(w_n) = d_P + (1 − w_n)·|offset_normal|,   d_P = its distance to the plane with the gap closed.
+        // A revealed depth closes by no more than the finger's clearance from last tick's plane (header): not into
+        // room the body made.
         const double gap_m = -offset_normal_m;
         const double d_closed_m =
             body->carry_normal(target_normal).dot(proxy_m - body->carry_point(target_point + tangential));
-        if (d_closed_m < 0.0) normal_weight = std::min(normal_weight, std::max(blend.normal_weight, 1.0 + d_closed_m / gap_m));
+        if (d_closed_m < 0.0) {
+          double limit = 1.0 + d_closed_m / gap_m;
+          if (blend.revealed) {
+            const double clearance_m = std::max(0.0, blend.last_normal.dot(proxy_m - blend.last_point_m));
+            limit = std::min(limit, blend.normal_weight + clearance_m / gap_m);
+          }
+          normal_weight = std::min(normal_weight, std::max(blend.normal_weight, limit));
+        }
       }
       blend.normal_weight = normal_weight;
       point = target_point + tangential + (1.0 - normal_weight) * offset_normal_m * target_normal;
@@ -510,6 +549,8 @@ void LocalDynamics::render(double w, const Eigen::Vector3d& proxy_m, PlaneSet& o
     if (body) {
       plane.point_m = body->carry_point(point);
       plane.normal = body->carry_normal(normal);  // turned for a flat face only: see the header
+      blend.last_point_m = plane.point_m;
+      blend.last_normal = plane.normal;
       plane.com_m = body->com_m();
       // A shape travels with its plane: its centre is the CoM, its axes turn with the body (shape_planes.h).
       for (int axis = 0; axis < 3; ++axis) plane.axes.col(axis) = body->carry_axis(plane.axes.col(axis));

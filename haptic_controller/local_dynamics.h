@@ -97,6 +97,15 @@
 // energy. w_n therefore never moves the plane past the last proxy: the gap closes only as the finger withdraws (a
 // wrong model errs toward a softer object, never toward an active one). The model itself never pushes: the plane
 // moves with the world's motion and with the finger's own impulse, which moves it away from the finger.
+// A depth the replay revealed (below, "Delay": a new plane whose body the replay carried over the proxy, a round trip
+// further on than any frame showed it) is held the same way from its first frame, and closes only by the finger's
+// own withdrawal: w_n grows by at most the proxy's clearance from the plane rendered the tick before, also in the
+// frames after, until it has closed. A body that moves back under the finger's push carries that plane with it, so
+// the finger's spring relaxes as against any face. Closing the gap as fast as the body leaves would keep the plane at
+// the proxy and the force at its height while the body moves under it: work on the body that neither hand nor spring
+// gave (a cube caught over a 50 ms link was thrown back up its ramp with 0.14 J more than it came with). A gap of
+// the model's own error (a body driven by a heavier neighbour than the model knows, hard case 12d) closes as the
+// body makes room: there the world's body is really over the finger, and holding it would let it through.
 // The model is restarted from the world's state at every frame, so a local deviation does not outlive the contact.
 //
 // Delay. A frame's state is the world's after it applied the report of tick a (PlaneFrame::report_tick_applied, this
@@ -302,6 +311,10 @@ class LocalDynamics final : public PlaneMotion {
     Eigen::Vector3d from_normal = Eigen::Vector3d::UnitZ();
     double normal_weight = 0.0;  // w_n: how much of the normal offset has been closed (never decreases)
     bool hold_normal = false;    // P is toward the finger from C: close no further than the proxy
+    bool revealed = false;       // the held gap is a depth the replay revealed: only the finger's withdrawal closes it
+    // The plane rendered the tick before (world frame): the finger's clearance from it is what w_n may close.
+    Eigen::Vector3d last_point_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d last_normal = Eigen::Vector3d::UnitZ();
   };
 
   PlaneFrame frame_{};  // the planes of the current frame (P)

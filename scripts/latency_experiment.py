@@ -111,12 +111,19 @@ def ledger_error_Ns(summary, out_dir):
 
 
 def energy_gain(out_dir, summary, scene, devices, phase_ticks):
-    """energy_balance of the trial: (largest energy gain beyond the hand's work, its tolerance), J. energy_balance
-    pairs each world step with the haptic tick of a phase-0 clock; with phase p the step was taken p ticks later,
-    so the world log's times are shifted by p ticks first."""
+    """energy_balance of the trial: (largest energy gain beyond the hand's work, its tolerance), J.
+
+    energy_balance pairs each world step with the haptic tick it was taken at on a phase-0 clock without delay, when
+    the step holds every impulse rendered up to that tick. Over a link of delay d (and with phase p) a step holds the
+    impulses up to the report it applied, d (and p) earlier; what the hand did after that tick is still on the link,
+    in both directions: a hand that has already taken the push of a cube the world has not yet stopped would show the
+    cube's energy twice (0.12 J in the catch at 50 ms). So each step is paired with the tick of the report it applied
+    (world.csv's haptic_time_s: logs.world_clock_offset_s, the phase alone without delay). Nothing is hidden: every
+    push lands in a later step, which is compared with the hand's work up to its own report."""
     world = logs.read_log(out_dir / logs.WORLD)
     haptic_period_s = summary.haptic_period_s
-    world.columns["time_s"] = world["time_s"] + phase_ticks * haptic_period_s
+    offset_s = logs.world_clock_offset_s(world) if summary.link["delay_ticks"] > 0 else -phase_ticks * haptic_period_s
+    world.columns["time_s"] = world["time_s"] - offset_s
     balance = energy_balance(scene, summary.objects, devices, world, summary.device, summary.world_period_s,
                              haptic_period_s)
     return balance["excess_J"], balance["tolerance_J"]
@@ -237,9 +244,9 @@ def parse_ms(text, name):
     return values
 
 
-# The delay up to which --check holds local coupling to no energy gain (ms, one way): every tap, loss, catch, stack
-# and grasp cell of docs/latency.md is within its tolerance there.
-PASSIVE_UP_TO_MS = 20.0
+# --check holds local coupling, and every coupling with the passivity layer, to no energy gain at every delay, except
+# the grasp under local coupling beyond this one-way delay (ms), where docs/latency.md reports a gain still open.
+GRASP_PASSIVE_UP_TO_MS = 20.0
 
 
 def ms_label(delay_ms):
@@ -313,12 +320,13 @@ def main():
     parser.add_argument("--plot", action=argparse.BooleanOptionalAction, default=True)
     parser.add_argument("--check", action="store_true",
                         help="exit 1 unless every number is finite, the ledger is exact in every impulse and local "
-                             "trial, and no local trial up to 20 ms gains energy beyond its tolerance")
+                             "trial, and no local or +layer trial gains energy beyond its tolerance (the grasp under "
+                             "local coupling up to 20 ms)")
     args = parser.parse_args()
     if args.quick:
         args.delays_ms, args.phases = "0,20", 2
         args.losses, args.loss_delays_ms = "20b5", "20"
-        args.catch_delays_ms, args.catch_couplings, args.catch_phases = "20", "local,impulse+layer", 1
+        args.catch_delays_ms, args.catch_couplings, args.catch_phases = "20,50", "local,impulse+layer", 1
         args.stack_delays_ms, args.stack_couplings, args.stack_phases = "20", "local", 1
         args.grasp_delays_ms, args.grasp_couplings, args.grasp_phases = "20", "local", 1
     for flag, count in (("--phases", args.phases), ("--grasp-phases", args.grasp_phases),
@@ -632,14 +640,15 @@ def main():
                 where = f"{scene} {coupling} {ms_label(delay)} ms" + (f" {loss_label(key[4])}" if len(key) > 4 else "")
                 failures.append(f"{where} phase {phase}: the impulse applied differs from the impulse rendered by "
                                 f"{error:.3g} (relative)")
-        # Passivity: local coupling (without the layer) gains no energy beyond a trial's tolerance up to
-        # PASSIVE_UP_TO_MS of one-way delay, in every scene (docs/latency.md; the grasp's gain beyond it is open).
+        # Passivity: local coupling and the passivity layer gain no energy beyond a trial's tolerance at any delay, in
+        # every scene (docs/latency.md; the grasp's gain beyond GRASP_PASSIVE_UP_TO_MS is open).
         for key, row in trials.items():
             scene, coupling, delay, phase = key[:4]
-            if coupling != "local" or delay > PASSIVE_UP_TO_MS or "energy_gain_J" not in row:
+            passive = coupling == "local" or coupling.endswith("+layer")
+            if not passive or (scene == "grasp" and delay > GRASP_PASSIVE_UP_TO_MS) or "energy_gain_J" not in row:
                 continue
             if not row["energy_gain_J"] <= row["energy_tolerance_J"]:
-                failures.append(f"{scene} local {ms_label(delay)} ms phase {phase}: energy gain "
+                failures.append(f"{scene} {coupling} {ms_label(delay)} ms phase {phase}: energy gain "
                                 f"{1e3 * row['energy_gain_J']:.2f} mJ over the tolerance "
                                 f"{1e3 * row['energy_tolerance_J']:.2f} mJ")
         if failures:

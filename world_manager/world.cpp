@@ -58,7 +58,7 @@ World::World(const Scene& scene, const WorldOptions& options)
                                                           state.pose.position_m, state.pose.orientation);
     }
   }
-  refresh_states(engine_->moved());
+  refresh_states(engine_->moved(), false);
   features_.index(states_, period_s_);
   for (PlaneFrame& frame : frames_) {
     frame.world_session = options_.world_session;
@@ -145,7 +145,7 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
   }
   ++steps_taken_;
   time_s_ = static_cast<double>(steps_taken_) * period_s_;  // no drift from summing periods
-  refresh_states(engine_->moved());
+  refresh_states(engine_->moved(), true);
   simulated_object_steps_ += engine_->moved().size();
   if (scene_.floor.present) {
     for (const std::size_t id : engine_->moved()) {
@@ -346,11 +346,14 @@ std::vector<CounterOwner> World::impulse_owners() const {
 
 const std::vector<std::size_t>& World::escaped() const { return engine_->escaped(); }
 
-void World::refresh_states(std::span<const std::size_t> moved) {
+void World::refresh_states(std::span<const std::size_t> moved, bool stepped) {
+  for (ObjectState& state : states_) state.acceleration_mps2.setZero();  // a body that did not move: none
   for (const std::size_t id : moved) {
     ObjectState& state = states_[id];
     const SceneObject& object = scene_.objects[id];
+    const Eigen::Vector3d velocity_before_mps = state.velocity_mps;
     engine_->read_state(id, state);
+    if (stepped) state.acceleration_mps2 = (state.velocity_mps - velocity_before_mps) / period_s_;
     state.inverse_mass_per_kg = 1.0 / object.mass_kg;
     const Eigen::Matrix3d rotation = state.pose.orientation.toRotationMatrix();
     state.inverse_inertia_world = rotation * engine_->inverse_inertia_body(id) * rotation.transpose();

@@ -121,11 +121,12 @@ def energy_balance(scene, bodies, device, world, finger, world_period_s, haptic_
     e0 = float(finger_kinetic[0])
     for obj in dynamic:
         e0 += _initial_energy_J(obj, bodies[obj["name"]], gravity)
-    # World step j (at world time t_j) was taken at haptic tick round((t_j - T_world) / T_haptic); steps after the
-    # device log ends are left out.
+    # World step j (at world time t_j) was taken at haptic tick round((t_j - T_world) / T_haptic); steps before the
+    # device log starts (a world log whose times were shifted back by a link's delay) and after it ends are left out.
     tick = np.rint((world["time_s"] - world_period_s) / haptic_period_s).astype(int)
     late = np.flatnonzero(tick >= len(times))
-    rows = slice(0, late[0] if len(late) else len(tick))
+    rows = np.arange(late[0] if len(late) else len(tick))
+    rows = rows[tick[rows] >= 0]
     tick = tick[rows]
     energy = finger_kinetic[tick]
     for obj in dynamic:

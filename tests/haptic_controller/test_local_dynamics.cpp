@@ -632,3 +632,59 @@ TEST_CASE("local dynamics over a delayed link: a frame of the world before the l
     CHECK(model.find(1)->velocity_mps.x() == Approx(4.0 * push_Ns.x()));
   }
 }
+
+TEST_CASE("local dynamics over a delayed link: a body the replay carries over the finger does not push it out by "
+          "the depth it was never pressed into, and that depth closes as the finger withdraws, not as the body "
+          "leaves") {
+  constexpr std::uint64_t kSession = 7;
+  const Vector3d proxy_m(-0.05, 0.0, 0.05);
+  // Ten ticks with no plane at all: the frame showing the cube has not arrived yet.
+  LocalDynamics model(kSession);
+  model.on_plane_frame(local_frame({}), nullptr, proxy_m);
+  PlaneSet planes;
+  for (std::uint64_t tick = 1; tick <= 10; ++tick) {
+    model.note_tick(tick);
+    model.planes_for_tick(1.0, kTick_s, false, proxy_m, planes);
+  }
+  // It arrives a round trip late (it applied tick 0): the cube's face 5 mm short of the proxy, coming on at 1 m/s.
+  // The replay of ticks 1…10 carries it 10 mm on, 5 mm over the proxy.
+  Plane face = cube_face();
+  face.point_m = {-0.045, 0.0, 0.05};
+  face.com_m = {-0.02, 0.0, 0.05};
+  face.velocity_mps = {-1.0, 0.0, 0.0};
+  PlaneFrame frame = local_frame({face}, 1);
+  frame.report_tick_applied = 0;
+  frame.report_session_applied = kSession;
+  model.on_plane_frame(frame, &planes, proxy_m);
+  REQUIRE(model.last_replayed_ticks() == 10);
+  REQUIRE(model.find(1)->com_m().x() == Approx(-0.03).epsilon(1e-9));
+
+  // The first tick: the plane starts at the proxy and moves on with the body by one tick's travel, 1 mm, not 6.
+  model.note_tick(11);
+  model.planes_for_tick(0.02, kTick_s, false, proxy_m, planes);
+  REQUIRE(planes.count == 1);
+  CHECK(planes.planes[0].point_m.x() == Approx(proxy_m.x() - 0.001).margin(1e-9));
+
+  // The finger's push turns the body back (+1 m/s). With the finger still, the plane leaves with the body, 1 mm a
+  // tick: the held depth does not close into the room the body makes.
+  impetus::ImpulseShare share;
+  share.object_id = 1;
+  share.dynamic = true;
+  share.impulse_Ns = {2.0, 0.0, 0.0};
+  model.take_shares(&share, 1);
+  const Vector3d pressed_m(proxy_m.x() - 0.001, 0.0, 0.05);  // the proxy on the plane it was pushed to
+  model.note_tick(12);
+  model.planes_for_tick(0.04, kTick_s, false, pressed_m, planes);
+  CHECK(planes.planes[0].point_m.x() == Approx(pressed_m.x() + 0.001).margin(1e-9));
+  model.note_tick(13);  // the proxy has followed the plane back toward the finger
+  model.planes_for_tick(0.06, kTick_s, false, Vector3d(pressed_m.x() + 0.001, 0.0, 0.05), planes);
+  CHECK(planes.planes[0].point_m.x() == Approx(pressed_m.x() + 0.002).margin(1e-9));
+
+  // The finger withdraws 3 mm (−x): the plane closes toward the world's face by at most that clearance, to the proxy.
+  const Vector3d withdrawn_m(pressed_m.x() + 0.002 - 0.003, 0.0, 0.05);
+  model.note_tick(14);
+  model.planes_for_tick(0.08, kTick_s, false, withdrawn_m, planes);
+  const double closed_x = planes.planes[0].point_m.x();
+  CHECK(closed_x < pressed_m.x() + 0.003 - 1e-4);  // it closed (the body alone would have put it at +3 mm)
+  CHECK(closed_x >= withdrawn_m.x() - 1e-9);       // never past the proxy
+}

@@ -49,6 +49,8 @@ RandomWorld make_random_world(std::uint32_t seed, int count) {
     state.pose.position_m = Vector3d(unit(rng), unit(rng), unit(rng));
     state.pose.orientation = Eigen::Quaterniond::UnitRandom();
     if (object.dynamic) state.velocity_mps = Vector3d(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5);
+    // Half the dynamic ones accelerate (up to 10 m/s² along each axis: falling, sliding down a slope, pushed).
+    if (object.dynamic && i % 2 == 0) state.acceleration_mps2 = 20.0 * Vector3d(unit(rng) - 0.5, unit(rng) - 0.5, 0.5);
     world.states.push_back(state);
   }
   return world;
@@ -62,8 +64,9 @@ std::set<std::int32_t> brute_force_within_reach(const RandomWorld& world, const 
   for (std::size_t i = 0; i < world.states.size(); ++i) {
     const auto surface = impetus::nearest_surface_point(world.scene.objects[i].shape, world.states[i].pose,
                                                         finger.position_m);
-    const double reach_m =
-        world.scene.haptic.reach_radius_m + (finger_speed + world.states[i].velocity_mps.norm()) * horizon_s;
+    const double reach_m = world.scene.haptic.reach_radius_m +
+                           (finger_speed + world.states[i].velocity_mps.norm()) * horizon_s +
+                           0.5 * world.states[i].acceleration_mps2.norm() * horizon_s * horizon_s;
     if (surface.signed_distance_m <= reach_m) ids.insert(static_cast<std::int32_t>(i));
   }
   if (finger.position_m.z() <= world.scene.haptic.reach_radius_m + finger_speed * horizon_s) {
@@ -118,6 +121,34 @@ TEST_CASE("the feature query returns exactly the objects within reach, over a ro
   INFO("found " << total_found << ", tested " << total_tested);
   CHECK(total_tested < 300 * 500 / 5);
   CHECK(total_found > 300);  // the trials do hit objects, so the comparison means something
+}
+
+TEST_CASE("an accelerating object is within reach once its travel at that acceleration covers the distance") {
+  // A 5 cm cube sliding toward the finger down a 25° ramp (3.3 m/s²) at 0.8 m/s, over a 100 ms round trip:
+  // H = 0.15 s, the speed covers 0.12 m and the acceleration 3.7 cm more.
+  Scene scene = lone_cube(0.05, 0.5);
+  scene.haptic.reach_radius_m = 0.005;
+  FeatureExtractor extractor(scene);
+  ObjectState cube;
+  cube.velocity_mps = Vector3d(0.8, 0.0, 0.0);
+  cube.acceleration_mps2 = Vector3d(3.3, 0.0, 0.0);
+  const std::vector<ObjectState> states{cube};
+  extractor.index(states, kPeriod_s);
+  ReachQuery finger;
+  finger.round_trip_s = 0.1;
+  const double horizon_s = kPeriod_s + finger.round_trip_s;
+  const double by_speed_m = 0.005 + 0.8 * horizon_s;
+  const double by_both_m = by_speed_m + 0.5 * 3.3 * horizon_s * horizon_s;
+  std::vector<ReachCandidate> found;
+  for (const double gap_m : {by_speed_m + 0.001, 0.5 * (by_speed_m + by_both_m), by_both_m - 0.001}) {
+    finger.position_m = Vector3d(0.025 + gap_m, 0.0, 0.0);
+    extractor.within_reach(finger, states, kPeriod_s, found);
+    INFO("gap " << gap_m);
+    CHECK(found.size() == 1);
+  }
+  finger.position_m = Vector3d(0.025 + by_both_m + 0.001, 0.0, 0.0);
+  extractor.within_reach(finger, states, kPeriod_s, found);
+  CHECK(found.empty());
 }
 
 TEST_CASE("more objects within reach than a frame holds: the nearest kMaxPlanes are kept") {

@@ -161,6 +161,25 @@ TEST_CASE("the world reports how deep a body has been into the floor, and shorte
   CHECK(world->floor_penetration_max_m() < 1e-5);
 }
 
+TEST_CASE("the world measures each body's mean acceleration over a step: g in free fall, none at rest") {
+  // A ball thrown up at 1 m/s from 1 m (it falls freely for the four steps) and a cube resting on the floor.
+  const impetus::Scene scene = impetus::parse_scene(
+      nlohmann::json::parse(R"({"objects": [
+        {"name": "ball", "shape": "sphere", "radius_m": 0.02, "dynamic": true, "mass_kg": 0.023,
+         "position_m": [0, 0, 1.0], "linear_velocity_mps": [0, 0, 1]},
+        {"name": "cube", "shape": "box", "size_m": [0.05, 0.05, 0.05], "dynamic": true, "mass_kg": 0.5,
+         "position_m": [0.5, 0, 0.025]}]})"),
+      "fall.json");
+  auto world = make_world(scene);
+  CHECK(world->states()[0].acceleration_mps2.norm() == 0.0);  // none before the first step, whatever the speed
+  for (int i = 0; i < 4; ++i) {
+    world->step(nullptr);
+    const Eigen::Vector3d gravity = impetus::to_eigen(scene.gravity_mps2);
+    CHECK((world->states()[0].acceleration_mps2 - gravity).norm() < 1e-9 * gravity.norm());
+    CHECK(world->states()[1].acceleration_mps2.norm() < 0.01);  // the floor carries it
+  }
+}
+
 TEST_CASE("bodies a scene places inside each other or the floor are found at the start, resting ones are not") {
   using nlohmann::json;
   const json document{

@@ -56,9 +56,11 @@ Eigen::AlignedBox3d FeatureExtractor::swept_bounds(std::size_t id, const ObjectS
 void FeatureExtractor::index(std::span<const ObjectState> states, double world_period_s) {
   swept_bounds_.resize(states.size());
   fastest_mps_ = 0.0;
+  largest_acceleration_mps2_ = 0.0;
   for (std::size_t i = 0; i < states.size(); ++i) {
     swept_bounds_[i] = swept_bounds(i, states[i], world_period_s);
     fastest_mps_ = std::max(fastest_mps_, states[i].velocity_mps.norm());
+    largest_acceleration_mps2_ = std::max(largest_acceleration_mps2_, states[i].acceleration_mps2.norm());
   }
   grid_.rebuild(swept_bounds_);
 }
@@ -66,10 +68,12 @@ void FeatureExtractor::index(std::span<const ObjectState> states, double world_p
 void FeatureExtractor::reindex(std::span<const ObjectState> states, double world_period_s,
                                std::span<const std::size_t> moved) {
   if (swept_bounds_.size() != states.size()) return index(states, world_period_s);
+  largest_acceleration_mps2_ = 0.0;
   for (const std::size_t id : moved) {
     if (id >= states.size()) continue;
     swept_bounds_[id] = swept_bounds(id, states[id], world_period_s);
     fastest_mps_ = std::max(fastest_mps_, states[id].velocity_mps.norm());
+    largest_acceleration_mps2_ = std::max(largest_acceleration_mps2_, states[id].acceleration_mps2.norm());
     grid_.update(static_cast<std::int32_t>(id), swept_bounds_[id]);
   }
 }
@@ -84,7 +88,8 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
   const double horizon_s = world_period_s + finger.round_trip_s;
   const double finger_reach_m = base_reach_m + finger_speed_mps * horizon_s;
   // The grid holds bounds swept over one period: over a round trip any object may come further by its speed.
-  const double query_m = finger_reach_m + (finger.round_trip_s > 0.0 ? fastest_mps_ * finger.round_trip_s : 0.0);
+  const double query_m = finger_reach_m + (finger.round_trip_s > 0.0 ? fastest_mps_ * finger.round_trip_s : 0.0) +
+                         0.5 * largest_acceleration_mps2_ * horizon_s * horizon_s;
   const Eigen::AlignedBox3d query(finger.position_m.array() - query_m, finger.position_m.array() + query_m);
   grid_.query(query, candidate_ids_);
 
@@ -120,8 +125,9 @@ void FeatureExtractor::within_reach(const ReachQuery& finger, std::span<const Ob
         }
       }
     }
-    // docs/architecture.md §1.1 step 4: reach = base radius + (finger speed + object speed)·(T_w + round trip).
-    const double reach_m = base_reach_m + (finger_speed_mps + state.velocity_mps.norm()) * horizon_s;
+    // docs/architecture.md §1.1 step 4 (header): the travel of both over H, and the object's at its acceleration.
+    const double reach_m = base_reach_m + (finger_speed_mps + state.velocity_mps.norm()) * horizon_s +
+                           0.5 * state.acceleration_mps2.norm() * horizon_s * horizon_s;
     // A NaN distance fails this test: a broken object gives no plane rather than a frame the haptic side rejects.
     if (surface.signed_distance_m <= reach_m && surface.point_m.allFinite() && surface.normal.allFinite()) {
       out.push_back({id, surface});

@@ -3,9 +3,12 @@
 // Paper §3.1 and docs/architecture.md §1.1 step 4: the planes of the objects near the finger.
 //
 // An object is *within reach* when its surface is at most
-//     reach = base radius + (finger speed + object speed) · T_w
+//     reach = base radius + (finger speed + object speed)·H + ½·|object acceleration|·H²,   H = T_w (+ round trip)
 // from the finger (inside counts: the signed distance is negative), so nothing either of them can reach before the next
-// world step is missed. The floor (object_id = scene.floor_object_id()) and static objects give planes too.
+// world step's planes replace these at the finger is missed. The acceleration is the object's mean over the last step
+// (ObjectState::acceleration_mps2): a cube sliding down a 25° ramp gains 3.3 m/s², and over a 50 ms link (H = 0.15 s)
+// that is 3.7 cm the speed term alone leaves out, more than the finger's stiffness can take up. The floor
+// (object_id = scene.floor_object_id()) and static objects give planes too.
 //
 // The extractor keeps a SpatialGrid of every object's bounding box swept by its own speed·T_w; index() builds it,
 // reindex() moves the objects that moved in a world step, and extract() then only tests the objects in the cells
@@ -93,6 +96,9 @@ class FeatureExtractor {
   // At least the fastest indexed object's speed (exact after index(), never lower after reindex()): a query over a
   // round trip widens its box by how far any object can come in it beyond the period its bounds are swept over.
   double fastest_mps_ = 0.0;
+  // The largest acceleration among the bodies that moved in the last step (the others have none): the query's box
+  // grows by its ½·a·H² as each object's reach does.
+  double largest_acceleration_mps2_ = 0.0;
   mutable std::vector<std::int32_t> candidate_ids_;     // reused between queries: no allocation per step
   mutable std::vector<ReachCandidate> reach_scratch_;
 };
