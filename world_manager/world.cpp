@@ -106,6 +106,10 @@ std::span<const PlaneFrame> World::step(std::span<const HapticReport* const> rep
     if (report == nullptr) continue;
     if (report->world_session != options_.world_session) {
       ++foreign_reports_;
+      // A haptic side that has seen no world yet (session 0) and rendered nothing has nothing to apply, and all of
+      // it is in this step: its frame names the report, so the haptic side measures the link's round trip from
+      // its first frame (HapticReport::link_round_trip_s), a round trip sooner than from the first applied one.
+      if (report->world_session == 0 && report->entry_count == 0) applied[slot] = report;
       continue;
     }
     applied[slot] = report;

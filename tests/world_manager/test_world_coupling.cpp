@@ -235,6 +235,25 @@ TEST_CASE("entries on static geometry or unknown ids move nothing") {
   CHECK(close(world->total_static_impulse_Ns(), Vector3d(1.0, 0.0, -0.5)));
 }
 
+TEST_CASE("a frame names the report of a haptic side that has seen no world yet and rendered nothing, so the "
+          "round trip is measured from the first frame; one that rendered against another world it does not name") {
+  const json cube{{"name", "cube"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", true},
+                  {"mass_kg", 1.0}, {"position_m", {0.03, 0.0, 0.025}}};
+  auto world = make_world(impetus::parse_scene(impetus::test::free_body_document(cube), "free.json"));
+  HapticReport fresh = make_report(4, 50, {0.0, 0.0, 0.025}, true);
+  fresh.world_session = 0;  // no frame seen yet
+  const impetus::PlaneFrame& first = world->step(&fresh);
+  CHECK(world->foreign_reports() == 1);  // still not counted against this world
+  CHECK(first.report_session_applied == 4);
+  CHECK(first.report_tick_applied == 50);
+  HapticReport rendered = make_report(5, 60, {0.0, 0.0, 0.025}, true);
+  rendered.world_session = 0;
+  add_entry(rendered, 0, 1, {0.5, 0.0, 0.0});  // impulse rendered against no world of ours: not named, not applied
+  const impetus::PlaneFrame& second = world->step(&rendered);
+  CHECK(second.report_session_applied == 4);  // the frame keeps the last report it could name
+  CHECK(world->states()[0].velocity_mps.norm() == 0.0);
+}
+
 TEST_CASE("a report counted against another world session moves nothing, but its finger still brings planes") {
   // A 1 kg cube in free space. The report's totals were rendered against a world that is gone (a restart), or
   // before any frame: this world must not apply them, neither now nor later.
