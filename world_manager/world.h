@@ -173,8 +173,8 @@ class World {
 
   void take_finger(Endpoint& endpoint, const HapticReport& report);
   void take_report(Endpoint& endpoint, const HapticReport& report);
-  // Reads the state of the dynamic objects in `moved` (static ones are set once, sleeping ones do not change).
-  // Reads the moved bodies' states from the engine; after a step (`stepped`) also their mean acceleration over it.
+  // Reads the state of the dynamic objects in `moved` (static ones are set once, sleeping ones do not change), and
+  // after a step (`stepped`) their mean acceleration over it.
   void refresh_states(std::span<const std::size_t> moved, bool stepped);
   void publish(std::size_t slot, const HapticReport* applied_report);
   // The passivity layer's stage 3 (couplings/passivity_layer.h): each object's unspent budget back to the endpoints

@@ -236,7 +236,7 @@ TEST_CASE("entries on static geometry or unknown ids move nothing") {
 }
 
 TEST_CASE("a frame names the report of a haptic side that has seen no world yet and rendered nothing, so the "
-          "round trip is measured from the first frame; one that rendered against another world it does not name") {
+          "round trip is measured from the first frame, but not one that rendered impulse against no world of ours") {
   const json cube{{"name", "cube"}, {"shape", "box"}, {"size_m", {0.05, 0.05, 0.05}}, {"dynamic", true},
                   {"mass_kg", 1.0}, {"position_m", {0.03, 0.0, 0.025}}};
   auto world = make_world(impetus::parse_scene(impetus::test::free_body_document(cube), "free.json"));
