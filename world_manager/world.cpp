@@ -351,7 +351,10 @@ std::vector<CounterOwner> World::impulse_owners() const {
 const std::vector<std::size_t>& World::escaped() const { return engine_->escaped(); }
 
 void World::refresh_states(std::span<const std::size_t> moved, bool stepped) {
-  for (ObjectState& state : states_) state.acceleration_mps2.setZero();  // a body that did not move: none
+  // A body that did not move has no acceleration: only those that moved last time can hold one (a step costs the
+  // bodies that move, not the bodies that exist).
+  for (const std::size_t id : accelerated_) states_[id].acceleration_mps2.setZero();
+  accelerated_.assign(moved.begin(), moved.end());
   for (const std::size_t id : moved) {
     ObjectState& state = states_[id];
     const SceneObject& object = scene_.objects[id];

@@ -187,6 +187,7 @@ class World {
   std::unique_ptr<RigidBodyEngine> engine_;
   std::vector<RigidBodyEngine::Overlap> start_overlaps_;
   std::vector<ObjectState> states_;
+  std::vector<std::size_t> accelerated_;  // the bodies that moved in the last step (refresh_states)
   ImpulseLedger ledger_;
   // The same running totals' first moments in time (ObjectImpulse::impulse_moment_Nss), differenced with the same
   // owner/epoch rules as the impulses themselves: when within its window each impulse was rendered.
