@@ -102,6 +102,7 @@ std::string scene_message(const ViewScene& scene, const std::string& source, con
   if (tool != nullptr) {
     nlohmann::json entry = nlohmann::json::object();
     add_shape(tool->shape, entry);
+    if (tool->shape.kind == ShapeKind::mesh) entry["mesh"] = mesh_form(tool->shape);  // drawn as a body's mesh is
     const Eigen::Vector3d& p = tool->placement.position_m;
     const Eigen::Quaterniond& q = tool->placement.orientation;
     entry["placement"] = {{"position_m", {p.x(), p.y(), p.z()}}, {"orientation_wxyz", {q.w(), q.x(), q.y(), q.z()}}};

@@ -18,7 +18,8 @@
 //         {"drawn": "bound", "why": "..."}: the page draws a ball of radius_m about its centre instead.
 //       "replay": {"start_s": t0, "end_s": t1, "frame_count": n},          (replay only)
 //       "tool": {"shape": ..., "size_m": ..., "radius_m": ..., "length_m": ...,   (a tool in the hand: a replay's, or
-//                                                  live the tool of the scene --meshes-from names)
+//                                                  live the tool of the scene --meshes-from names; a mesh tool
+//                                                  also has "mesh", as a body's)
 //                "placement": {"position_m": [x, y, z], "orientation_wxyz": [w, x, y, z]}}}   (shape → grip frame)
 //    Body k of every frame below is bodies[k]. A shape's axis of symmetry is its body z.
 //

@@ -347,7 +347,7 @@ Scene parse_scene(const nlohmann::json& document, const std::string& source_name
   if (root.has("physics")) scene.physics = parse_physics(root.child("physics"));
   if (root.has("haptic")) scene.haptic = parse_haptic(root.child("haptic"));
   if (root.has("tool")) {
-    scene.tool = parse_tool_block(root.child("tool"), scene.gravity_mps2);
+    scene.tool = parse_tool_block(root.child("tool"), scene.gravity_mps2, scene_folder(source_name));
     // The world sends the planes of objects within the reach radius of the tool's grip: it must cover the tool, with
     // a finger's neighbourhood around its farthest point. Given, it is checked; not given, it is widened.
     const bool reach_given = root.has("haptic") && root.child("haptic").has("reach_radius_m");

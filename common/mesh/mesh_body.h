@@ -50,11 +50,14 @@ class MeshBody final : public MeshGeometry {
     return bvh_.on_triangle(triangle, x, tolerance_m, out);
   }
   Eigen::Vector3d bounds_half(const Eigen::Matrix3d& rotation) const override;
+  int contact_samples(ContactSamples& samples) const override;
+  int contact_edges(ContactEdges& edges) const override;
   double volume_m3() const override { return volume_m3_; }
   Eigen::Matrix3d inertia_per_kg() const override { return inertia_per_kg_; }
 
  private:
   MeshBody(TriangleMesh mesh, bool closed, bool flipped);
+  void take_contact_features();
 
   Shape shape_;
   Eigen::Vector3d origin_in_file_m_ = Eigen::Vector3d::Zero();
@@ -63,6 +66,10 @@ class MeshBody final : public MeshGeometry {
   double volume_m3_ = 0.0;
   Eigen::Matrix3d inertia_per_kg_ = Eigen::Matrix3d::Zero();
   MeshBvh bvh_;
+  ContactSamples samples_{};  // its corners and sharp edges, if they stand for it (contact_samples)
+  int sample_count_ = 0;
+  ContactEdges edges_{};
+  int edge_count_ = 0;
   mutable std::once_flag smooth_built_;
   mutable std::unique_ptr<SmoothSurface> smooth_;
 };

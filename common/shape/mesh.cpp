@@ -54,6 +54,16 @@ bool segment_enters(const Shape& shape, const Eigen::Vector3d& a, const Eigen::V
   return mesh != nullptr && mesh->segment_enters(a, d, margin_m);
 }
 
+int contact_samples(const Shape& shape, ContactSamples& samples) {
+  const MeshGeometry* mesh = find_mesh_geometry(shape.mesh_hash);
+  return mesh != nullptr ? mesh->contact_samples(samples) : 0;
+}
+
+int contact_edges(const Shape& shape, ContactEdges& edges) {
+  const MeshGeometry* mesh = find_mesh_geometry(shape.mesh_hash);
+  return mesh != nullptr ? mesh->contact_edges(edges) : 0;
+}
+
 // The tangent plane at the mesh's point nearest `around_m` (the proxy), with the pseudo-normal of the face, edge or
 // vertex it lies on, as a sphere's is retaken: the proxy follows the surface tick by tick between world frames.
 void retake(ShapePlane& plane, const Eigen::Vector3d& around_m) {
@@ -91,8 +101,8 @@ const ShapeKindOps kMeshOps{
     .retake = retake,
     .nearest_faces = nullptr,
     .support_corners = nullptr,
-    .contact_samples = nullptr,
-    .contact_edges = nullptr,
+    .contact_samples = contact_samples,
+    .contact_edges = contact_edges,
 };
 
 }  // namespace impetus::shape_detail

@@ -58,6 +58,17 @@ class MeshGeometry {
   // Whether the mesh bounds a convex body (closed, every edge bent outward or flat). Then the body lies behind every
   // triangle's plane: a point on or in front of any of them is outside it.
   virtual bool convex() const = 0;
+  // Its contact features (common/shape/shape.h), where they stand for it: the corners and sharp edges of a convex
+  // mesh of at most kMaxContactSamples corners and kMaxContactEdges sharp edges; 0 otherwise (a tool cannot be made
+  // of it, and a tool meets it as its plane).
+  virtual int contact_samples(ContactSamples& samples) const {
+    (void)samples;
+    return 0;
+  }
+  virtual int contact_edges(ContactEdges& edges) const {
+    (void)edges;
+    return 0;
+  }
   virtual double volume_m3() const = 0;
   virtual Eigen::Matrix3d inertia_per_kg() const = 0;  // m², about the centre of mass, body frame
 };

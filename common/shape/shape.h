@@ -173,8 +173,9 @@ struct ContactSample {
 inline constexpr int kMaxContactSamples = 32;
 using ContactSamples = std::array<ContactSample, kMaxContactSamples>;
 // The kind's samples: a box's eight corners; a ball's centre and a capsule's two cap centres (radius r); a
-// cylinder's two rims, 16 points each (a chord of 22.5° lies within r·(1 − cos 11.25°) = 0.019·r of the rim). Returns
-// the count (0: the kind has none yet — a mesh).
+// cylinder's two rims, 16 points each (a chord of 22.5° lies within r·(1 − cos 11.25°) = 0.019·r of the rim); a
+// convex mesh's corners, if it has at most kMaxContactSamples (mesh_geometry.h). Returns the count (0: none stand for
+// the shape — any other mesh, or one this process has not loaded).
 int contact_samples(const Shape& shape, ContactSamples& samples);
 
 struct ContactEdge {
@@ -190,8 +191,8 @@ inline constexpr int kMaxContactEdges = 33;
 using ContactEdges = std::array<ContactEdge, kMaxContactEdges>;
 // The kind's edges: a box's twelve (radius 0, with their faces); the axis of a capsule or a cylinder, cap centre to
 // cap centre, swept by r (a cylinder's side), and a cylinder's rims as 16 chords each (with the cap's and the
-// side's normals as their faces; its flat caps are met by the other body's samples). None for a ball or a mesh.
-// Returns the count.
+// side's normals as their faces; its flat caps are met by the other body's samples); a convex mesh's sharp edges,
+// with the samples above. None for a ball. Returns the count.
 int contact_edges(const Shape& shape, ContactEdges& edges);
 
 }  // namespace impetus

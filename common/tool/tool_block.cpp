@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "common/tool/tool_block.h"
 
+#include "common/mesh/mesh_object.h"
 #include "common/runtime/message_text.h"
 #include "common/shape/shape.h"
 
@@ -20,16 +21,21 @@ constexpr std::string_view kToolKeys[] = {
 
 }  // namespace
 
-ToolBlock parse_tool_block(const JsonNode& node, const Vec3& gravity_mps2) {
+ToolBlock parse_tool_block(const JsonNode& node, const Vec3& gravity_mps2, const std::string& scene_dir) {
   node.expect_object();
   const ShapeKind kind = parse_shape_kind(node.required("shape"));
   node.expect_keys({std::span<const std::string_view>(kToolKeys), shape_keys(kind)});
-  if (kind == ShapeKind::mesh) {
-    node.child("shape").fail("a tool cannot be a mesh yet: a tool touches by its shape's corners and edges "
-                             "(docs/tool.md), which a mesh does not give; use box, sphere, capsule or cylinder");
-  }
   ToolBlock tool;
-  tool.shape.shape = parse_shape(node, kind);
+  // A mesh tool is a closed body (its mass and inertia come from its volume) whose corners and sharp edges stand for
+  // it: it touches by them (docs/tool.md), so it must be convex and have few enough of them.
+  tool.shape.shape = kind == ShapeKind::mesh ? load_mesh_shape(node, scene_dir, true) : parse_shape(node, kind);
+  ContactSamples samples;
+  if (kind == ShapeKind::mesh && contact_samples(tool.shape.shape, samples) == 0) {
+    node.child("file").fail("a tool's mesh must bound a convex body with at most " +
+                            std::to_string(kMaxContactSamples) + " corners and " + std::to_string(kMaxContactEdges) +
+                            " sharp edges: a tool touches by its corners and edges (docs/tool.md); make a convex "
+                            "hull of few faces, or use box, sphere, capsule or cylinder");
+  }
   if (node.has("position_m")) {
     const Vec3 at = node.child("position_m").vector_up_to(ToolLimits::kMaxToolReach_m, " m");
     tool.shape.placement.position_m = Eigen::Vector3d(at[0], at[1], at[2]);
@@ -102,7 +108,7 @@ std::optional<ToolBlock> load_scene_tool(const std::string& path) {
   if (root.has("gravity_mps2")) {
     gravity_mps2 = root.child("gravity_mps2").vector_up_to(limits::kMaxGravity_mps2, " m/s²");
   }
-  return parse_tool_block(root.child("tool"), gravity_mps2);
+  return parse_tool_block(root.child("tool"), gravity_mps2, scene_folder(path));
 }
 
 }  // namespace impetus

@@ -33,8 +33,9 @@ struct ToolLimits {
   static constexpr double kMaxToolMass_kg = 10.0;  // a sledgehammer is 5 kg
 };
 
-// The block at `node`, its weight under `gravity_mps2`. Throws InputError naming the file, the field and the value.
-ToolBlock parse_tool_block(const JsonNode& node, const Vec3& gravity_mps2);
+// The block at `node`, its weight under `gravity_mps2`; a mesh's file is found from `scene_dir` (the scene file's
+// folder: common/mesh/mesh_object.h). Throws InputError naming the file, the field and the value.
+ToolBlock parse_tool_block(const JsonNode& node, const Vec3& gravity_mps2, const std::string& scene_dir);
 
 // The tool of the scene file at `path` (its "tool" block under its "gravity_mps2"), or none if it has no tool block.
 // Reads only those two keys; the world checks the rest. Throws InputError naming the file and field.

@@ -107,9 +107,15 @@ struct PlacedBody {
 
   Eigen::Vector3d point(const Eigen::Vector3d& body_m) const { return centre_m + rotation * body_m; }
   Eigen::Vector3d local(const Eigen::Vector3d& world_m) const { return rotation.transpose() * (world_m - centre_m); }
-  // The body's surface point nearest a world point (common/shape/shape.h), in world terms.
+  // The body's surface point nearest a world point (common/shape/shape.h), in world terms. A mesh's normal at an edge
+  // or a corner is its pseudo-normal, which tells inside from outside; outside, the way from the surface to the point
+  // is the direction the two are apart, which is a primitive's normal there.
   SurfacePoint nearest(const Eigen::Vector3d& world_m) const {
-    const SurfacePoint body = nearest_surface_point_body(*shape, rotation.transpose() * (world_m - centre_m));
+    const Eigen::Vector3d here_m = rotation.transpose() * (world_m - centre_m);
+    SurfacePoint body = nearest_surface_point_body(*shape, here_m);
+    if (shape->kind == ShapeKind::mesh && body.signed_distance_m > kOnSurface_m) {
+      body.normal = (here_m - body.point_m).normalized();
+    }
     return {point(body.point_m), rotation * body.normal, body.signed_distance_m};
   }
   // The edges that pass within `within_m` of a ball of `radius_m` about `centre_m`, placed in the world; the least
@@ -311,8 +317,10 @@ ToolContacts::ToolContacts(const ToolShape& tool) : tool_(tool) {
   sample_count_ = contact_samples(tool.shape, samples_);
   edge_count_ = contact_edges(tool.shape, edges_);
   if (sample_count_ == 0) {
-    throw std::invalid_argument(std::string("tool shape: a ") + to_string(tool.shape.kind) +
-                                " tool is not supported (its contacts are taken from samples it has none of yet)");
+    throw std::invalid_argument(std::string("tool shape: this ") + to_string(tool.shape.kind) +
+                                " has no corners and edges to touch by (a tool's mesh must be convex, with at most " +
+                                std::to_string(kMaxContactSamples) + " corners and " +
+                                std::to_string(kMaxContactEdges) + " sharp edges, and loaded in this process)");
   }
   shape_radius_m_ = radius_of(samples_, sample_count_);
   bounding_radius_m_ = tool.placement.position_m.norm() + shape_radius_m_;

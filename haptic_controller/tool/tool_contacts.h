@@ -9,8 +9,8 @@
 // (closest points inside both). A constraint is the half-space of the nearest surface at the pose now (its tangent
 // plane there), or for crossing edges the plane across both (their cross product, where it lies in both edges'
 // normal cones): the gap, the normal it pushes the tool along, and where on each body it acts. A plane without a
-// shape (the floor) or with one this process has no features of (a mesh) is taken as the half-space it is, for the
-// tool's samples only.
+// shape (the floor) or with one this process has no features of (a mesh that is not small and convex, or not loaded
+// here) is taken as the half-space it is, for the tool's samples only.
 //
 // Only constraints the tool can reach in this solve are listed: a sample whose gap exceeds how far that part of the
 // tool can travel (a bound the caller gives, linear and angular) cannot become active. Frames: world, SI.
@@ -62,7 +62,8 @@ struct ToolReach {
 
 class ToolContacts {
  public:
-  // Throws std::invalid_argument when the tool's shape has no contact samples (a mesh, for now) or is unusable.
+  // Throws std::invalid_argument when the tool's shape has no contact samples (a mesh that is not small and convex, or
+  // not loaded here) or is unusable.
   explicit ToolContacts(const ToolShape& tool);
 
   // The constraints at grip pose `grip` that `reach` can close, nearest first when there are more than

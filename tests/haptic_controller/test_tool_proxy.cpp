@@ -6,15 +6,18 @@
 
 #include "common/contract/rotation.h"
 #include "common/hand/grip_hand.h"
+#include "common/mesh/mesh_body.h"
 #include "haptic_controller/tool/tool_proxy.h"
 #include "test_support.h"
 
 #include "tests/support/allocation_counter.h"
+#include "tests/support/mesh_shapes.h"
 #include "tests/support/tool_scenes.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
 #include <vector>
 
@@ -148,16 +151,69 @@ TEST_CASE("contact features: each kind's samples lie within it and touch its sur
   }
 }
 
-TEST_CASE("tool: a mesh tool is refused with a message that says why") {
+TEST_CASE("tool: a mesh this process has not loaded is refused as a tool with a message that says why") {
   Shape mesh;
   mesh.kind = ShapeKind::mesh;
   mesh.radius_m = 0.01;
   mesh.box_size_m = {0.02, 0.02, 0.02};
   mesh.mesh_hash = 1;
-  CHECK_THROWS_WITH(ToolContacts(ToolShape{mesh, BodyPose{}}), Catch::Contains("mesh tool is not supported"));
+  CHECK_THROWS_WITH(ToolContacts(ToolShape{mesh, BodyPose{}}), Catch::Contains("no corners and edges to touch by"));
   ToolCoupling bad;
   bad.rotational_stiffness_Nmprad = 0.0;
   CHECK_THROWS_WITH(ToolProxy(cube_tool(), bad), Catch::Contains("rotational_stiffness_Nmprad"));
+}
+
+TEST_CASE("tool: a mesh cube's corners and sharp edges are a box's, and as a tool it meets what the box meets") {
+  // The same 2 cm cube as the primitive tool, as a mesh file: its corners are its samples, its twelve edges (not the
+  // six diagonals that cut its faces in two) its edges, with the faces that meet there.
+  const std::string file = (std::filesystem::temp_directory_path() / "impetus-mesh-cube-tool.obj").string();
+  impetus::test::write_obj(impetus::test::box_mesh(Vector3d(0.02, 0.02, 0.02)), file);
+  const MeshBody& cube = MeshBody::load(file, Vector3d::Ones(), true);
+  ContactSamples samples;
+  ContactEdges edges;
+  REQUIRE(contact_samples(cube.shape(), samples) == 8);
+  REQUIRE(contact_edges(cube.shape(), edges) == 12);
+  for (int k = 0; k < 12; ++k) {
+    CHECK((edges[k].to_m - edges[k].from_m).norm() == Approx(0.02));
+    CHECK(edges[k].face_a.dot(edges[k].face_b) == Approx(0.0).margin(1e-15));
+  }
+  // Pressed into a box object and the floor at poses turned every way, the mesh tool's constraints are the primitive
+  // tool's: the same gaps, normals and points, in some order. The file's corners are read as floats (Assimp's), so
+  // they agree to about 1e-9 m.
+  const PlaneSet planes =
+      set_of({floor_plane(0), box_object(1, Vector3d(0.03, 0.0, 0.01), Vector3d(0.01, 0.02, 0.01))});
+  ToolContacts primitive(cube_tool()), mesh(ToolShape{cube.shape(), BodyPose{}});
+  const ToolReach reach{0.01, 0.5};
+  auto listed = [](const ToolContacts& contacts) {
+    std::vector<Eigen::Matrix<double, 7, 1>> out;
+    for (int k = 0; k < contacts.count(); ++k) {
+      const ToolConstraint& c = contacts[k];
+      if (c.gap_m >= kOpenGap_m) continue;
+      Eigen::Matrix<double, 7, 1> row;
+      row << c.gap_m, c.normal, c.tool_point_m;
+      out.push_back(row);
+    }
+    return out;
+  };
+  int compared = 0;
+  for (int turn = 0; turn < 12; ++turn) {
+    const BodyPose grip = pose_at(Vector3d(0.012, 0.001 * turn, 0.0095 + 0.0004 * turn),
+                                  Vector3d(0.05 * turn, -0.03 * turn, 0.07 * turn));
+    const int count = primitive.gather(planes, grip, reach);
+    REQUIRE(mesh.gather(planes, grip, reach) == count);
+    const auto expected = listed(primitive);
+    auto got = listed(mesh);
+    REQUIRE(got.size() == expected.size());
+    for (const auto& want : expected) {  // each matched by one of the mesh tool's, to the file's float rounding
+      const auto match = std::find_if(got.begin(), got.end(), [&](const auto& row) {
+        return (row - want).cwiseAbs().maxCoeff() < 1e-6;
+      });
+      CHECK(match != got.end());
+      if (match != got.end()) got.erase(match);
+    }
+    compared += static_cast<int>(expected.size());
+  }
+  CHECK(compared > 12);  // something was pressed
 }
 
 TEST_CASE("tool: free of contact the proxy is on the grip and the wrench is zero") {

@@ -93,15 +93,15 @@ struct Strike : Ledger {
 };
 
 // The peg (10 mm square, its tip 5 mm above the floor) swung in +x at 0.3 m/s through the line y = 15 mm, off the
-// cube's centre, for 0.25 s, then drawn back; the world runs 1.2 s in all.
-inline Strike strike(double world_rate_hz, Coupling coupling) {
+// cube's centre, for 0.25 s, then drawn back; the world runs 1.2 s in all. Another `tool` may swing instead.
+inline Strike strike(double world_rate_hz, Coupling coupling, const ToolShape& tool = peg_tool()) {
   Strike out;
   const auto grip_at = [](double t_s) {
     const double x_m = t_s < 0.25 ? 0.3 * t_s : 0.075 - 0.3 * (t_s - 0.25);
     return BodyPose{Eigen::Vector3d(std::max(x_m, -0.05), 0.015, 0.055), Eigen::Quaterniond::Identity()};
   };
   static_cast<Ledger&>(out) =
-      play_tool(strike_scene(world_rate_hz), peg_tool(), world_rate_hz, coupling, 1200, 0, false, grip_at,
+      play_tool(strike_scene(world_rate_hz), tool, world_rate_hz, coupling, 1200, 0, false, grip_at,
                 [&](const World& world) {
         const ObjectState& cube = world.states()[0];
         out.position_m = cube.pose.position_m;

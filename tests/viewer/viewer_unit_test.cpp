@@ -556,6 +556,26 @@ TEST_CASE("a replay reads a trial's scene and logs (every finger's), a malformed
 
 namespace impetus {
 
+TEST_CASE("a mesh tool's triangles go to the page with its shape, as a mesh body's do") {
+  const fs::path file = fs::temp_directory_path() / "impetus-viewer-tool-wedge.obj";
+  {  // a wedge: a triangular prism, 6 corners, 8 triangles
+    std::ofstream obj(file);
+    obj << "v 0 0 0\nv 0.02 0 0\nv 0 0.01 0\nv 0 0 0.03\nv 0.02 0 0.03\nv 0 0.01 0.03\n"
+        << "f 1 3 2\nf 4 5 6\nf 1 2 5\nf 1 5 4\nf 2 3 6\nf 2 6 5\nf 3 1 4\nf 3 4 6\n";
+  }
+  ToolShape tool;
+  tool.shape = MeshBody::load(file.string(), Eigen::Vector3d::Ones(), true).shape();
+  fs::remove(file);
+  auto described = std::make_unique<ViewScene>();
+  const nlohmann::json message =
+      nlohmann::json::parse(view::scene_message(*described, "test", std::nullopt, &tool));
+  const auto& form = message.at("tool").at("mesh");
+  CHECK(message.at("tool").at("shape") == "mesh");
+  REQUIRE(form.at("drawn") == "triangles");
+  CHECK(form.at("triangles").size() == 3 * 8);
+  CHECK(form.at("vertices_m").size() == 3 * 6);
+}
+
 TEST_CASE("a tool's replay carries its shape, and its grip's and proxy's poses from the tool log, into the messages") {
   const fs::path dir = scratch("replay_tool");
   std::ofstream(dir / "summary.json") << R"({"config": {"scene": ")" << IMPETUS_SOURCE_DIR

@@ -5,6 +5,7 @@
 #include "common/shape/shape.h"
 #include "world_manager/engine/engine_registry.h"
 #include "world_manager/scene.h"
+#include "common/tool/tool_block.h"
 #include "world_test_support.h"
 #include "tests/support/mesh_shapes.h"
 
@@ -12,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -108,6 +110,40 @@ TEST_CASE("scene error: a mesh file missing, unreadable, open for a dynamic body
   json unknown = mesh_object("parts/box.obj", false);
   unknown["size_m"] = {0.1, 0.1, 0.1};  // a box's key
   CHECK(error_of(dir, unknown).find("size_m") != std::string::npos);
+}
+
+TEST_CASE("a mesh tool: a small convex mesh beside the scene is a tool, weighed from its volume, and others are "
+          "refused") {
+  const std::filesystem::path dir = fresh_dir("tool");
+  test::write_obj(test::box_mesh(Vector3d(0.01, 0.01, 0.04)), (dir / "parts/peg.obj").string());
+  test::write_obj(test::icosphere(0.01, 2), (dir / "parts/ball.obj").string());  // 162 corners
+  TriangleMesh dented = test::icosphere(0.01, 0);                              // 12 corners, one pushed in
+  dented.vertices_m[0] *= 0.3;  // below its five neighbours (at 0.447 of the radius): a dent
+  test::write_obj(dented, (dir / "parts/dented.obj").string());
+  const auto scene_with_tool = [&](const std::string& file) {
+    const json tool{{"shape", "mesh"}, {"file", file}, {"density_kgpm3", 1000.0}, {"position_m", {0.0, 0.0, -0.03}}};
+    std::ofstream(dir / "scene.json") << json{{"objects", json::array()}, {"tool", tool}}.dump();
+    return (dir / "scene.json").string();
+  };
+  const Scene scene = load_scene(scene_with_tool("parts/peg.obj"));
+  REQUIRE(scene.tool.has_value());
+  CHECK(scene.tool->shape.shape.kind == ShapeKind::mesh);
+  CHECK(scene.tool->shape.mass_kg == Approx(1000.0 * 0.01 * 0.01 * 0.04).epsilon(1e-6));  // 4 g
+  CHECK(scene.tool->reach_m == Approx(0.03 + std::sqrt(0.005 * 0.005 * 2 + 0.02 * 0.02)).epsilon(1e-6));
+  // The haptic controller reads the same block (--tool-from), the mesh with it.
+  const std::optional<ToolBlock> read = load_scene_tool(scene_with_tool("parts/peg.obj"));
+  REQUIRE(read.has_value());
+  CHECK(read->shape.shape.mesh_hash == scene.tool->shape.shape.mesh_hash);
+  for (const char* refused : {"parts/ball.obj", "parts/dented.obj"}) {
+    CAPTURE(refused);
+    std::string message = "no error";
+    try {
+      load_scene(scene_with_tool(refused));
+    } catch (const SceneError& error) {
+      message = error.what();
+    }
+    CHECK_THAT(message, Catch::Contains("/tool/file") && Catch::Contains("convex body with at most 32 corners"));
+  }
 }
 
 }  // namespace

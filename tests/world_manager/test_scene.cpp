@@ -421,7 +421,7 @@ TEST_CASE("a tool block is parsed, its reach widens the world's, and bad values 
     return document;
   };
   const json ball = {{"shape", "sphere"}, {"radius_m", 0.01}};
-  require_error(with_tool({{"shape", "mesh"}, {"file", "x.obj"}}), "/tool/shape", "cannot be a mesh");
+  require_error(with_tool({{"shape", "mesh"}, {"file", "x.obj"}}), "/tool/file", "cannot open the mesh file");
   require_error(with_tool({{"radius_m", 0.01}}), "/tool/shape", "missing");
   json bad = ball;
   bad["stiffness_Npm"] = -1;
