@@ -155,10 +155,16 @@ std::vector<ViewToolFrame> read_tool_track(const fs::path& path, const std::vect
   std::vector<ViewToolFrame> frames(times_s.size());
   if (log.rows.empty()) return frames;
   check_times(log, c[0], path);
+  const auto posed = [&](std::size_t r) { return (static_cast<std::uint32_t>(log.rows[r][c[21]]) & 1u) != 0; };
+  // Past the log's end the tool rests where it was last posed: the servo's last ticks may come after the device's
+  // session ended, with no pose, while the world logs one more step.
+  std::size_t last_posed = log.rows.size() - 1;
+  while (last_posed > 0 && !posed(last_posed)) --last_posed;
   std::size_t next = 0;
   for (std::size_t f = 0; f < times_s.size(); ++f) {
     const bool started = advance_to(log, c[0], times_s[f] - world_ahead_s, next);
-    const std::vector<double>& row = log.rows[next];
+    const bool ended = next + 1 == log.rows.size() && times_s[f] - world_ahead_s > log.rows[next][c[0]];
+    const std::vector<double>& row = log.rows[ended ? last_posed : next];
     ViewToolFrame& frame = frames[f];
     auto value = [&](std::size_t v) { return row[static_cast<std::size_t>(c[v])]; };
     for (int i = 0; i < 3; ++i) {
@@ -176,7 +182,7 @@ std::vector<ViewToolFrame> read_tool_track(const fs::path& path, const std::vect
       return std::abs(norm - 1.0) < 1e-6;
     };
     // A tick without a pose (flags bit 0 clear) logs the last pose it had; a grip before its first tick has none.
-    const bool grip_valid = (static_cast<std::uint32_t>(value(21)) & 1u) != 0;
+    const bool grip_valid = posed(ended ? last_posed : next);
     frame.valid = started && grip_valid && all_finite(frame.grip.position_m) && all_finite(frame.proxy.position_m) &&
                   all_finite(frame.force_N) && all_finite(frame.torque_Nm) && unit(frame.grip.orientation_wxyz) &&
                   unit(frame.proxy.orientation_wxyz);

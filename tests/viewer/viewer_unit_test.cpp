@@ -630,6 +630,17 @@ TEST_CASE("a tool's replay carries its shape, and its grip's and proxy's poses f
   CHECK_THROWS_WITH(view::Replay(dir.string()), Catch::Contains("haptic.tool.csv") && Catch::Contains("grip_y_m"));
   std::ofstream(dir / "haptic.tool.csv") << header << "0.0,0,0,0,0.1,1,0,0,0,0,0,0.1,1,0,0,0,0,0,0,0,0,0,0,0\n";
   CHECK_FALSE(view::Replay(dir.string()).tool_frame(1)->valid);
+
+  // Past the log's end, after a last tick without a pose (the device's session over), the tool rests at its last
+  // pose; within the log such a tick still hides it.
+  std::ofstream(dir / "haptic.tool.csv") << header << "0.0,0,0,0,0.1,1,0,0,0,0,0,0.1,1,0,0,0,0,0,0,0,0,0,0,1\n"
+                                         << "0.03,30,0,0,0.08,1,0,0,0,0,0,0.08,1,0,0,0,0,0,0,0,0,0,0,0\n"
+                                         << "0.06,60,0,0,0.07,1,0,0,0,0,0,0.07,1,0,0,0,0,0,0,0,0,0,0,1\n"
+                                         << "0.07,70,0,0,0.07,1,0,0,0,0,0,0.07,1,0,0,0,0,0,0,0,0,0,0,0\n";
+  const view::Replay ended(dir.string());
+  CHECK_FALSE(ended.tool_frame(0)->valid);  // 0.05 s: the row at 0.03, within the log, has no pose
+  REQUIRE(ended.tool_frame(1)->valid);  // 0.1 s, past the log's end
+  CHECK(ended.tool_frame(1)->grip.position_m[2] == 0.07);
 }
 
 TEST_CASE("a replay page plays, pauses, seeks and changes speed on its own clock, bad controls are refused") {
