@@ -102,9 +102,11 @@ std::uint32_t MeshBvh::build(std::uint32_t begin, std::uint32_t end, std::vector
 
 void MeshBvh::pseudo_normals() {
   const std::size_t n = mesh_.triangles.size();
-  face_normals_ = face_normals(mesh_);
+  const std::vector<Eigen::Vector3d> faces = face_normals(mesh_);
+  face_normals_.assign(faces.begin(), faces.end());
   edge_normals_.assign(n, {});
-  vertex_normals_ = angle_weighted_normals(mesh_, face_normals_);
+  const std::vector<Eigen::Vector3d> vertices = angle_weighted_normals(mesh_, faces);
+  vertex_normals_.assign(vertices.begin(), vertices.end());
   // An edge's pseudo-normal is the sum of its two faces' normals (one face's at an open edge): the edges are matched
   // by their sorted vertex pair.
   struct Use {

@@ -12,6 +12,7 @@
 // The query allocates nothing and never throws; the tree holds the mesh's copy and is immutable after construction,
 // so any number of threads may query it.
 
+#include "common/mesh/huge_pages.h"
 #include "common/mesh/triangle_mesh.h"
 #include "common/shape/mesh_geometry.h"  // MeshEntry
 
@@ -98,11 +99,12 @@ class MeshBvh {
   bool within_edges(std::uint32_t triangle, const Eigen::Vector3d& x, double tolerance_m) const;
 
   TriangleMesh mesh_;
-  std::vector<Node> nodes_;
-  std::vector<std::uint32_t> order_;                      // triangle indices, leaf by leaf
-  std::vector<Eigen::Vector3d> face_normals_;             // unit
-  std::vector<std::array<Eigen::Vector3d, 3>> edge_normals_;  // per triangle, edges ab, bc, ca (unit)
-  std::vector<Eigen::Vector3d> vertex_normals_;           // unit, angle-weighted
+  // In huge pages where large (huge_pages.h), as the mesh's own arrays.
+  HugeVector<Node> nodes_;
+  HugeVector<std::uint32_t> order_;                          // triangle indices, leaf by leaf
+  HugeVector<Eigen::Vector3d> face_normals_;                 // unit
+  HugeVector<std::array<Eigen::Vector3d, 3>> edge_normals_;  // per triangle, edges ab, bc, ca (unit)
+  HugeVector<Eigen::Vector3d> vertex_normals_;               // unit, angle-weighted
   bool locally_convex_ = false;
 };
 

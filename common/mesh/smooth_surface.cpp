@@ -16,7 +16,9 @@ constexpr double kShape = 0.5;
 
 }  // namespace
 
-SmoothSurface::SmoothSurface(const TriangleMesh& mesh) : vertices_m_(mesh.vertices_m), triangles_(mesh.triangles) {
+SmoothSurface::SmoothSurface(const TriangleMesh& mesh)
+    : vertices_m_(mesh.vertices_m.begin(), mesh.vertices_m.end()),
+      triangles_(mesh.triangles.begin(), mesh.triangles.end()) {
   const std::vector<Eigen::Vector3d> faces = face_normals(mesh);
   normals_ = angle_weighted_normals(mesh, faces);
   // Each vertex's triangles, by counting then filling.

@@ -6,6 +6,8 @@
 //
 // Winding: counter-clockwise seen from outside, so (b − a) × (c − a) points out of a closed mesh.
 
+#include "common/mesh/huge_pages.h"
+
 #include <Eigen/Core>
 
 #include <array>
@@ -14,9 +16,10 @@
 
 namespace impetus {
 
+// Held in huge pages where large (huge_pages.h): the servo's walk reads the triangles it meets at random.
 struct TriangleMesh {
-  std::vector<Eigen::Vector3d> vertices_m;
-  std::vector<std::array<std::uint32_t, 3>> triangles;
+  HugeVector<Eigen::Vector3d> vertices_m;
+  HugeVector<std::array<std::uint32_t, 3>> triangles;
 };
 
 // Limits a mesh file must keep, each with its reason.

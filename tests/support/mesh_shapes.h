@@ -51,7 +51,7 @@ inline TriangleMesh icosphere(double radius_m, int subdivisions) {
       middle.emplace(key, index);
       return index;
     };
-    std::vector<std::array<std::uint32_t, 3>> finer;
+    HugeVector<std::array<std::uint32_t, 3>> finer;
     finer.reserve(4 * mesh.triangles.size());
     for (const auto& tri : mesh.triangles) {
       const std::uint32_t ab = mid(tri[0], tri[1]), bc = mid(tri[1], tri[2]), ca = mid(tri[2], tri[0]);

@@ -64,7 +64,7 @@ btScalar combined_damping(const btCollisionObject* a, const btCollisionObject* b
 // principal axes where they are not the file's.
 struct MeshArrays {
   std::vector<std::unique_ptr<btTriangleIndexVertexArray>> views;
-  std::vector<std::unique_ptr<std::vector<Eigen::Vector3d>>> turned_vertices_m;
+  std::vector<std::unique_ptr<HugeVector<Eigen::Vector3d>>> turned_vertices_m;
 };
 
 // A mesh's triangles for Bullet (docs/meshes.md), read in place from the loaded MeshBody (which lives as long as the
@@ -75,9 +75,9 @@ std::unique_ptr<btCollisionShape> make_mesh_shape(const SceneObject& object, con
   const auto* body = dynamic_cast<const MeshBody*>(find_mesh_geometry(object.shape.mesh_hash));
   if (body == nullptr) throw SceneError("object '" + object.name + "': its mesh was not loaded");
   const TriangleMesh& mesh = body->bvh().mesh();
-  const std::vector<Eigen::Vector3d>* vertices_m = &mesh.vertices_m;
+  const HugeVector<Eigen::Vector3d>* vertices_m = &mesh.vertices_m;
   if (!to_principal.isIdentity(0.0)) {
-    auto turned = std::make_unique<std::vector<Eigen::Vector3d>>(mesh.vertices_m.size());
+    auto turned = std::make_unique<HugeVector<Eigen::Vector3d>>(mesh.vertices_m.size());
     for (std::size_t k = 0; k < mesh.vertices_m.size(); ++k) (*turned)[k] = to_principal * mesh.vertices_m[k];
     vertices_m = turned.get();
     arrays.turned_vertices_m.push_back(std::move(turned));
