@@ -152,3 +152,25 @@ TEST_CASE("contact graph: a sleeping body keeps the contacts it fell asleep with
   graph.rest(0);
   CHECK_FALSE(graph.touching(0));
 }
+
+TEST_CASE("contact graph: the weight the contacts do not carry is the slope's share of it, none on a floor") {
+  const Vector3d weight_N(0.0, 0.0, -10.0);
+  ContactGraph graph;
+  graph.reset(3);
+  for (int corner = 0; corner < 4; ++corner) graph.add(0, kStatic, Vector3d::UnitZ(), 0.3, 2.5);  // on a floor
+  // On a slope of 30° rising along +x: its normal leans back along −x.
+  const Vector3d slope(-std::sin(M_PI / 6), 0.0, std::cos(M_PI / 6));
+  graph.add(1, kStatic, slope, 0.3, 8.66);
+  graph.finish();  // body 2 touches nothing
+  CHECK(graph.unsupported_weight_N(0, weight_N).norm() < 1e-12);
+  const Vector3d loose = graph.unsupported_weight_N(1, weight_N);
+  CHECK(loose.dot(slope) == Approx(0.0).margin(1e-12));  // along the slope, down it (−x), m·g·sin 30°
+  CHECK(loose.norm() == Approx(5.0));
+  CHECK(loose.x() < 0.0);
+  CHECK(graph.unsupported_weight_N(2, weight_N) == weight_N);
+  // A contact above it carries none of it (a box pressed from above).
+  graph.reset(1);
+  graph.add(0, kStatic, -Vector3d::UnitZ(), 0.3, 4.0);
+  graph.finish();
+  CHECK(graph.unsupported_weight_N(0, weight_N) == weight_N);
+}

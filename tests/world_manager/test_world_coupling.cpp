@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <functional>
 
 using impetus::Coupling;
 using impetus::HapticReport;
@@ -332,7 +333,9 @@ json floor_cube() {
 
 // Steps the world `steps` times with a steady push `force_N` on the cube, reported as the haptic side does: each
 // report adds one period's impulse to the running total, its moment rendered evenly over the period.
-void push_steadily(World& world, const Vector3d& force_N, int steps) {
+// `after_step(step)` is called after each step.
+void push_steadily(World& world, const Vector3d& force_N, int steps,
+                   const std::function<void(int)>& after_step = [](int) {}) {
   const double period_s = world.world_period_s();
   HapticReport report = make_report(7, 0);
   report.entry_count = 1;
@@ -352,6 +355,7 @@ void push_steadily(World& world, const Vector3d& force_N, int steps) {
     report.haptic_time_s = (step + 1) * period_s;
     entry.last_tick = report.tick;
     world.step(&report);
+    after_step(step);
   }
 }
 
@@ -371,6 +375,29 @@ TEST_CASE("a steady push that friction holds leaves a resting cube where it was,
     // And every bit of it was applied.
     CHECK(world->total_impulse_Ns(0).x() == Approx(2.0 * 200 * world->world_period_s()).epsilon(1e-12));
   }
+}
+
+TEST_CASE("impulse coupling: a steady push that holds a cube on a slope is a force, and the cube stays") {
+  // The floor tilted by tilting gravity 25°: the cube's weight along the slope, m·g·sin 25° = 4.15 N, is more than
+  // its friction holds (μ·m·g·cos 25° = 0.89 N at μ = 0.1), so it slides unless pushed. A steady 4.15 N push up the
+  // slope holds it still with no work done; as a kick of all but the friction's share at each step's start it would
+  // throw the cube up the slope and let it slide back every step.
+  const double tilt = 25.0 * M_PI / 180.0;
+  json tilted = floor_cube();
+  tilted["gravity_mps2"] = {-9.81 * std::sin(tilt), 0.0, -9.81 * std::cos(tilt)};
+  tilted["floor"] = {{"static_friction", 0.1}};
+  const impetus::Scene scene = impetus::parse_scene(tilted, "slope.json");
+  WorldOptions options;
+  options.coupling = Coupling::impulse;
+  auto world = make_world(scene, options);
+  const Vector3d hold_N(9.81 * std::sin(tilt), 0.0, 0.0);
+  // Its first step has no contacts to hold the push yet: the cube is let settle under it for 10 steps, then 10 s.
+  Vector3d settled = Vector3d::Zero();
+  push_steadily(*world, hold_N, 210, [&](int step) {
+    if (step == 9) settled = world->states()[0].pose.position_m;
+  });
+  CHECK(std::abs(world->states()[0].pose.position_m.x() - settled.x()) < 1e-4);
+  CHECK(world->total_impulse_Ns(0).x() == Approx(hold_N.x() * 210 * world->world_period_s()).epsilon(1e-12));
 }
 
 TEST_CASE("impulse coupling: a push beyond what friction holds moves the cube at once, with the exact momentum") {

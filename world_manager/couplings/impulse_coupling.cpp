@@ -15,8 +15,19 @@ ImpulseCoupling::ImpulseCoupling(const CouplingContext& context)
 void ImpulseCoupling::take_impulse(std::size_t id, const ImpulseDelta& delta, const ImpulseDelta&, bool,
                                    const RenderWindow&) {
   const double period_s = context_.world_period_s;
-  const double holdable_Ns = context_.engine.contacts().friction_capacity_N(static_cast<std::int32_t>(id)) * period_s;
   const double magnitude_Ns = delta.impulse_Ns.norm();
+  // What the body's contacts hold of a steady push: their friction, and the part of its weight the supports do not
+  // carry where the push stands against it (a cube held on a slope).
+  const auto body = static_cast<std::int32_t>(id);
+  const ContactGraph& contacts = context_.engine.contacts();
+  double holding_N = contacts.friction_capacity_N(body);
+  const double inverse_mass_per_kg = context_.states[id].inverse_mass_per_kg;
+  if (contacts.touching(body) && inverse_mass_per_kg > 0.0 && magnitude_Ns > 0.0) {
+    const Eigen::Vector3d loose_N =
+        contacts.unsupported_weight_N(body, to_eigen(context_.scene.gravity_mps2) / inverse_mass_per_kg);
+    holding_N += std::max(0.0, -loose_N.dot(delta.impulse_Ns) / magnitude_Ns);
+  }
+  const double holdable_Ns = holding_N * period_s;
   const double held_share = !(holdable_Ns > 0.0) ? 0.0 : magnitude_Ns > holdable_Ns ? holdable_Ns / magnitude_Ns : 1.0;
   if (held_share < 1.0) {
     change_velocity(id, (1.0 - held_share) * delta.impulse_Ns, (1.0 - held_share) * delta.angular_impulse_Nms);

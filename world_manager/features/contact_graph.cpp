@@ -75,6 +75,16 @@ double ContactGraph::friction_capacity_N(std::int32_t body) const {
   return capacity_N;
 }
 
+Eigen::Vector3d ContactGraph::unsupported_weight_N(std::int32_t body, const Eigen::Vector3d& weight_N) const {
+  Eigen::Vector3d support = Eigen::Vector3d::Zero();
+  for (const Edge& edge : edges_of(body)) support += edge.normal_force_N * edge.normal;
+  const double norm = support.norm();
+  if (!(norm > 0.0)) return weight_N;
+  const Eigen::Vector3d n = support / norm;
+  const double into_support_N = weight_N.dot(n);
+  return into_support_N < 0.0 ? Eigen::Vector3d(weight_N - into_support_N * n) : weight_N;
+}
+
 bool ContactGraph::holds(std::int32_t body, const Eigen::Vector3d& direction) {
   if (body < 0 || static_cast<std::size_t>(body) >= body_count_) return false;
   if (++generation_ == 0) {  // wrapped: clear the marks once every 2^32 queries

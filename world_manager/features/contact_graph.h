@@ -73,6 +73,11 @@ class ContactGraph {
   // its contacts' friction can hold (N). 0 for a body without contacts or with unknown forces.
   double friction_capacity_N(std::int32_t body) const;
 
+  // The weight `weight_N` less what `body`'s contacts carry of it: the part along the contacts' mean normal (Σ N·n,
+  // each contact's normal force on it) taken off where they push against it. A body on a slope keeps its weight's
+  // part along the slope; one on a floor keeps none; one without contacts or with unknown forces keeps all of it.
+  Eigen::Vector3d unsupported_weight_N(std::int32_t body, const Eigen::Vector3d& weight_N) const;
+
   // Whether `body`, pushed along `direction` (unit), is held by a chain of contacts to static geometry (header).
   bool holds(std::int32_t body, const Eigen::Vector3d& direction);
 
