@@ -10,7 +10,6 @@
 #include <catch2/catch.hpp>
 
 #include <cstdint>
-#include <limits>
 #include <numeric>
 
 using namespace impetus;
@@ -38,13 +37,7 @@ TEST_CASE("huge pages: a tree over 80 k triangles, its arrays in huge pages, ans
   for (const Eigen::Vector3d& query : {Eigen::Vector3d(0.01, 0.02, 0.06), Eigen::Vector3d(-0.03, 0.0, 0.02)}) {
     MeshPoint found;
     REQUIRE(tree.nearest(query, found));
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& tri : mesh.triangles) {
-      std::uint8_t feature = 0;
-      const Eigen::Vector3d p = closest_point_on_triangle(query, mesh.vertices_m[tri[0]], mesh.vertices_m[tri[1]],
-                                                          mesh.vertices_m[tri[2]], feature);
-      best = std::min(best, (query - p).norm());
-    }
-    CHECK(std::abs(found.signed_distance_m) == Approx(best).margin(1e-15));
+    CHECK(std::abs(found.signed_distance_m) ==
+          Approx(impetus::test::brute_force_distance(mesh, query)).margin(1e-15));
   }
 }

@@ -165,13 +165,7 @@ TEST_CASE("mesh: the tree's nearest point, distance and side agree with brute fo
   int inside = 0;
   for (int q = 0; q < 2000; ++q) {
     const Eigen::Vector3d p(coordinate(random), coordinate(random), coordinate(random));
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& t : sphere.triangles) {
-      std::uint8_t feature = 0;
-      const Eigen::Vector3d c = closest_point_on_triangle(p, sphere.vertices_m[t[0]], sphere.vertices_m[t[1]],
-                                                          sphere.vertices_m[t[2]], feature);
-      best = std::min(best, (p - c).norm());
-    }
+    const double best = impetus::test::brute_force_distance(sphere, p);
     MeshPoint found;
     REQUIRE(tree.nearest(p, found));
     CHECK(std::abs(found.signed_distance_m) == Approx(best).margin(1e-15));

@@ -1,15 +1,19 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Meshes of known shape for the mesh tests and benchmarks: a box, a subdivided icosahedron (a sphere of 20·4ⁿ
-// triangles), and writers of the file formats users bring (OBJ, ASCII and binary STL).
+// triangles), writers of the file formats users bring (OBJ, ASCII and binary STL), and the brute-force distance the
+// tree is checked against.
 
+#include "common/mesh/mesh_bvh.h"
 #include "common/mesh/triangle_mesh.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -104,6 +108,18 @@ inline void write_stl_binary(const TriangleMesh& mesh, const std::string& path) 
     const std::uint16_t attributes = 0;
     out.write(reinterpret_cast<const char*>(&attributes), 2);
   }
+}
+
+// The distance from `p` to the mesh's nearest point, by trying every triangle.
+inline double brute_force_distance(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& t : mesh.triangles) {
+    std::uint8_t feature = 0;
+    const Eigen::Vector3d c =
+        closest_point_on_triangle(p, mesh.vertices_m[t[0]], mesh.vertices_m[t[1]], mesh.vertices_m[t[2]], feature);
+    best = std::min(best, (p - c).norm());
+  }
+  return best;
 }
 
 }  // namespace impetus::test
