@@ -16,8 +16,8 @@ void ImpulseCoupling::take_impulse(std::size_t id, const ImpulseDelta& delta, co
                                    const RenderWindow&) {
   const double period_s = context_.world_period_s;
   const double magnitude_Ns = delta.impulse_Ns.norm();
-  // What the body's contacts hold of a steady push: their friction, and the part of its weight the supports do not
-  // carry where the push stands against it (a cube held on a slope).
+  // What the body's contacts hold of a steady push (header, H): their friction, and the part of its weight the
+  // supports do not carry where the push stands against it (a cube held on a slope).
   const auto body = static_cast<std::int32_t>(id);
   const ContactGraph& contacts = context_.engine.contacts();
   double holding_N = contacts.friction_capacity_N(body);
