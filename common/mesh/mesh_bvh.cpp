@@ -67,6 +67,87 @@ MeshBvh::MeshBvh(TriangleMesh mesh) : mesh_(std::move(mesh)) {
     build(0, static_cast<std::uint32_t>(n), centroids, 0);
   }
   pseudo_normals();
+  if (n > 0 && nodes_.front().count == 0) {
+    widen(0);
+    wide_.shrink_to_fit();  // grown by doubling: hold only what the tree uses
+  } else {  // no triangles, or a root that is a leaf: one wide node whose one child is that leaf, its box everywhere
+    WideNode root;
+    root.min_x.fill(1.0f);
+    root.min_y.fill(1.0f);
+    root.min_z.fill(1.0f);
+    root.max_x.fill(-1.0f);
+    root.max_y.fill(-1.0f);
+    root.max_z.fill(-1.0f);
+    root.child.fill(0);
+    root.count.fill(kNone);
+    if (n > 0) {
+      constexpr float kAll = std::numeric_limits<float>::infinity();
+      root.min_x[0] = root.min_y[0] = root.min_z[0] = -kAll;
+      root.max_x[0] = root.max_y[0] = root.max_z[0] = kAll;
+      root.child[0] = nodes_.front().first;
+      root.count[0] = nodes_.front().count;
+    }
+    wide_.push_back(root);
+  }
+}
+
+namespace {
+
+// A double rounded to the float at or below it, or at or above it: a float box holds the double one.
+float float_down(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+float float_up(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+}  // namespace
+
+std::uint32_t MeshBvh::widen(std::uint32_t node) {
+  const auto index = static_cast<std::uint32_t>(wide_.size());
+  wide_.emplace_back();
+  // The children that are leaves, and the grandchildren under those that are not.
+  std::array<std::uint32_t, 4> entries{};
+  std::size_t used = 0;
+  for (const std::uint32_t c : {node + 1, nodes_[node].first}) {
+    if (nodes_[c].count > 0) {
+      entries[used++] = c;
+    } else {
+      entries[used++] = c + 1;
+      entries[used++] = nodes_[c].first;
+    }
+  }
+  WideNode wide;
+  wide.child.fill(0);
+  wide.count.fill(kNone);
+  wide.min_x.fill(1.0f);
+  wide.min_y.fill(1.0f);
+  wide.min_z.fill(1.0f);
+  wide.max_x.fill(-1.0f);
+  wide.max_y.fill(-1.0f);
+  wide.max_z.fill(-1.0f);
+  for (std::size_t k = 0; k < used; ++k) {
+    const Node& entry = nodes_[entries[k]];
+    wide.min_x[k] = float_down(entry.bounds.min().x());
+    wide.min_y[k] = float_down(entry.bounds.min().y());
+    wide.min_z[k] = float_down(entry.bounds.min().z());
+    wide.max_x[k] = float_up(entry.bounds.max().x());
+    wide.max_y[k] = float_up(entry.bounds.max().y());
+    wide.max_z[k] = float_up(entry.bounds.max().z());
+    if (entry.count > 0) {
+      wide.child[k] = entry.first;
+      wide.count[k] = entry.count;
+    } else {
+      wide.child[k] = widen(entries[k]);
+      wide.count[k] = kInner;
+    }
+  }
+  wide_[index] = wide;  // after the recursion, which may have moved the array
+  return index;
 }
 
 std::uint32_t MeshBvh::build(std::uint32_t begin, std::uint32_t end, std::vector<Eigen::Vector3d>& centroids,
@@ -316,41 +397,6 @@ double segment_meets_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d
   return inverse * e2.dot(k);
 }
 
-// A way a + t·d, t in [0, 1], ready to be clipped to many boxes by the slab method: 1/d_i is taken once.
-class SegmentSlabs {
- public:
-  SegmentSlabs(const Eigen::Vector3d& a, const Eigen::Vector3d& d) : a_(a) {
-    for (int i = 0; i < 3; ++i) {
-      along_[i] = d[i] != 0.0;
-      inverse_[i] = along_[i] ? 1.0 / d[i] : 0.0;
-    }
-  }
-  // Whether some t in [0, t_max] puts the way in `box` grown by `margin_m` on every side; `t_enter` is the least.
-  bool enters(const Eigen::AlignedBox3d& box, double margin_m, double t_max, double& t_enter) const {
-    double t0 = 0.0, t1 = t_max;
-    for (int i = 0; i < 3; ++i) {
-      const double low = box.min()[i] - margin_m, high = box.max()[i] + margin_m;
-      if (!along_[i]) {
-        if (a_[i] < low || a_[i] > high) return false;
-        continue;
-      }
-      double near = (low - a_[i]) * inverse_[i];
-      double far = (high - a_[i]) * inverse_[i];
-      if (near > far) std::swap(near, far);
-      t0 = std::max(t0, near);
-      t1 = std::min(t1, far);
-      if (t0 > t1) return false;
-    }
-    t_enter = t0;
-    return true;
-  }
-
- private:
-  Eigen::Vector3d a_;
-  Eigen::Vector3d inverse_;
-  std::array<bool, 3> along_{};
-};
-
 }  // namespace
 
 bool MeshBvh::segment_crosses(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double t_min) const {
@@ -380,47 +426,24 @@ bool MeshBvh::segment_crosses(const Eigen::Vector3d& a, const Eigen::Vector3d& b
 
 bool MeshBvh::first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double tolerance_m,
                           const std::uint32_t* skip, int skip_count, MeshEntry& out) const {
-  if (nodes_.empty()) return false;
+  if (mesh_.triangles.empty()) return false;
   const Eigen::Vector3d d = b - a;
-  const SegmentSlabs way(a, d);
-  // Nearest box first, and a box the way enters later than the best crossing so far is skipped with all it holds: a
-  // crossing lies within tolerance_m of its triangle, so within that much of every box holding it, and is entered no
-  // earlier than that box. Ties go to the lower leaf position (the order a plain depth-first walk meets them in), so
-  // the answer does not depend on the order the boxes are taken in.
+  // The slab method per lane, in doubles: an axis the way does not move along is crossed at no t, and there the way
+  // is in the slab or not at all (a huge 1/d would give inf·0).
+  std::array<double, 3> origin{}, inverse{};
+  std::array<bool, 3> along{};
+  for (int i = 0; i < 3; ++i) {
+    const auto axis = static_cast<std::size_t>(i);
+    origin[axis] = a[i];
+    along[axis] = d[i] != 0.0;
+    inverse[axis] = along[axis] ? 1.0 / d[i] : 0.0;
+  }
+  // As the binary walk: nearest box first, a box the way enters after the best crossing skipped with all it holds,
+  // ties to the lower leaf position whatever the order boxes are taken in.
   double best_t = std::numeric_limits<double>::infinity();
   std::uint32_t best_position = 0;
-  struct Pending {
-    std::uint32_t node;
-    double t_enter;
-  };
-  std::array<Pending, kMaxDepth + 1> stack;
-  std::size_t top = 0;
-  double t_root = 0.0;
-  if (!way.enters(nodes_.front().bounds, tolerance_m, 1.0, t_root)) return false;
-  stack[top++] = {0, t_root};
-  while (top > 0) {
-    const Pending pending = stack[--top];
-    if (pending.t_enter > best_t) continue;
-    const Node& node = nodes_[pending.node];
-    const double t_max = std::min(1.0, best_t);
-    if (node.count == 0) {
-      const std::uint32_t left = pending.node + 1, right = node.first;
-      double t_left = 0.0, t_right = 0.0;
-      const bool in_left = way.enters(nodes_[left].bounds, tolerance_m, t_max, t_left);
-      const bool in_right = way.enters(nodes_[right].bounds, tolerance_m, t_max, t_right);
-      // Pushed later first, so the earlier is taken next. The depth is below kMaxDepth by construction.
-      if (in_left && in_right) {
-        const bool left_first = t_left <= t_right;
-        stack[top++] = left_first ? Pending{right, t_right} : Pending{left, t_left};
-        stack[top++] = left_first ? Pending{left, t_left} : Pending{right, t_right};
-      } else if (in_left) {
-        stack[top++] = {left, t_left};
-      } else if (in_right) {
-        stack[top++] = {right, t_right};
-      }
-      continue;
-    }
-    for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+  const auto test_leaf = [&](std::uint32_t first, std::uint32_t count) {
+    for (std::uint32_t i = first; i < first + count; ++i) {
       const std::uint32_t triangle = order_[i];
       if (std::find(skip, skip + skip_count, triangle) != skip + skip_count) continue;
       const auto& tri = mesh_.triangles[triangle];
@@ -440,6 +463,63 @@ bool MeshBvh::first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, do
       out.normal = n;
       out.t = t;
       out.triangle = triangle;
+    }
+  };
+  struct Pending {
+    std::uint32_t node;
+    double t_enter;
+  };
+  std::array<Pending, 3 * kMaxDepth + 4> stack;  // up to three pushed a level, half as many levels as the binary tree
+  std::size_t top = 0;
+  stack[top++] = {0, 0.0};
+  while (top > 0) {
+    const Pending pending = stack[--top];
+    if (pending.t_enter > best_t) continue;
+    const WideNode& node = wide_[pending.node];
+    const double t_max = std::min(1.0, best_t);
+    // The four boxes, grown by the tolerance, at once: t0 the latest entry, t1 the earliest exit, over the slabs.
+    std::array<double, 4> t0{}, t1{};
+    std::array<bool, 4> outside{};
+    const std::array<const std::array<float, 4>*, 3> low{&node.min_x, &node.min_y, &node.min_z};
+    const std::array<const std::array<float, 4>*, 3> high{&node.max_x, &node.max_y, &node.max_z};
+    for (std::size_t k = 0; k < 4; ++k) {
+      t0[k] = 0.0;
+      t1[k] = t_max;
+    }
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+      if (along[axis]) {
+        for (std::size_t k = 0; k < 4; ++k) {
+          const double near = (static_cast<double>((*low[axis])[k]) - tolerance_m - origin[axis]) * inverse[axis];
+          const double far = (static_cast<double>((*high[axis])[k]) + tolerance_m - origin[axis]) * inverse[axis];
+          t0[k] = std::max(t0[k], std::min(near, far));
+          t1[k] = std::min(t1[k], std::max(near, far));
+        }
+      } else {
+        for (std::size_t k = 0; k < 4; ++k) {
+          outside[k] = outside[k] || origin[axis] < static_cast<double>((*low[axis])[k]) - tolerance_m ||
+                       origin[axis] > static_cast<double>((*high[axis])[k]) + tolerance_m;
+        }
+      }
+    }
+    std::array<std::pair<double, std::size_t>, 4> hits;
+    int hit_count = 0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (node.count[k] == kNone || outside[k] || t0[k] > t1[k]) continue;
+      hits[static_cast<std::size_t>(hit_count++)] = {t0[k], k};
+    }
+    for (int h = 1; h < hit_count; ++h) {  // at most four: by insertion, nearest first
+      for (int g = h; g > 0 && hits[static_cast<std::size_t>(g)] < hits[static_cast<std::size_t>(g - 1)]; --g) {
+        std::swap(hits[static_cast<std::size_t>(g)], hits[static_cast<std::size_t>(g - 1)]);
+      }
+    }
+    // Leaves at once, nearest first; wide nodes pushed farthest first, so the nearest is taken next.
+    for (int h = 0; h < hit_count; ++h) {
+      const auto [t, k] = hits[static_cast<std::size_t>(h)];
+      if (node.count[k] != kInner && !(t > best_t)) test_leaf(node.child[k], node.count[k]);
+    }
+    for (int h = hit_count - 1; h >= 0; --h) {
+      const auto [t, k] = hits[static_cast<std::size_t>(h)];
+      if (node.count[k] == kInner && !(t > best_t)) stack[top++] = {node.child[k], t};
     }
   }
   return best_t <= 1.0;
@@ -474,8 +554,9 @@ bool MeshBvh::on_triangle(std::uint32_t triangle, const Eigen::Vector3d& x, doub
 std::size_t MeshBvh::memory_bytes() const {
   return mesh_.vertices_m.capacity() * sizeof(Eigen::Vector3d) +
          mesh_.triangles.capacity() * sizeof(mesh_.triangles[0]) + nodes_.capacity() * sizeof(Node) +
-         order_.capacity() * sizeof(std::uint32_t) + face_normals_.capacity() * sizeof(Eigen::Vector3d) +
-         edge_normals_.capacity() * sizeof(edge_normals_[0]) + vertex_normals_.capacity() * sizeof(Eigen::Vector3d);
+         wide_.capacity() * sizeof(WideNode) + order_.capacity() * sizeof(std::uint32_t) +
+         face_normals_.capacity() * sizeof(Eigen::Vector3d) + edge_normals_.capacity() * sizeof(edge_normals_[0]) +
+         vertex_normals_.capacity() * sizeof(Eigen::Vector3d);
 }
 
 }  // namespace impetus

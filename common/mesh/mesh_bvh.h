@@ -83,6 +83,19 @@ class MeshBvh {
     std::uint32_t first = 0;  // leaf: first index into order_; inner: the right child (the left is the next node)
     std::uint32_t count = 0;  // leaf: triangles; inner: 0
   };
+  // The tree again, each node folded with its children into one of four (a node's grandchildren where its child is
+  // not a leaf): half the levels, and a node's four boxes tested together, lane by lane (the test that takes more than
+  // half of a mesh tick, docs/meshes.md). Its boxes are floats rounded outward: they only prune, the triangles are
+  // tested exactly, so first_entry, which walks it, answers as the binary tree would.
+  struct alignas(64) WideNode {
+    std::array<float, 4> min_x, min_y, min_z, max_x, max_y, max_z;
+    std::array<std::uint32_t, 4> child;  // a leaf's first index into order_, or a wide node
+    std::array<std::uint32_t, 4> count;  // a leaf's triangles; kInner for a wide node; kNone for no child
+  };
+  static constexpr std::uint32_t kInner = 0, kNone = 0xFFFFFFFFu;
+  // Folds binary node `node` (not a leaf) and its subtree into wide_; returns its index there.
+  std::uint32_t widen(std::uint32_t node);
+
   static constexpr std::uint32_t kLeafTriangles = 4;
   static constexpr std::size_t kMaxDepth = 64;
 
@@ -101,6 +114,7 @@ class MeshBvh {
   TriangleMesh mesh_;
   // In huge pages where large (huge_pages.h), as the mesh's own arrays.
   HugeVector<Node> nodes_;
+  HugeVector<WideNode> wide_;  // wide_[0] is the root
   HugeVector<std::uint32_t> order_;                          // triangle indices, leaf by leaf
   HugeVector<Eigen::Vector3d> face_normals_;                 // unit
   HugeVector<std::array<Eigen::Vector3d, 3>> edge_normals_;  // per triangle, edges ab, bc, ca (unit)

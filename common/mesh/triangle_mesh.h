@@ -24,8 +24,8 @@ struct TriangleMesh {
 
 // Limits a mesh file must keep, each with its reason.
 struct MeshLimits {
-  // 2·10^6 triangles: a scanned object at fine resolution. The BVH and the checks hold about 200 bytes a triangle
-  // (docs/meshes.md), 400 MB at the limit, the most a desktop trial should ask of memory.
+  // 2·10^6 triangles: a scanned object at fine resolution. The BVH and the checks hold about 235 bytes a triangle
+  // (docs/meshes.md), 470 MB at the limit, the most a desktop trial should ask of memory.
   static constexpr std::size_t kMaxTriangles = 2'000'000;
   // A coordinate beyond 1 km is not a desk-sized object in metres: most likely millimetres read as metres, or garbage.
   static constexpr double kMaxCoordinate_m = 1000.0;

@@ -277,3 +277,64 @@ TEST_CASE("mesh: a box and a tessellated ball are convex, a dented ball, a box w
   valley.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
   CHECK_FALSE(MeshBvh(valley).locally_convex());
 }
+
+namespace {
+
+// The first entry by trying every triangle, as MeshBvh::first_entry defines it: `a` in front of the triangle's plane
+// or within the tolerance behind it, `b` behind it by more, and the crossing on the triangle to the tolerance; the
+// least t, and every triangle that gives it; triangle `skip` is not tried (−1: none).
+double brute_force_entry(const MeshBvh& tree, const TriangleMesh& mesh, const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b, double tolerance_m, int skip,
+                         std::vector<std::uint32_t>& at_least_t) {
+  const std::vector<Eigen::Vector3d> normals = face_normals(mesh);
+  double best = std::numeric_limits<double>::infinity();
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (static_cast<int>(t) == skip) continue;
+    const Eigen::Vector3d& p = mesh.vertices_m[mesh.triangles[t][0]];
+    const double height_a = normals[t].dot(a - p), height_b = normals[t].dot(b - p);
+    if (height_a < -tolerance_m || height_b >= -tolerance_m) continue;
+    const double s = height_a > 0.0 ? height_a / (height_a - height_b) : 0.0;
+    MeshEntry on;
+    if (s > best || !tree.on_triangle(t, a + s * (b - a), tolerance_m, on)) continue;
+    if (s < best) at_least_t.clear();
+    best = s;
+    at_least_t.push_back(t);
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("mesh: the first entry of a way agrees with trying every triangle, on spheres, a box and one triangle") {
+  TriangleMesh one;
+  one.vertices_m = {{-0.01, -0.01, 0.0}, {0.02, -0.01, 0.0}, {-0.01, 0.02, 0.0}};
+  one.triangles = {{0, 1, 2}};
+  std::vector<TriangleMesh> meshes = {icosphere(0.05, 1), icosphere(0.05, 4), box_mesh(Eigen::Vector3d(0.08, 0.05,
+                                                                                                       0.03)), one};
+  for (const TriangleMesh& mesh : meshes) {
+    CAPTURE(mesh.triangles.size());
+    const MeshBvh tree(mesh);
+    std::mt19937 random(5);
+    std::uniform_real_distribution<double> coordinate(-0.07, 0.07), step(-0.004, 0.004);
+    int entered = 0;
+    for (int q = 0; q < 4000; ++q) {
+      const Eigen::Vector3d a(coordinate(random), coordinate(random), coordinate(random));
+      Eigen::Vector3d b = q % 2 == 0 ? Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random))
+                                     : Eigen::Vector3d(a + Eigen::Vector3d(step(random), step(random), step(random)));
+      if (q % 5 == 0) b.z() = a.z();  // along a slab: a way that does not move along an axis
+      const std::uint32_t skip = static_cast<std::uint32_t>(q) % static_cast<std::uint32_t>(mesh.triangles.size());
+      const int skip_count = q % 3 == 0 ? 1 : 0;
+      std::vector<std::uint32_t> tied;
+      MeshEntry found;
+      const bool entry = tree.first_entry(a, b, 1e-9, &skip, skip_count, found);
+      const double brute =
+          brute_force_entry(tree, mesh, a, b, 1e-9, skip_count == 1 ? static_cast<int>(skip) : -1, tied);
+      REQUIRE(entry == (brute <= 1.0));
+      if (!entry) continue;
+      ++entered;
+      CHECK(found.t == brute);
+      CHECK(std::find(tied.begin(), tied.end(), found.triangle) != tied.end());
+    }
+    CHECK(entered > 10);  // ways that enter: 17 through the one triangle, thousands through the spheres
+  }
+}
