@@ -71,15 +71,7 @@ MeshBvh::MeshBvh(TriangleMesh mesh) : mesh_(std::move(mesh)) {
     widen(0);
     wide_.shrink_to_fit();  // grown by doubling: hold only what the tree uses
   } else {  // no triangles, or a root that is a leaf: one wide node whose one child is that leaf, its box everywhere
-    WideNode root;
-    root.min_x.fill(1.0f);
-    root.min_y.fill(1.0f);
-    root.min_z.fill(1.0f);
-    root.max_x.fill(-1.0f);
-    root.max_y.fill(-1.0f);
-    root.max_z.fill(-1.0f);
-    root.child.fill(0);
-    root.count.fill(kNone);
+    WideNode root = childless();
     if (n > 0) {
       constexpr float kAll = std::numeric_limits<float>::infinity();
       root.min_x[0] = root.min_y[0] = root.min_z[0] = -kAll;
@@ -107,6 +99,15 @@ float float_up(double x) {
 
 }  // namespace
 
+MeshBvh::WideNode MeshBvh::childless() {
+  WideNode node;
+  node.child.fill(0);
+  node.count.fill(kNone);
+  for (auto* low : {&node.min_x, &node.min_y, &node.min_z}) low->fill(1.0f);  // empty boxes: min above max
+  for (auto* high : {&node.max_x, &node.max_y, &node.max_z}) high->fill(-1.0f);
+  return node;
+}
+
 std::uint32_t MeshBvh::widen(std::uint32_t node) {
   const auto index = static_cast<std::uint32_t>(wide_.size());
   wide_.emplace_back();
@@ -121,15 +122,7 @@ std::uint32_t MeshBvh::widen(std::uint32_t node) {
       entries[used++] = nodes_[c].first;
     }
   }
-  WideNode wide;
-  wide.child.fill(0);
-  wide.count.fill(kNone);
-  wide.min_x.fill(1.0f);
-  wide.min_y.fill(1.0f);
-  wide.min_z.fill(1.0f);
-  wide.max_x.fill(-1.0f);
-  wide.max_y.fill(-1.0f);
-  wide.max_z.fill(-1.0f);
+  WideNode wide = childless();
   for (std::size_t k = 0; k < used; ++k) {
     const Node& entry = nodes_[entries[k]];
     wide.min_x[k] = float_down(entry.bounds.min().x());

@@ -93,6 +93,8 @@ class MeshBvh {
     std::array<std::uint32_t, 4> count;  // a leaf's triangles; kInner for a wide node; kNone for no child
   };
   static constexpr std::uint32_t kInner = 0, kNone = 0xFFFFFFFFu;
+  // A wide node with no children (every count kNone, every box empty).
+  static WideNode childless();
   // Folds binary node `node` (not a leaf) and its subtree into wide_; returns its index there.
   std::uint32_t widen(std::uint32_t node);
 
