@@ -423,16 +423,17 @@ bool MeshBvh::first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, do
   const Eigen::Vector3d d = b - a;
   // The slab method per lane, in doubles: an axis the way does not move along is crossed at no t, and there the way
   // is in the slab or not at all (a huge 1/d would give inf·0).
-  std::array<double, 3> origin{}, inverse{};
+  std::array<double, 3> inverse{};
   std::array<bool, 3> along{};
   for (int i = 0; i < 3; ++i) {
     const auto axis = static_cast<std::size_t>(i);
-    origin[axis] = a[i];
     along[axis] = d[i] != 0.0;
     inverse[axis] = along[axis] ? 1.0 / d[i] : 0.0;
   }
-  // As the binary walk: nearest box first, a box the way enters after the best crossing skipped with all it holds,
-  // ties to the lower leaf position whatever the order boxes are taken in.
+  // Nearest box first, and a box the way enters later than the best crossing so far is skipped with all it holds: a
+  // crossing lies within tolerance_m of its triangle, so within that much of every box holding it, and is entered no
+  // earlier than that box. Ties go to the lower leaf position, so the answer does not depend on the order the boxes
+  // are taken in.
   double best_t = std::numeric_limits<double>::infinity();
   std::uint32_t best_position = 0;
   const auto test_leaf = [&](std::uint32_t first, std::uint32_t count) {
@@ -482,15 +483,17 @@ bool MeshBvh::first_entry(const Eigen::Vector3d& a, const Eigen::Vector3d& b, do
     for (std::size_t axis = 0; axis < 3; ++axis) {
       if (along[axis]) {
         for (std::size_t k = 0; k < 4; ++k) {
-          const double near = (static_cast<double>((*low[axis])[k]) - tolerance_m - origin[axis]) * inverse[axis];
-          const double far = (static_cast<double>((*high[axis])[k]) + tolerance_m - origin[axis]) * inverse[axis];
+          const auto i = static_cast<Eigen::Index>(axis);
+          const double near = (static_cast<double>((*low[axis])[k]) - tolerance_m - a[i]) * inverse[axis];
+          const double far = (static_cast<double>((*high[axis])[k]) + tolerance_m - a[i]) * inverse[axis];
           t0[k] = std::max(t0[k], std::min(near, far));
           t1[k] = std::min(t1[k], std::max(near, far));
         }
       } else {
+        const double at = a[static_cast<Eigen::Index>(axis)];
         for (std::size_t k = 0; k < 4; ++k) {
-          outside[k] = outside[k] || origin[axis] < static_cast<double>((*low[axis])[k]) - tolerance_m ||
-                       origin[axis] > static_cast<double>((*high[axis])[k]) + tolerance_m;
+          outside[k] = outside[k] || at < static_cast<double>((*low[axis])[k]) - tolerance_m ||
+                       at > static_cast<double>((*high[axis])[k]) + tolerance_m;
         }
       }
     }
